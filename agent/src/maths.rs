@@ -1,0 +1,116 @@
+//! Numerical primitives shared by every module (DESIGN §5 "Conventions").
+//!
+//! Natural logarithms throughout; `ln x` is computed as `ln(max(x, 1e-16))` so
+//! that zero probabilities give a large finite penalty instead of `-inf`;
+//! softmax is max-subtracted.
+
+/// Floor applied before every logarithm (DESIGN §5): `ln x = ln(max(x, LN_FLOOR))`.
+pub const LN_FLOOR: f64 = 1e-16;
+
+/// Floored natural logarithm, `ln(max(x, 1e-16))` (DESIGN §5 conventions).
+#[inline]
+pub fn ln(x: f64) -> f64 {
+    x.max(LN_FLOOR).ln()
+}
+
+/// In-place softmax `σ(x)_i = exp(x_i - max x) / Σ_j exp(x_j - max x)`
+/// (the normalisation σ of §III eq. "iterative" and §IV eq. "gradient_descent_equations").
+pub fn softmax_in_place(x: &mut [f64]) {
+    let m = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !m.is_finite() {
+        let n = x.len() as f64;
+        x.iter_mut().for_each(|v| *v = 1.0 / n);
+        return;
+    }
+    let mut z = 0.0;
+    for v in x.iter_mut() {
+        *v = (*v - m).exp();
+        z += *v;
+    }
+    for v in x.iter_mut() {
+        *v /= z;
+    }
+}
+
+/// Softmax of a slice into a new vector (see [`softmax_in_place`]).
+pub fn softmax(x: &[f64]) -> Vec<f64> {
+    let mut v = x.to_vec();
+    softmax_in_place(&mut v);
+    v
+}
+
+/// `log_softmax(x)_i = x_i - ln Σ_j exp(x_j)`, computed stably. Used for the
+/// preferences `C = ln c = log_softmax(R / τ_c)` (DESIGN §5, §IV "EFE_0").
+pub fn log_softmax(x: &[f64]) -> Vec<f64> {
+    let m = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let lse = m + x.iter().map(|v| (v - m).exp()).sum::<f64>().ln();
+    x.iter().map(|v| v - lse).collect()
+}
+
+/// Kullback–Leibler divergence `KL[p || q] = Σ p_i (ln p_i - ln q_i)` with floored logs;
+/// terms with `p_i = 0` contribute 0 (§IV, eq. "stopping_criterion").
+pub fn kl(p: &[f64], q: &[f64]) -> f64 {
+    p.iter()
+        .zip(q)
+        .filter(|(pi, _)| **pi > 0.0)
+        .map(|(pi, qi)| pi * (ln(*pi) - ln(*qi)))
+        .sum()
+}
+
+/// Shannon entropy `H[p] = -Σ p_i ln p_i` in nats (zero terms contribute 0); Prop. 1 ambiguity.
+pub fn entropy(p: &[f64]) -> f64 {
+    -p.iter().filter(|x| **x > 0.0).map(|x| x * ln(*x)).sum::<f64>()
+}
+
+/// Normalise a non-negative vector to sum to 1 in place; a zero vector becomes uniform.
+/// Returns the sum before normalisation.
+pub fn normalize_in_place(x: &mut [f64]) -> f64 {
+    let z: f64 = x.iter().sum();
+    if z > 0.0 && z.is_finite() {
+        x.iter_mut().for_each(|v| *v /= z);
+    } else {
+        let n = x.len() as f64;
+        x.iter_mut().for_each(|v| *v = 1.0 / n);
+    }
+    z
+}
+
+/// Index of the largest entry, ties broken by the lowest index (deterministic mode).
+pub fn argmax(x: &[f64]) -> usize {
+    let mut best = 0;
+    for (i, v) in x.iter().enumerate() {
+        if *v > x[best] {
+            best = i;
+        }
+    }
+    best
+}
+
+/// Nats to bits (reporting only: DESIGN §5 says nats inside, bits when reported).
+pub fn nats_to_bits(x: f64) -> f64 {
+    x / std::f64::consts::LN_2
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn softmax_and_log_softmax_agree() {
+        let x = [1.0, 2.0, -3.0];
+        let s = softmax(&x);
+        let l = log_softmax(&x);
+        for (a, b) in s.iter().zip(&l) {
+            assert!((a.ln() - b).abs() < 1e-12);
+        }
+        assert!((s.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn kl_and_entropy_basics() {
+        assert!(kl(&[0.5, 0.5], &[0.5, 0.5]).abs() < 1e-15);
+        assert!((entropy(&[0.5, 0.5]) - 2f64.ln()).abs() < 1e-15);
+        assert_eq!(argmax(&[1.0, 3.0, 3.0]), 1);
+        assert!((ln(0.0) - (1e-16f64).ln()).abs() < 1e-12);
+    }
+}

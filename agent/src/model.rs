@@ -1,0 +1,400 @@
+//! The world model `W` (§II-A eq. "world model"; Dirichlet parameters §V):
+//! factor CPTs with Dirichlet counts, the joint `B[u]` materialised from them,
+//! the observation model `A` with Dirichlet counts, preferences `C` and the state prior `D`.
+
+use crate::error::{AgentError, ParamError};
+use crate::maths::{ln, log_softmax};
+use crate::params::ModelPriors;
+use crate::structure::Structure;
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+/// The plain matrices of a generative model (what perception and planning read):
+/// `A[o,s] = p(o|s)`, `B[u][(s',s)] = p(s'|s,u)`, `C = ln c` (normalised log
+/// preferences), `D = p(s_1)`, plus the derived `ln A`, `ln B` and the ambiguity
+/// `H_A[s] = -Σ_o A[o,s] ln A[o,s]` (Prop. 1).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GenerativeModel {
+    /// Observation model `A` (n_obs x n_states, column-stochastic).
+    pub a: DMatrix<f64>,
+    /// Elementwise floored `ln A`.
+    pub ln_a: DMatrix<f64>,
+    /// Ambiguity per state, `H_A[s]`.
+    pub h_a: Vec<f64>,
+    /// Whether `A` is exactly the identity (enables one-hot fast paths).
+    pub a_identity: bool,
+    /// Transition matrices `B[u]` (n_states x n_states, column-stochastic).
+    pub b: Vec<DMatrix<f64>>,
+    /// Elementwise floored `ln B[u]`.
+    pub ln_b: Vec<DMatrix<f64>>,
+    /// Log preferences over observations, `C = ln c` (a normalised log distribution).
+    pub c: Vec<f64>,
+    /// Initial state prior `D`.
+    pub d: Vec<f64>,
+}
+
+impl GenerativeModel {
+    /// Build from `A`, `B`, `C` (already normalised log preferences) and `D`, computing
+    /// the derived quantities. Shapes are the caller's responsibility (see `inspect`).
+    pub fn new(a: DMatrix<f64>, b: Vec<DMatrix<f64>>, c: Vec<f64>, d: Vec<f64>) -> Self {
+        let ln_a = a.map(ln);
+        let h_a = (0..a.ncols())
+            .map(|s| -(0..a.nrows()).map(|o| a[(o, s)] * ln_a[(o, s)]).sum::<f64>())
+            .collect();
+        let a_identity = a.is_square() && a == DMatrix::identity(a.nrows(), a.ncols());
+        let ln_b = b.iter().map(|m| m.map(ln)).collect();
+        GenerativeModel {
+            a,
+            ln_a,
+            h_a,
+            a_identity,
+            b,
+            ln_b,
+            c,
+            d,
+        }
+    }
+
+    /// Number of hidden states.
+    pub fn n_states(&self) -> usize {
+        self.a.ncols()
+    }
+    /// Number of observations.
+    pub fn n_obs(&self) -> usize {
+        self.a.nrows()
+    }
+    /// Number of actions.
+    pub fn n_actions(&self) -> usize {
+        self.b.len()
+    }
+}
+
+#[derive(Serialize, Deserialize, Clone)]
+struct WorldModelRepr {
+    structure: Structure,
+    n_actions: usize,
+    priors: ModelPriors,
+    cpt: Vec<Vec<f64>>,
+    a_counts: DMatrix<f64>,
+    c: Vec<f64>,
+    d: Vec<f64>,
+}
+
+/// The agent's world model (§II-A, §V): Dirichlet-count CPTs per factor, `A` counts,
+/// `C`, `D`, and the materialised joint [`GenerativeModel`] (derived, not serialised).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "WorldModelRepr", into = "WorldModelRepr")]
+pub struct WorldModel {
+    structure: Structure,
+    n_actions: usize,
+    priors: ModelPriors,
+    /// Per factor: counts laid out `[config * size + child]`, priors included.
+    cpt: Vec<Vec<f64>>,
+    a_counts: DMatrix<f64>,
+    gm: GenerativeModel,
+}
+
+impl From<WorldModel> for WorldModelRepr {
+    fn from(w: WorldModel) -> Self {
+        WorldModelRepr {
+            structure: w.structure,
+            n_actions: w.n_actions,
+            priors: w.priors,
+            cpt: w.cpt,
+            a_counts: w.a_counts,
+            c: w.gm.c,
+            d: w.gm.d,
+        }
+    }
+}
+
+impl TryFrom<WorldModelRepr> for WorldModel {
+    type Error = AgentError;
+    fn try_from(r: WorldModelRepr) -> Result<Self, AgentError> {
+        let n = r.structure.joint_size();
+        for (f, counts) in r.cpt.iter().enumerate() {
+            if f >= r.structure.factors().len() {
+                break;
+            }
+            let want = r.structure.n_configs(f, r.n_actions) * r.structure.factors()[f].size;
+            if counts.len() != want {
+                return Err(AgentError::SizeMismatch {
+                    what: format!("CPT counts of factor {f}"),
+                    expected: want,
+                    found: counts.len(),
+                });
+            }
+        }
+        if r.cpt.len() != r.structure.factors().len() {
+            return Err(AgentError::SizeMismatch {
+                what: "number of CPTs".into(),
+                expected: r.structure.factors().len(),
+                found: r.cpt.len(),
+            });
+        }
+        if r.a_counts.ncols() != n || r.c.len() != r.a_counts.nrows() || r.d.len() != n {
+            return Err(AgentError::SizeMismatch {
+                what: "A/C/D sizes".into(),
+                expected: n,
+                found: r.a_counts.ncols(),
+            });
+        }
+        let mut w = WorldModel {
+            gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], r.c, r.d),
+            structure: r.structure,
+            n_actions: r.n_actions,
+            priors: r.priors,
+            cpt: r.cpt,
+            a_counts: r.a_counts,
+        };
+        w.materialize();
+        Ok(w)
+    }
+}
+
+impl WorldModel {
+    /// A world model with prior counts only (§II-A): CPT cells get
+    /// `transition_concentration`, `A` is identity or noisy per [`ModelPriors`], `C` is
+    /// uniform (set it with [`WorldModel::set_preferences`]), `D` from the priors.
+    pub fn new(structure: Structure, n_actions: usize, priors: &ModelPriors) -> Result<WorldModel, AgentError> {
+        priors.check()?;
+        if n_actions == 0 {
+            return Err(ParamError::new("n_actions", 0, ">= 1").into());
+        }
+        let n = structure.joint_size();
+        let cpt = (0..structure.factors().len())
+            .map(|f| vec![priors.transition_concentration; structure.n_configs(f, n_actions) * structure.factors()[f].size])
+            .collect();
+        let mut a_counts = DMatrix::from_element(n, n, 0.0);
+        for s in 0..n {
+            for o in 0..n {
+                a_counts[(o, s)] = if n == 1 {
+                    priors.a_concentration
+                } else if o == s {
+                    priors.a_concentration * (1.0 - priors.a_noise)
+                } else {
+                    priors.a_concentration * priors.a_noise / (n - 1) as f64
+                };
+            }
+        }
+        let d = match &priors.d {
+            Some(d) if d.len() == n => d.clone(),
+            Some(d) => {
+                return Err(AgentError::SizeMismatch {
+                    what: "D".into(),
+                    expected: n,
+                    found: d.len(),
+                });
+            }
+            None => vec![1.0 / n as f64; n],
+        };
+        let c = vec![-(n as f64).ln(); n];
+        let mut w = WorldModel {
+            gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], c, d),
+            structure,
+            n_actions,
+            priors: priors.clone(),
+            cpt,
+            a_counts,
+        };
+        w.materialize();
+        Ok(w)
+    }
+
+    /// The factor structure.
+    pub fn structure(&self) -> &Structure {
+        &self.structure
+    }
+    /// Number of actions.
+    pub fn n_actions(&self) -> usize {
+        self.n_actions
+    }
+    /// Number of joint states.
+    pub fn n_states(&self) -> usize {
+        self.structure.joint_size()
+    }
+    /// The priors the model was built with.
+    pub fn priors(&self) -> &ModelPriors {
+        &self.priors
+    }
+    /// The materialised matrices.
+    pub fn generative(&self) -> &GenerativeModel {
+        &self.gm
+    }
+
+    /// Fully observed training (§V with one-hot posteriors): add one count to the
+    /// CPT cell of every factor for the transition `s --a--> s_next`. Call
+    /// [`WorldModel::materialize`] afterwards. Out-of-range indices are ignored.
+    pub fn observe_transition(&mut self, s: usize, a: usize, s_next: usize) {
+        let n = self.n_states();
+        if s >= n || s_next >= n || a >= self.n_actions {
+            return;
+        }
+        let prev = self.structure.decode(s);
+        let next = self.structure.decode(s_next);
+        for f in 0..self.cpt.len() {
+            let size = self.structure.factors()[f].size;
+            let cfg = self.structure.config_index(f, &prev, &next, a, self.n_actions);
+            self.cpt[f][cfg * size + next[f]] += 1.0;
+        }
+    }
+
+    /// Rebuild the joint `B[u][(s',s)] = Π_f p(s'_f | parents_f, u)` from CPT posterior
+    /// means, and `A` from its counts (§II-A; re-run after learning, §V).
+    pub fn materialize(&mut self) {
+        let n = self.n_states();
+        let nf = self.structure.factors().len();
+        // Posterior means of each CPT.
+        let means: Vec<Vec<f64>> = (0..nf)
+            .map(|f| {
+                let size = self.structure.factors()[f].size;
+                let mut m = self.cpt[f].clone();
+                for row in m.chunks_mut(size) {
+                    crate::maths::normalize_in_place(row);
+                }
+                m
+            })
+            .collect();
+        let decoded: Vec<Vec<usize>> = (0..n).map(|s| self.structure.decode(s)).collect();
+        let mut b = Vec::with_capacity(self.n_actions);
+        for u in 0..self.n_actions {
+            let mut m = DMatrix::zeros(n, n);
+            for (s, prev) in decoded.iter().enumerate() {
+                for (s2, next) in decoded.iter().enumerate() {
+                    let mut p = 1.0;
+                    for f in 0..nf {
+                        let size = self.structure.factors()[f].size;
+                        let cfg = self.structure.config_index(f, prev, next, u, self.n_actions);
+                        p *= means[f][cfg * size + next[f]];
+                        if p == 0.0 {
+                            break;
+                        }
+                    }
+                    m[(s2, s)] = p;
+                }
+            }
+            b.push(m);
+        }
+        let mut a = self.a_counts.clone();
+        for mut col in a.column_iter_mut() {
+            let z: f64 = col.sum();
+            if z > 0.0 {
+                col /= z;
+            }
+        }
+        let c = std::mem::take(&mut self.gm.c);
+        let d = std::mem::take(&mut self.gm.d);
+        self.gm = GenerativeModel::new(a, b, c, d);
+    }
+
+    /// `B[u]` (n_states x n_states, column-stochastic; entry `(s', s)`).
+    pub fn b(&self, u: usize) -> &DMatrix<f64> {
+        &self.gm.b[u]
+    }
+    /// `A` (entry `(o, s)`).
+    pub fn a(&self) -> &DMatrix<f64> {
+        &self.gm.a
+    }
+    /// Dirichlet counts of `A` (§V "Updating the World Model: Observation Model").
+    pub fn a_counts(&self) -> &DMatrix<f64> {
+        &self.a_counts
+    }
+    /// Mutable Dirichlet counts of `A` (call [`WorldModel::materialize`] afterwards).
+    pub fn a_counts_mut(&mut self) -> &mut DMatrix<f64> {
+        &mut self.a_counts
+    }
+    /// CPT counts of factor `f`, laid out `[config * size + child]`.
+    pub fn cpt_counts(&self, f: usize) -> &[f64] {
+        &self.cpt[f]
+    }
+    /// Mutable CPT counts of factor `f` (call [`WorldModel::materialize`] afterwards).
+    pub fn cpt_counts_mut(&mut self, f: usize) -> &mut [f64] {
+        &mut self.cpt[f]
+    }
+    /// Log preferences `C`.
+    pub fn c(&self) -> &[f64] {
+        &self.gm.c
+    }
+    /// State prior `D`.
+    pub fn d(&self) -> &[f64] {
+        &self.gm.d
+    }
+
+    /// Set `C = log_softmax(R / τ_c)` from per-observation rewards (DESIGN §5 "Preferences").
+    pub fn set_preferences(&mut self, rewards: &[f64], tau_c: f64) -> Result<(), AgentError> {
+        if rewards.len() != self.gm.n_obs() {
+            return Err(AgentError::SizeMismatch {
+                what: "rewards".into(),
+                expected: self.gm.n_obs(),
+                found: rewards.len(),
+            });
+        }
+        if !(tau_c > 0.0 && tau_c.is_finite()) {
+            return Err(ParamError::new("tau_c", tau_c, "finite and > 0").into());
+        }
+        let scaled: Vec<f64> = rewards.iter().map(|r| r / tau_c).collect();
+        self.gm.c = log_softmax(&scaled);
+        Ok(())
+    }
+
+    /// Set the initial state prior `D` (must have `n_states` non-negative entries summing to 1).
+    pub fn set_d(&mut self, d: &[f64]) -> Result<(), AgentError> {
+        if d.len() != self.n_states() {
+            return Err(AgentError::SizeMismatch {
+                what: "D".into(),
+                expected: self.n_states(),
+                found: d.len(),
+            });
+        }
+        if d.iter().any(|x| !(*x >= 0.0)) || (d.iter().sum::<f64>() - 1.0).abs() > 1e-9 {
+            return Err(ParamError::new("d", format!("{d:?}"), "non-negative and summing to 1").into());
+        }
+        self.gm.d = d.to_vec();
+        Ok(())
+    }
+
+    /// Posterior-mean probability `p(child' = child_value | parents = parent_values, u)`
+    /// of factor `factor` (parent values in the factor's parent order; `action` is used
+    /// only if the action is a parent). E.g. `P(p'=1 | p, L'=1, d'=2)` (§VI Fig. 9).
+    /// Returns NaN for out-of-range arguments.
+    pub fn cpt_prob(&self, factor: usize, child_value: usize, parent_values: &[usize], action: Option<usize>) -> f64 {
+        let Some(fac) = self.structure.factors().get(factor) else {
+            return f64::NAN;
+        };
+        if child_value >= fac.size || parent_values.len() != fac.parents.len() || action.is_some_and(|a| a >= self.n_actions) {
+            return f64::NAN;
+        }
+        let cfg = self.structure.config_from_parent_values(factor, parent_values, action, self.n_actions);
+        let row = &self.cpt[factor][cfg * fac.size..(cfg + 1) * fac.size];
+        let z: f64 = row.iter().sum();
+        if z > 0.0 { row[child_value] / z } else { 1.0 / fac.size as f64 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn b_is_column_stochastic_and_learns() {
+        let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
+        let mut w = WorldModel::new(st.clone(), 3, &ModelPriors::default()).unwrap();
+        for u in 0..3 {
+            for s in 0..64 {
+                let z: f64 = w.b(u).column(s).sum();
+                assert!((z - 1.0).abs() < 1e-12);
+            }
+        }
+        let s = st.encode(&[2, 1, 1, 0]);
+        let s2 = st.encode(&[1, 2, 1, 0]);
+        for _ in 0..100 {
+            w.observe_transition(s, 1, s2);
+        }
+        w.materialize();
+        assert!(w.b(1)[(s2, s)] > 0.8);
+        // p' | p=0, L'=1, d'=1: 101 counts on p'=0 out of 102.
+        assert!((w.cpt_prob(3, 0, &[0, 1, 1], None) - 101.0 / 102.0).abs() < 1e-12);
+        assert_eq!(w.a(), &DMatrix::identity(64, 64));
+        assert!(w.generative().a_identity);
+    }
+}

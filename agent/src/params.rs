@@ -1,0 +1,424 @@
+//! Hyperparameters in checked parameter types (linfa style: plain structs with
+//! documented defaults, `check()` returns a typed [`ParamError`] instead of panicking).
+//!
+//! Every constructor that takes parameters ([`crate::model::WorldModel::new`],
+//! [`crate::scaled::ScaledAgent::new`], [`crate::bayes_rl::BayesRl::new`],
+//! [`crate::q_learning::QLearning::try_new`]) calls `check()` and returns the error.
+//! Defaults follow the paper's §VI where it states them.
+
+use crate::error::ParamError;
+use serde::{Deserialize, Serialize};
+
+fn in_half_open01(name: &'static str, x: f64) -> Result<(), ParamError> {
+    if x > 0.0 && x <= 1.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, x, "in (0, 1]"))
+    }
+}
+fn in_closed01(name: &'static str, x: f64) -> Result<(), ParamError> {
+    if (0.0..=1.0).contains(&x) {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, x, "in [0, 1]"))
+    }
+}
+fn positive(name: &'static str, x: f64) -> Result<(), ParamError> {
+    if x > 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, x, "finite and > 0"))
+    }
+}
+fn non_negative(name: &'static str, x: f64) -> Result<(), ParamError> {
+    if x >= 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, x, "finite and >= 0"))
+    }
+}
+fn at_least_one(name: &'static str, x: usize) -> Result<(), ParamError> {
+    if x >= 1 {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, x, ">= 1"))
+    }
+}
+
+/// Priors of the world model's Dirichlet counts (§II-A world model, §V learning).
+///
+/// | field | default | range | meaning |
+/// |---|---|---|---|
+/// | `transition_concentration` | 1.0 | >= 0 | prior count added to every CPT cell (b0) |
+/// | `a_concentration` | 1000.0 | > 0 | total prior count of each column of A |
+/// | `a_noise` | 0.0 | [0, 1) | mass of each column of A spread uniformly over the other observations (0 = identity A) |
+/// | `d` | `None` (uniform) | length = states, sums to 1 | initial state prior D |
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelPriors {
+    /// Prior count per CPT cell (b0 >= 0). With 0, a parent configuration never seen is uniform.
+    pub transition_concentration: f64,
+    /// Total prior count per column of A (> 0).
+    pub a_concentration: f64,
+    /// Off-diagonal mass of A's columns in [0, 1): 0 gives the identity A (MDP, §VI).
+    pub a_noise: f64,
+    /// Initial state prior D; `None` means uniform.
+    pub d: Option<Vec<f64>>,
+}
+
+impl Default for ModelPriors {
+    fn default() -> Self {
+        Self {
+            transition_concentration: 1.0,
+            a_concentration: 1000.0,
+            a_noise: 0.0,
+            d: None,
+        }
+    }
+}
+
+impl ModelPriors {
+    /// Validate ranges (table above).
+    pub fn check(&self) -> Result<(), ParamError> {
+        non_negative("transition_concentration", self.transition_concentration)?;
+        positive("a_concentration", self.a_concentration)?;
+        if !(0.0..1.0).contains(&self.a_noise) {
+            return Err(ParamError::new("a_noise", self.a_noise, "in [0, 1)"));
+        }
+        if let Some(d) = &self.d {
+            let s: f64 = d.iter().sum();
+            if d.iter().any(|x| !(*x >= 0.0)) || (s - 1.0).abs() > 1e-9 {
+                return Err(ParamError::new("d", format!("{d:?}"), "non-negative and summing to 1"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How the scaled policy is computed (§IV Theorem 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum ScalingMode {
+    /// The iterative update of eq. "gradient_descent_equations" with eq. "stopping_criterion".
+    #[default]
+    Iterative,
+    /// The closed form of Theorem 1: `π' ∝ π_o ψ^θ`.
+    ClosedForm,
+}
+
+/// How the action is drawn from the policy acted upon (DESIGN §5 "Action selection").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum ActionSelection {
+    /// The mode (ties: lowest index). Default in evaluation.
+    #[default]
+    Mode,
+    /// Sample with the agent's seeded ChaCha8 RNG.
+    Sample,
+}
+
+/// When reasoning (VMP + planning + scaling) runs (§II footnote, §IV; ablation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum ReasoningMode {
+    /// Only when θ_t > ε (the paper's method).
+    #[default]
+    Triggered,
+    /// On every tick (ablation "scaled with reasoning on every tick").
+    Always,
+}
+
+/// Hyperparameters of the paper's agent ([`crate::scaled::ScaledAgent`]).
+///
+/// | field | default | range | paper |
+/// |---|---|---|---|
+/// | `omega` Ω | 0.425 | > 0 | §IV θ = 1 - exp(-Ω S), §VI |
+/// | `epsilon` ε | 0.2 | [0, 1) | §II reasoning trigger θ > ε, §VI |
+/// | `gamma` γ | 0.5 | > 0 | Cor. 1 q(π) = σ(-γG), §VI |
+/// | `varsigma` ς | 0.05 | >= 0 | eq. "stopping_criterion", §VI |
+/// | `kappa_pi` | 0.5 | (0, 1] | scaling step size (1 = the paper's full step) |
+/// | `max_scaling_iters` | 50 | >= 1 | cap of the scaling loop |
+/// | `horizon` H | 3 | 1..=8 | policy length (3^H policies) |
+/// | `vmp_window` W | 4 | >= 1 | VMP window (ticks) |
+/// | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
+/// | `vmp_tol` | 1e-6 | > 0 | VMP convergence threshold on max |Δ q| |
+/// | `vmp_max_iters` | 32 | >= 1 | VMP iteration cap |
+/// | `scaling_mode` | Iterative | | Theorem 1 iterative / closed form |
+/// | `action_selection` | Mode | | mode or sample |
+/// | `reasoning` | Triggered | | triggered or always (ablation) |
+/// | `learning` | true | | test-time learning §V at episode end |
+/// | `learning_rate` | 1.0 | >= 0 | multiplies the expected counts added in §V |
+/// | `nu0` ν0 | 10.0 | > 0 | prior strength of ν = ν0 σ(Q/T) (DESIGN §5) |
+/// | `nu_temperature` T | 1.0 | > 0 | temperature of ν's softmax over Q |
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ScaledParams {
+    /// Ω, saturation of the normalised surprise.
+    pub omega: f64,
+    /// ε, reasoning threshold on θ.
+    pub epsilon: f64,
+    /// γ, policy precision.
+    pub gamma: f64,
+    /// ς, stopping tolerance.
+    pub varsigma: f64,
+    /// Scaling step size in (0, 1].
+    pub kappa_pi: f64,
+    /// Maximum scaling iterations.
+    pub max_scaling_iters: u32,
+    /// Planning horizon H.
+    pub horizon: usize,
+    /// VMP window W.
+    pub vmp_window: usize,
+    /// VMP step size κ.
+    pub vmp_kappa: f64,
+    /// VMP tolerance.
+    pub vmp_tol: f64,
+    /// VMP iteration cap.
+    pub vmp_max_iters: u32,
+    /// Iterative or closed-form scaling.
+    pub scaling_mode: ScalingMode,
+    /// Mode or sample.
+    pub action_selection: ActionSelection,
+    /// Triggered or always.
+    pub reasoning: ReasoningMode,
+    /// Test-time learning on/off.
+    pub learning: bool,
+    /// Test-time learning rate.
+    pub learning_rate: f64,
+    /// ν0, prior strength of the policy counts.
+    pub nu0: f64,
+    /// T, temperature of the Q softmax that initialises ν.
+    pub nu_temperature: f64,
+}
+
+impl Default for ScaledParams {
+    fn default() -> Self {
+        Self {
+            omega: 0.425,
+            epsilon: 0.2,
+            gamma: 0.5,
+            varsigma: 0.05,
+            kappa_pi: 0.5,
+            max_scaling_iters: 50,
+            horizon: 3,
+            vmp_window: 4,
+            vmp_kappa: 1.0,
+            vmp_tol: 1e-6,
+            vmp_max_iters: 32,
+            scaling_mode: ScalingMode::Iterative,
+            action_selection: ActionSelection::Mode,
+            reasoning: ReasoningMode::Triggered,
+            learning: true,
+            learning_rate: 1.0,
+            nu0: 10.0,
+            nu_temperature: 1.0,
+        }
+    }
+}
+
+impl ScaledParams {
+    /// Validate ranges (table above).
+    pub fn check(&self) -> Result<(), ParamError> {
+        positive("omega", self.omega)?;
+        if !(0.0..1.0).contains(&self.epsilon) {
+            return Err(ParamError::new("epsilon", self.epsilon, "in [0, 1)"));
+        }
+        positive("gamma", self.gamma)?;
+        non_negative("varsigma", self.varsigma)?;
+        in_half_open01("kappa_pi", self.kappa_pi)?;
+        at_least_one("max_scaling_iters", self.max_scaling_iters as usize)?;
+        if !(1..=8).contains(&self.horizon) {
+            return Err(ParamError::new("horizon", self.horizon, "in 1..=8"));
+        }
+        at_least_one("vmp_window", self.vmp_window)?;
+        in_half_open01("vmp_kappa", self.vmp_kappa)?;
+        positive("vmp_tol", self.vmp_tol)?;
+        at_least_one("vmp_max_iters", self.vmp_max_iters as usize)?;
+        non_negative("learning_rate", self.learning_rate)?;
+        positive("nu0", self.nu0)?;
+        positive("nu_temperature", self.nu_temperature)?;
+        Ok(())
+    }
+}
+
+/// Hyperparameters of tabular Q-learning (§VI base policy).
+///
+/// | field | default | range | meaning |
+/// |---|---|---|---|
+/// | `alpha` | 0.1 | (0, 1] | learning rate |
+/// | `discount` | 0.95 | [0, 1] | discount factor |
+/// | `epsilon` | 1.0 | [0, 1] | initial exploration rate of ε-greedy |
+/// | `epsilon_decay` | 0.999 | (0, 1] | multiplicative decay per [`crate::q_learning::QLearning::decay_epsilon`] call |
+/// | `epsilon_min` | 0.05 | [0, epsilon] | floor of the decayed exploration rate |
+/// | `bias_action` | `Some(1)` ("speed up") | < n_actions | action whose initial Q gets `bias` (§VI velocity preference) |
+/// | `bias` | 1.0 | finite | initial Q of `bias_action` (others start at 0) |
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct QParams {
+    /// Learning rate α.
+    pub alpha: f64,
+    /// Discount factor.
+    pub discount: f64,
+    /// Initial ε of ε-greedy.
+    pub epsilon: f64,
+    /// Multiplicative ε decay.
+    pub epsilon_decay: f64,
+    /// Minimum ε.
+    pub epsilon_min: f64,
+    /// Action favoured at initialisation.
+    pub bias_action: Option<usize>,
+    /// Initial Q value of `bias_action`.
+    pub bias: f64,
+}
+
+impl Default for QParams {
+    fn default() -> Self {
+        Self {
+            alpha: 0.1,
+            discount: 0.95,
+            epsilon: 1.0,
+            epsilon_decay: 0.999,
+            epsilon_min: 0.05,
+            bias_action: Some(1),
+            bias: 1.0,
+        }
+    }
+}
+
+impl QParams {
+    /// Validate ranges (table above; `bias_action` is checked against `n_actions` by
+    /// [`crate::q_learning::QLearning::try_new`]).
+    pub fn check(&self) -> Result<(), ParamError> {
+        in_half_open01("alpha", self.alpha)?;
+        in_closed01("discount", self.discount)?;
+        in_closed01("epsilon", self.epsilon)?;
+        in_half_open01("epsilon_decay", self.epsilon_decay)?;
+        if !(0.0..=self.epsilon).contains(&self.epsilon_min) {
+            return Err(ParamError::new("epsilon_min", self.epsilon_min, "in [0, epsilon]"));
+        }
+        if !self.bias.is_finite() {
+            return Err(ParamError::new("bias", self.bias, "finite"));
+        }
+        Ok(())
+    }
+}
+
+/// Planner of the Bayesian-RL baseline (§VI).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Planner {
+    /// Value iteration on the posterior-mean MDP, warm-started from the previous values.
+    ValueIteration {
+        /// Maximum sweeps per tick.
+        iterations: u32,
+        /// Stop when the largest value change is below this.
+        tol: f64,
+    },
+    /// Finite-horizon lookahead (backward induction over `horizon` steps).
+    Lookahead {
+        /// Depth.
+        horizon: usize,
+    },
+}
+
+/// Transition model of the Bayesian-RL baseline.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum BayesModel {
+    /// Flat Dirichlet posterior over joint transitions (the paper's baseline).
+    Flat,
+    /// The factored model of [`crate::structure::Structure`] (ablation).
+    Factored(crate::structure::Structure),
+}
+
+/// Hyperparameters of the Bayesian-RL baseline.
+///
+/// | field | default | range | meaning |
+/// |---|---|---|---|
+/// | `prior_concentration` | 0.1 | >= 0 | Dirichlet prior count per successor state |
+/// | `discount` | 0.95 | [0, 1) | discount of the planner |
+/// | `planner` | ValueIteration{200, 1e-6} | iterations >= 1, tol > 0, horizon >= 1 | |
+/// | `model` | Flat | | flat or factored |
+/// | `learn_online` | true | | update the posterior from `Controller::observe` at test time |
+/// | `reward_prior` | 0.0 | finite | mean reward assumed for unvisited (s, a) |
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct BayesRlParams {
+    /// Prior concentration.
+    pub prior_concentration: f64,
+    /// Discount.
+    pub discount: f64,
+    /// Planner.
+    pub planner: Planner,
+    /// Transition model.
+    pub model: BayesModel,
+    /// Online updates at test time.
+    pub learn_online: bool,
+    /// Reward of unvisited pairs.
+    pub reward_prior: f64,
+}
+
+impl Default for BayesRlParams {
+    fn default() -> Self {
+        Self {
+            prior_concentration: 0.1,
+            discount: 0.95,
+            planner: Planner::ValueIteration {
+                iterations: 200,
+                tol: 1e-6,
+            },
+            model: BayesModel::Flat,
+            learn_online: true,
+            reward_prior: 0.0,
+        }
+    }
+}
+
+impl BayesRlParams {
+    /// Validate ranges (table above).
+    pub fn check(&self) -> Result<(), ParamError> {
+        non_negative("prior_concentration", self.prior_concentration)?;
+        if !(0.0..1.0).contains(&self.discount) {
+            return Err(ParamError::new("discount", self.discount, "in [0, 1)"));
+        }
+        match self.planner {
+            Planner::ValueIteration { iterations, tol } => {
+                at_least_one("planner.iterations", iterations as usize)?;
+                positive("planner.tol", tol)?;
+            }
+            Planner::Lookahead { horizon } => at_least_one("planner.horizon", horizon)?,
+        }
+        if !self.reward_prior.is_finite() {
+            return Err(ParamError::new("reward_prior", self.reward_prior, "finite"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_match_paper() {
+        let p = ScaledParams::default();
+        p.check().unwrap();
+        assert_eq!((p.omega, p.epsilon, p.gamma, p.varsigma), (0.425, 0.2, 0.5, 0.05));
+        QParams::default().check().unwrap();
+        BayesRlParams::default().check().unwrap();
+        ModelPriors::default().check().unwrap();
+    }
+
+    #[test]
+    fn invalid_values_are_typed_errors() {
+        let p = ScaledParams {
+            omega: -1.0,
+            ..Default::default()
+        };
+        assert_eq!(p.check().unwrap_err().name, "omega");
+        let q = QParams {
+            alpha: 0.0,
+            ..Default::default()
+        };
+        assert_eq!(q.check().unwrap_err().name, "alpha");
+        let b = BayesRlParams {
+            discount: 1.0,
+            ..Default::default()
+        };
+        assert_eq!(b.check().unwrap_err().name, "discount");
+    }
+}
