@@ -1,0 +1,23 @@
+//! `unforeseen inspect --model FILE.json`: the agent's math on a single-factor model in
+//! pymdp's layout, for cross-checking against the reference library.
+
+use clap::Args;
+use std::path::PathBuf;
+
+use super::BadInput;
+
+/// Arguments of `inspect`.
+#[derive(Debug, Clone, Args)]
+pub struct InspectArgs {
+    /// Model JSON: {"A", "B", "C", "D", "obs", "actions", "policy_len", "gamma"}.
+    #[arg(long, value_name = "FILE.json")]
+    pub model: PathBuf,
+}
+
+/// Runs `inspect`, printing the report as JSON on stdout.
+pub fn run(args: InspectArgs) -> anyhow::Result<()> {
+    let text = std::fs::read_to_string(&args.model).map_err(|e| BadInput(format!("{}: cannot read ({e})", args.model.display())))?;
+    let out = unforeseen_agent::inspect::inspect_json(&text).map_err(|e| BadInput(format!("{}: {e}", args.model.display())))?;
+    println!("{out}");
+    Ok(())
+}

@@ -1,0 +1,120 @@
+//! The command line (clap). Each command lives in its own file; library errors become
+//! messages here, and bad input (maps, agent files, arguments) exits with code 2.
+
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use unforeseen_agent::persist::AgentBundle;
+use unforeseen_agent::params::ScaledParams;
+
+use crate::training::{TrainConfig, train};
+
+pub mod batch;
+pub mod check_map;
+pub mod compare;
+pub mod eval;
+pub mod inspect;
+pub mod learn;
+pub mod params;
+pub mod plot_sweep;
+pub mod trace;
+pub mod train;
+
+/// Bad input from the user (a map, an agent file, an argument): exit code 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+/// Active inference as the test-time scaling law for physical AI agents, on a Rapier 2D
+/// intersection. With no command, runs `compare` on the embedded default maps.
+#[derive(Debug, Parser)]
+#[command(name = "unforeseen", version, about, long_about = None)]
+pub struct Cli {
+    /// What to run (default: `compare` on the embedded maps).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Train on a map and compare Q-learning, Bayesian RL and the scaled agent on a test map (the paper's table).
+    Compare(compare::CompareArgs),
+    /// Train Q-learning, the world model and Bayesian RL on a map; write an agent file.
+    Train(train::TrainArgs),
+    /// Evaluate one method of a trained agent on a map.
+    Eval(eval::EvalArgs),
+    /// Run one episode step by step: table, CSV, surprise plot and filmstrip.
+    Trace(trace::TraceArgs),
+    /// Test-time learning curves over repeated episodes (paper Fig. 9).
+    Learn(learn::LearnArgs),
+    /// Validate map files and print a readable summary.
+    CheckMap(check_map::CheckMapArgs),
+    /// Run scenario suites headless: every map x method x parameter set, in parallel, as JSON Lines, with expectations.
+    Batch(batch::BatchArgs),
+    /// Plot a sweep's results (success and reward against reasoning compute) as SVG.
+    PlotSweep(plot_sweep::PlotSweepArgs),
+    /// Cross-check the agent's math on a single-factor model given as JSON (pymdp layout).
+    Inspect(inspect::InspectArgs),
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command.unwrap_or_else(|| Command::Compare(compare::CompareArgs::default())) {
+        Command::Compare(args) => compare::run(args),
+        Command::Train(args) => train::run(args),
+        Command::Eval(args) => eval::run(args),
+        Command::Trace(args) => trace::run(args),
+        Command::Learn(args) => learn::run(args),
+        Command::CheckMap(args) => check_map::run(args),
+        Command::Inspect(args) => inspect::run(args),
+        Command::Batch(args) => batch::run_cli(args),
+        Command::PlotSweep(args) => plot_sweep::run(args),
+    }
+}
+
+/// Whether an error (or anything in its chain) is bad input, to pick exit code 2.
+pub fn is_bad_input(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| {
+        e.is::<BadInput>() || e.is::<crate::maps::MapLookupError>() || e.is::<unforeseen_sim::MapError>()
+    })
+}
+
+/// Options shared by the commands that drive a trained agent.
+#[derive(Debug, Clone, Args)]
+pub struct AgentArgs {
+    /// Agent file from `unforeseen train`; without it, one is trained first on the
+    /// embedded training map (`intersection`) with the default episodes and this seed.
+    #[arg(long, value_name = "FILE")]
+    pub agent: Option<PathBuf>,
+    /// Scaled-agent parameter overrides, e.g. `--set omega=0.3 --set horizon=2`
+    /// (keys: omega, epsilon, gamma, varsigma, horizon, kappa_pi, vmp_window, max_scaling_iters, nu0, nu_temperature, learning_rate, sample).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl AgentArgs {
+    /// Loads the agent file, or trains one on the embedded training map.
+    pub fn bundle(&self, seed: u64, quiet: bool) -> anyhow::Result<AgentBundle> {
+        match &self.agent {
+            Some(path) => crate::agent_file::load(path),
+            None => {
+                let map = crate::maps::load("intersection")?;
+                let cfg = TrainConfig { quiet, ..TrainConfig::new(compare::DEFAULT_TRAIN_EPISODES, seed) };
+                if !quiet {
+                    eprintln!("no --agent given: training on the embedded 'intersection' map ({} episodes, seed {seed})", cfg.episodes);
+                }
+                Ok(train(&map, &cfg)?.0)
+            }
+        }
+    }
+
+    /// The scaled agent's parameters with the `--set` overrides applied.
+    pub fn params(&self) -> anyhow::Result<ScaledParams> {
+        params::apply(ScaledParams::default(), &self.set)
+    }
+}
+
+/// `--out` folder handling shared by the commands.
+pub fn out_dir(out: &Option<PathBuf>, default: &str) -> PathBuf {
+    out.clone().unwrap_or_else(|| PathBuf::from(default))
+}

@@ -1,0 +1,50 @@
+//! `--set KEY=VALUE` overrides of the scaled agent's parameters (also used by sweeps).
+
+use unforeseen_agent::params::{ActionSelection, ScaledParams};
+
+use super::BadInput;
+
+/// The keys `--set` accepts.
+pub const KEYS: &[&str] = &[
+    "omega", "epsilon", "gamma", "varsigma", "horizon", "kappa_pi", "vmp_window", "max_scaling_iters", "nu0", "nu_temperature", "learning_rate", "sample",
+];
+
+/// Applies `KEY=VALUE` overrides in order, then checks the result.
+pub fn apply(mut p: ScaledParams, sets: &[String]) -> anyhow::Result<ScaledParams> {
+    for set in sets {
+        let (key, value) = set
+            .split_once('=')
+            .ok_or_else(|| BadInput(format!("--set {set}: expected KEY=VALUE, e.g. --set omega=0.425 (keys: {})", KEYS.join(", "))))?;
+        set_one(&mut p, key.trim(), value.trim())?;
+    }
+    p.check().map_err(|e| BadInput(format!("--set: {e}")))?;
+    Ok(p)
+}
+
+/// Sets one parameter by name.
+pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), BadInput> {
+    let float = || value.parse::<f64>().map_err(|_| BadInput(format!("--set {key}={value}: '{value}' is not a number")));
+    let int = || value.parse::<usize>().map_err(|_| BadInput(format!("--set {key}={value}: '{value}' is not a whole number")));
+    match key {
+        "omega" => p.omega = float()?,
+        "epsilon" => p.epsilon = float()?,
+        "gamma" => p.gamma = float()?,
+        "varsigma" => p.varsigma = float()?,
+        "horizon" => p.horizon = int()?,
+        "kappa_pi" => p.kappa_pi = float()?,
+        "vmp_window" => p.vmp_window = int()?,
+        "max_scaling_iters" => p.max_scaling_iters = int()? as u32,
+        "nu0" => p.nu0 = float()?,
+        "nu_temperature" => p.nu_temperature = float()?,
+        "learning_rate" => p.learning_rate = float()?,
+        "sample" => {
+            p.action_selection = match value {
+                "true" | "1" | "yes" => ActionSelection::Sample,
+                "false" | "0" | "no" => ActionSelection::Mode,
+                _ => return Err(BadInput(format!("--set sample={value}: expected true or false"))),
+            }
+        }
+        _ => return Err(BadInput(format!("--set {key}: unknown parameter; known: {}", KEYS.join(", ")))),
+    }
+    Ok(())
+}

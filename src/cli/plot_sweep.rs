@@ -1,0 +1,91 @@
+//! `unforeseen plot-sweep results.jsonl`: the measured test-time scaling law — success
+//! and reward against reasoning compute, one panel pair per swept parameter.
+
+use clap::Args;
+use plotters::style::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED, RGBColor};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use super::BadInput;
+use crate::batch::read_lines;
+use crate::plots::{Series, line_panels};
+
+/// Arguments of `plot-sweep`.
+#[derive(Debug, Clone, Args)]
+pub struct PlotSweepArgs {
+    /// Results file written by `unforeseen batch --set ...`.
+    #[arg(value_name = "RESULTS.jsonl")]
+    pub results: PathBuf,
+    /// Output SVG.
+    #[arg(long, value_name = "FILE", default_value = "sweep.svg")]
+    pub out: PathBuf,
+}
+
+const COLORS: [RGBColor; 6] = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
+
+/// Runs `plot-sweep`.
+pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
+    let lines = read_lines(&args.results)?;
+    if lines.is_empty() {
+        return Err(BadInput(format!("{}: no result lines; run `unforeseen batch --set KEY=V1,V2 --out {}` first", args.results.display(), args.results.display())).into());
+    }
+    // Swept keys: those taking more than one numeric value.
+    let mut values: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for l in &lines {
+        for (k, v) in &l.params {
+            if let Ok(x) = v.parse::<f64>() {
+                values.entry(k.clone()).or_default().push(x);
+            }
+        }
+    }
+    let keys: Vec<String> = values.into_iter().filter(|(_, v)| v.iter().any(|x| *x != v[0])).map(|(k, _)| k).collect();
+    let mut x_axes: Vec<(String, Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>>)> = keys
+        .iter()
+        .map(|k| {
+            let key = k.clone();
+            let f: Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>> =
+                Box::new(move |l| l.params.iter().find(|(kk, _)| *kk == key).and_then(|(_, v)| v.parse().ok()));
+            (k.clone(), f)
+        })
+        .collect();
+    x_axes.push(("EFE mat-vecs per tick (reasoning compute)".into(), Box::new(|l| Some(l.efe_matvecs_per_tick))));
+
+    let mut panels = Vec::new();
+    let groups: Vec<(String, String)> = {
+        let mut g: Vec<(String, String)> = lines.iter().map(|l| (l.scenario.clone(), l.method.clone())).collect();
+        g.sort();
+        g.dedup();
+        g
+    };
+    for (name, x_of) in &x_axes {
+        for (figure, y_of) in [("success rate", (|l: &crate::batch::ResultLine| l.success_rate) as fn(&_) -> f64), ("mean reward", |l| l.mean_reward)] {
+            let series = groups
+                .iter()
+                .enumerate()
+                .map(|(i, (scenario, method))| {
+                    let mut points: Vec<(f64, f64)> = lines
+                        .iter()
+                        .filter(|l| &l.scenario == scenario && &l.method == method)
+                        .filter_map(|l| x_of(l).map(|x| (x, y_of(l))))
+                        .collect();
+                    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                    Series { label: "", points, color: COLORS[i % COLORS.len()] }
+                })
+                .collect::<Vec<_>>();
+            panels.push((format!("{figure} vs {name}"), series));
+        }
+    }
+    let labels: Vec<String> = groups.iter().map(|(s, m)| format!("{s} / {m}")).collect();
+    let panels: Vec<(&str, Vec<Series<'_>>)> = panels
+        .iter()
+        .map(|(title, series)| {
+            (
+                title.as_str(),
+                series.iter().zip(&labels).map(|(s, label)| Series { label, points: s.points.clone(), color: s.color }).collect(),
+            )
+        })
+        .collect();
+    line_panels(&args.out, "parameter value", &panels)?;
+    println!("wrote {} ({} panels over {} result lines)", args.out.display(), panels.len(), lines.len());
+    Ok(())
+}

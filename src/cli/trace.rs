@@ -1,0 +1,82 @@
+//! `unforeseen trace`: one episode step by step (paper Figs. 6-7).
+
+use clap::Args;
+use std::path::PathBuf;
+
+use super::{AgentArgs, out_dir};
+use crate::experiments::trace;
+use crate::maps;
+use crate::methods::Method;
+use crate::plots::{filmstrip, theta_trace};
+use crate::report::{Csv, num};
+
+/// Arguments of `trace`.
+#[derive(Debug, Clone, Args)]
+pub struct TraceArgs {
+    /// Map (file or embedded name).
+    #[arg(long, default_value = "jaywalk")]
+    pub map: String,
+    /// Method to trace.
+    #[arg(long, value_enum, default_value_t = Method::Scaled)]
+    pub method: Method,
+    /// Run seed (the episode is the first evaluation episode of this seed).
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    /// Output folder for trace.csv, theta.svg and filmstrip.svg.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// No progress bars.
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Trained agent and parameter overrides.
+    #[command(flatten)]
+    pub agent: AgentArgs,
+}
+
+fn mode(reasoned: bool) -> &'static str {
+    if reasoned { "reasoning" } else { "feed-forward" }
+}
+
+/// Runs `trace`.
+pub fn run(args: TraceArgs) -> anyhow::Result<()> {
+    let map = maps::load(&args.map)?;
+    let params = args.agent.params()?;
+    let bundle = args.agent.bundle(args.seed, args.quiet)?;
+    let (result, ticks) = trace(&bundle, &params, args.method, &map, args.seed)?;
+    let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
+    println!("{} on '{}', seed {}", args.method, map.name, args.seed);
+    println!("{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}", "step", "d", "v", "L", "p", "action", "mode", "S(nats)", "theta", "reward");
+    let mut csv = Csv::new(&["step", "d", "v", "L", "p", "action", "mode", "surprise_nats", "theta", "reward", "car_x", "car_speed", "light"]);
+    let decided = &ticks[..ticks.len().saturating_sub(1)];
+    for t in decided {
+        let s = t.state;
+        println!(
+            "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8.2}",
+            t.step, s.d, s.v, s.l, s.p, t.action.to_string(), mode(t.reasoned), opt(t.surprise, 3), opt(t.theta, 3), t.reward
+        );
+        csv.row(vec![
+            t.step.to_string(),
+            s.d.to_string(),
+            s.v.to_string(),
+            s.l.to_string(),
+            s.p.to_string(),
+            t.action.to_string(),
+            mode(t.reasoned).into(),
+            opt(t.surprise, 6),
+            opt(t.theta, 6),
+            num(t.reward, 4),
+            num(t.snapshot.car_x, 3),
+            num(t.snapshot.car_speed, 3),
+            format!("{:?}", t.snapshot.light),
+        ]);
+    }
+    let outcome = if result.success { "reached the destination" } else if result.collision { "hit a pedestrian" } else { "ran out of time" };
+    println!("{outcome} after {} ticks, return {:.2}, reasoned on {} ticks", result.ticks, result.ret, result.reasoning_ticks);
+    let dir = out_dir(&args.out, "out/trace");
+    csv.write(&dir.join("trace.csv"))?;
+    let points: Vec<_> = decided.iter().map(|t| (t.step, t.theta.unwrap_or(0.0), t.reasoned, t.action.to_string())).collect();
+    theta_trace(&dir.join("theta.svg"), &format!("{} on {}: normalized surprise", args.method, map.name), &points, params.epsilon)?;
+    filmstrip(&dir.join("filmstrip.svg"), &map, &ticks)?;
+    println!("wrote {}/trace.csv, theta.svg, filmstrip.svg", dir.display());
+    Ok(())
+}

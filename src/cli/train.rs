@@ -1,0 +1,47 @@
+//! `unforeseen train`: learn on a map and write an agent file.
+
+use clap::Args;
+use std::path::PathBuf;
+
+use crate::maps;
+use crate::training::{TrainConfig, train};
+
+/// Arguments of `train`.
+#[derive(Debug, Clone, Args)]
+pub struct TrainArgs {
+    /// Training map (file or embedded name).
+    #[arg(long, default_value = "intersection")]
+    pub map: String,
+    /// Training episodes.
+    #[arg(long, default_value_t = super::compare::DEFAULT_TRAIN_EPISODES)]
+    pub episodes: u64,
+    /// Run seed.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    /// Agent file to write (RON).
+    #[arg(long, value_name = "FILE", default_value = "agent.ron")]
+    pub out: PathBuf,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Runs `train`.
+pub fn run(args: TrainArgs) -> anyhow::Result<()> {
+    let map = maps::load(&args.map)?;
+    let cfg = TrainConfig { quiet: args.quiet, ..TrainConfig::new(args.episodes, args.seed) };
+    let started = std::time::Instant::now();
+    let (bundle, log) = train(&map, &cfg)?;
+    let tail = &log.returns[log.returns.len().saturating_sub(100)..];
+    let mean = if tail.is_empty() { 0.0 } else { tail.iter().sum::<f64>() / tail.len() as f64 };
+    crate::agent_file::save(&args.out, &bundle)?;
+    println!(
+        "trained on '{}' for {} episodes in {:.1} s (mean return of the last {} with exploration: {mean:.2}); wrote {}",
+        map.name,
+        args.episodes,
+        started.elapsed().as_secs_f64(),
+        tail.len(),
+        args.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,36 @@
+//! # unforeseen
+//!
+//! Active inference as the test-time scaling law for physical AI agents, on a real
+//! physics engine. This crate wires the pieces of the paper's §VI experiment:
+//!
+//! ```text
+//! map.ron -> sim::World --snapshot--> discretizer --state/obs--> agent --action--> sim
+//!                        \--events (collision, goal)--------------------> runner (reward, metrics)
+//! ```
+//!
+//! * [`maps`] finds a map by path or by embedded name;
+//! * [`rewards`] turns a map's reward section into per-tick rewards and the agent's
+//!   per-state preferences (the C vector of §IV);
+//! * [`training`] learns Q-learning, the world model and Bayesian RL on the same episodes;
+//! * [`runner`] drives one episode of any [`unforeseen_agent::controller::Controller`];
+//! * [`methods`] builds the three compared methods (§VI) and their ablations;
+//! * [`metrics`] aggregates episodes into the paper's table;
+//! * [`experiments`] runs `compare`, `trace` and `learn`;
+//! * [`report`] writes JSON/CSV atomically and [`plots`] draws SVG figures;
+//! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
+//! * [`cli`] is the command line.
+
+pub mod agent_file;
+pub mod batch;
+pub mod cli;
+pub mod experiments;
+pub mod maps;
+pub mod methods;
+pub mod metrics;
+pub mod plots;
+pub mod progress;
+pub mod report;
+pub mod rewards;
+pub mod runner;
+pub mod seeds;
+pub mod training;

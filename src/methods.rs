@@ -1,0 +1,101 @@
+//! The methods compared in §VI, and the ablations of DESIGN.md §6, built from one
+//! trained [`AgentBundle`] so every method shares the same training data.
+
+use unforeseen_agent::bayes_rl::BayesRl;
+use unforeseen_agent::controller::Controller;
+use unforeseen_agent::persist::AgentBundle;
+use unforeseen_agent::params::{ReasoningMode, ScaledParams};
+use unforeseen_agent::scaled::ScaledAgent;
+
+/// A method (or ablation) the runner can drive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Tabular Q-learning, greedy on its Q-table; never reasons.
+    QLearning,
+    /// Model-based Bayesian RL on a flat Dirichlet joint-transition posterior; plans every tick.
+    BayesRl,
+    /// The paper's agent: Q-learning policy as pi_o, surprise-triggered reasoning,
+    /// test-time scaling and test-time learning.
+    Scaled,
+    /// Ablation: Bayesian RL planning on the factored world model instead of the flat one.
+    BayesRlFactored,
+    /// Ablation: the scaled agent reasoning on every tick.
+    ScaledAlways,
+    /// Ablation: the scaled agent without test-time learning.
+    ScaledNoLearning,
+}
+
+impl Method {
+    /// The three methods of the paper's table.
+    pub const PAPER: [Method; 3] = [Method::QLearning, Method::BayesRl, Method::Scaled];
+    /// The ablations of DESIGN.md §6.
+    pub const ABLATIONS: [Method; 3] = [Method::BayesRlFactored, Method::ScaledAlways, Method::ScaledNoLearning];
+
+    /// The name used on the command line and in result files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::QLearning => "q-learning",
+            Method::BayesRl => "bayes-rl",
+            Method::Scaled => "scaled",
+            Method::BayesRlFactored => "bayes-rl-factored",
+            Method::ScaledAlways => "scaled-always",
+            Method::ScaledNoLearning => "scaled-no-learning",
+        }
+    }
+
+    /// The paper's reported figures for this method (§VI, Fig. 8), where it reports them:
+    /// (train reward, test reward, success rate, inference rate relative to bayes-rl).
+    pub fn paper(self) -> Option<PaperFigures> {
+        match self {
+            Method::QLearning => Some(PaperFigures { train_reward: 78.0, test_reward: -21.8, success_rate: 0.03, inference_rate: 0.0 }),
+            Method::BayesRl => Some(PaperFigures { train_reward: 72.7, test_reward: -18.2, success_rate: 0.05, inference_rate: 1.0 }),
+            Method::Scaled => Some(PaperFigures { train_reward: 78.0, test_reward: 22.9, success_rate: 1.0, inference_rate: 0.633 }),
+            _ => None,
+        }
+    }
+
+    /// Whether the method carries state from one episode to the next (test-time
+    /// learning), so its episodes must run in order.
+    pub fn learns_across_episodes(self, params: &ScaledParams) -> bool {
+        match self {
+            Method::Scaled | Method::ScaledAlways => params.learning,
+            Method::ScaledNoLearning | Method::QLearning => false,
+            Method::BayesRl | Method::BayesRlFactored => true,
+        }
+    }
+
+    /// Builds a fresh controller of this method from the trained bundle.
+    pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> anyhow::Result<Box<dyn Controller>> {
+        let scaled = |params: ScaledParams| -> anyhow::Result<Box<dyn Controller>> {
+            Ok(Box::new(ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params)?))
+        };
+        Ok(match self {
+            Method::QLearning => Box::new(bundle.q_learning.clone()),
+            Method::BayesRl => Box::new(bundle.bayes_rl.clone()),
+            Method::BayesRlFactored => Box::new(BayesRl::factored_from(&bundle.bayes_rl, &bundle.world_model)?),
+            Method::Scaled => scaled(params.clone())?,
+            Method::ScaledAlways => scaled(ScaledParams { reasoning: ReasoningMode::Always, ..params.clone() })?,
+            Method::ScaledNoLearning => scaled(ScaledParams { learning: false, ..params.clone() })?,
+        })
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Figures the paper reports for a method (§VI).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PaperFigures {
+    /// Mean training reward.
+    pub train_reward: f64,
+    /// Mean test reward on the jaywalk scenario.
+    pub test_reward: f64,
+    /// Success rate on the jaywalk scenario.
+    pub success_rate: f64,
+    /// Inference rate relative to Bayesian RL (which reasons on every tick).
+    pub inference_rate: f64,
+}

@@ -1,0 +1,45 @@
+//! Rewards (§VI): the per-tick reward the runner pays out, and the per-state reward
+//! R(s) behind the agent's preferences C = log_softmax(R / tau_c) (§IV, DESIGN.md §5).
+
+use unforeseen_discretizer::Discretizer;
+use unforeseen_sim::{Map, StepOutcome};
+
+/// The reward of one decision tick: progress toward the goal, minus the step cost,
+/// plus the goal bonus or the crash penalty when the tick ends the episode that way.
+pub fn tick_reward(map: &Map, outcome: &StepOutcome) -> f64 {
+    let r = &map.reward;
+    let mut reward = r.progress_per_metre * outcome.progress - r.step_cost;
+    if outcome.goal {
+        reward += r.goal;
+    }
+    if outcome.collision {
+        reward += r.crash;
+    }
+    reward
+}
+
+/// Distance bins that overlap the crosswalk (the paper's "intersection at d = 1").
+pub fn crosswalk_bins(map: &Map, disc: &Discretizer) -> Vec<usize> {
+    let (a, b) = map.crosswalk_distance_to_goal();
+    let (lo, hi) = (disc.distance_bin(a.min(b)), disc.distance_bin(a.max(b)));
+    (lo..=hi).collect()
+}
+
+/// R(s) for every joint state: the goal reward where the car has arrived (d = 0), the
+/// crash penalty in crash-risk states (a pedestrian on the crosswalk while the car is
+/// moving in a crosswalk bin), and zero elsewhere.
+pub fn state_rewards(map: &Map, disc: &Discretizer) -> Vec<f64> {
+    let risky = crosswalk_bins(map, disc);
+    (0..disc.n_states())
+        .map(|s| {
+            let st = disc.decode(s);
+            if st.d == 0 {
+                map.reward.goal
+            } else if st.p == 1 && st.v > 0 && risky.contains(&st.d) {
+                map.reward.crash
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}

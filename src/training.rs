@@ -1,0 +1,111 @@
+//! Training (§VI): Q-learning, the world model's Dirichlet counts and Bayesian RL all
+//! learn from the same episodes on the training map, driven by Q-learning's
+//! epsilon-greedy exploration.
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::collections::BTreeMap;
+use unforeseen_agent::bayes_rl::BayesRl;
+use unforeseen_agent::model::WorldModel;
+use unforeseen_agent::params::{BayesRlParams, ModelPriors, QParams};
+use unforeseen_agent::persist::AgentBundle;
+use unforeseen_agent::q_learning::QLearning;
+use unforeseen_agent::structure::Structure;
+use unforeseen_discretizer::Discretizer;
+use unforeseen_sim::{Action, Map, World};
+
+use crate::progress;
+use crate::rewards::{state_rewards, tick_reward};
+use crate::seeds::episode_seed;
+
+/// Everything training needs besides the map.
+#[derive(Debug, Clone)]
+pub struct TrainConfig {
+    /// Training episodes (the paper uses 6000).
+    pub episodes: u64,
+    /// Run seed; episode seeds derive from it.
+    pub seed: u64,
+    /// Q-learning hyperparameters.
+    pub q: QParams,
+    /// Dirichlet priors of the world model.
+    pub priors: ModelPriors,
+    /// Bayesian-RL hyperparameters.
+    pub bayes: BayesRlParams,
+    /// Temperature tau_c of the preferences C = log_softmax(R / tau_c).
+    pub tau_c: f64,
+    /// Hide the progress bar.
+    pub quiet: bool,
+}
+
+impl TrainConfig {
+    /// The paper's defaults (§VI) with `episodes` and `seed`.
+    pub fn new(episodes: u64, seed: u64) -> Self {
+        Self {
+            episodes,
+            seed,
+            q: QParams { bias_action: Some(Action::SpeedUp.index()), ..QParams::default() },
+            priors: ModelPriors::default(),
+            bayes: BayesRlParams::default(),
+            tau_c: 1.0,
+            quiet: false,
+        }
+    }
+}
+
+/// Mean return of the last `window` training episodes, per episode.
+#[derive(Debug, Clone, Default)]
+pub struct TrainLog {
+    /// Return of every training episode (with exploration).
+    pub returns: Vec<f64>,
+}
+
+/// Trains all learners on `map` and bundles them (with the preferences set from the
+/// map's rewards) for evaluation or for saving as an agent file.
+pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, TrainLog)> {
+    let disc = Discretizer::new(&map.bins)?;
+    let n = disc.n_states();
+    let n_actions = Action::ALL.len();
+    let mut q = QLearning::new(n, n_actions, cfg.q.clone())?;
+    let structure = Structure::paper_default(disc.factor_sizes())?;
+    let mut model = WorldModel::new(structure, n_actions, &cfg.priors)?;
+    let mut bayes = BayesRl::new(n, n_actions, cfg.bayes.clone())?;
+    let mut log = TrainLog::default();
+    let bar = progress::bar(cfg.episodes, "training", cfg.quiet);
+    let stream = format!("{}/train", map.name);
+    for episode in 0..cfg.episodes {
+        let seed = episode_seed(cfg.seed, &stream, episode);
+        let mut world = World::from_map(map, seed);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6578_706c_6f72_6521);
+        let mut s = disc.encode(disc.state(&world.snapshot()));
+        let mut ret = 0.0;
+        loop {
+            let a = q.act_epsilon_greedy(s, &mut rng);
+            let outcome = world.step(Action::from_index(a).expect("Q-learning picks one of 3 actions"));
+            let r = tick_reward(map, &outcome);
+            let s_next = disc.encode(disc.state(&world.snapshot()));
+            let done = outcome.done();
+            q.update(s, a, r, s_next, done);
+            model.observe_transition(s, a, s_next);
+            bayes.observe_transition(s, a, r, s_next, done);
+            ret += r;
+            s = s_next;
+            if done {
+                break;
+            }
+        }
+        q.decay_epsilon();
+        log.returns.push(ret);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    model.materialize();
+    model.set_preferences(&state_rewards(map, &disc), cfg.tau_c)?;
+    bayes.finish_training();
+    let mut meta = BTreeMap::new();
+    meta.insert("map".into(), map.name.clone());
+    meta.insert("episodes".into(), cfg.episodes.to_string());
+    meta.insert("seed".into(), cfg.seed.to_string());
+    meta.insert("factor_sizes".into(), format!("{:?}", disc.factor_sizes()));
+    meta.insert("unforeseen_version".into(), env!("CARGO_PKG_VERSION").into());
+    Ok((AgentBundle::new(q, model, bayes, meta), log))
+}
