@@ -77,7 +77,7 @@ struct WorldModelRepr {
     cpt: Vec<Vec<f64>>,
     a_counts: DMatrix<f64>,
     c: Vec<f64>,
-    d: Vec<f64>,
+    d_counts: Vec<f64>,
 }
 
 /// The agent's world model (§II-A, §V): Dirichlet-count CPTs per factor, `A` counts,
@@ -91,6 +91,8 @@ pub struct WorldModel {
     /// Per factor: counts laid out `[config * size + child]`, priors included.
     cpt: Vec<Vec<f64>>,
     a_counts: DMatrix<f64>,
+    /// Counts behind `D` (prior mass 1 spread per `ModelPriors::d`).
+    d_counts: Vec<f64>,
     gm: GenerativeModel,
 }
 
@@ -103,7 +105,7 @@ impl From<WorldModel> for WorldModelRepr {
             cpt: w.cpt,
             a_counts: w.a_counts,
             c: w.gm.c,
-            d: w.gm.d,
+            d_counts: w.d_counts,
         }
     }
 }
@@ -132,7 +134,7 @@ impl TryFrom<WorldModelRepr> for WorldModel {
                 found: r.cpt.len(),
             });
         }
-        if r.a_counts.ncols() != n || r.c.len() != r.a_counts.nrows() || r.d.len() != n {
+        if r.a_counts.ncols() != n || r.c.len() != r.a_counts.nrows() || r.d_counts.len() != n {
             return Err(AgentError::SizeMismatch {
                 what: "A/C/D sizes".into(),
                 expected: n,
@@ -140,7 +142,8 @@ impl TryFrom<WorldModelRepr> for WorldModel {
             });
         }
         let mut w = WorldModel {
-            gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], r.c, r.d),
+            gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], r.c, vec![]),
+            d_counts: r.d_counts,
             structure: r.structure,
             n_actions: r.n_actions,
             priors: r.priors,
@@ -190,7 +193,8 @@ impl WorldModel {
         };
         let c = vec![-(n as f64).ln(); n];
         let mut w = WorldModel {
-            gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], c, d),
+            gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], c, vec![]),
+            d_counts: d,
             structure,
             n_actions,
             priors: priors.clone(),
@@ -283,7 +287,8 @@ impl WorldModel {
             }
         }
         let c = std::mem::take(&mut self.gm.c);
-        let d = std::mem::take(&mut self.gm.d);
+        let mut d = self.d_counts.clone();
+        crate::maths::normalize_in_place(&mut d);
         self.gm = GenerativeModel::new(a, b, c, d);
     }
 
@@ -337,7 +342,8 @@ impl WorldModel {
         Ok(())
     }
 
-    /// Set the initial state prior `D` (must have `n_states` non-negative entries summing to 1).
+    /// Set the initial state prior `D` (must have `n_states` non-negative entries summing to 1);
+    /// the Dirichlet counts behind `D` keep their total mass.
     pub fn set_d(&mut self, d: &[f64]) -> Result<(), AgentError> {
         if d.len() != self.n_states() {
             return Err(AgentError::SizeMismatch {
@@ -349,8 +355,18 @@ impl WorldModel {
         if d.iter().any(|x| !(*x >= 0.0)) || (d.iter().sum::<f64>() - 1.0).abs() > 1e-9 {
             return Err(ParamError::new("d", format!("{d:?}"), "non-negative and summing to 1").into());
         }
+        let mass = self.d_counts.iter().sum::<f64>().max(1.0);
+        self.d_counts = d.iter().map(|x| x * mass).collect();
         self.gm.d = d.to_vec();
         Ok(())
+    }
+
+    /// Count `s` as an initial state (D's Dirichlet counts, §V applied to `D`); takes
+    /// effect at the next [`WorldModel::materialize`]. Out-of-range `s` is ignored.
+    pub fn observe_initial(&mut self, s: usize) {
+        if let Some(c) = self.d_counts.get_mut(s) {
+            *c += 1.0;
+        }
     }
 
     /// Posterior-mean probability `p(child' = child_value | parents = parent_values, u)`

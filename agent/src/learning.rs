@@ -1,0 +1,93 @@
+//! Learning at test time (§V): conjugate Dirichlet updates of `A`, of the factor CPTs
+//! behind `B`, and of the policy counts `ν`, each adding exactly the expected counts
+//! under the posteriors `q_τ` (scaled by a learning rate).
+//!
+//! - `a[o,s] += lr Σ_τ o_τ ⊗ q_τ` (§V-A, `α'_ij = α_ij + Σ_τ 1[o_τ = i] q(s_τ = j)`)
+//! - `b_f[child | parents, u] += lr Σ_τ E_{q_{τ-1} ⊗ q_τ}[1[...]]` (§V-B, factored)
+//! - `ν[u,s] += lr Σ_τ q_τ[s] 1[a_τ = u]` (§V-C; `a_τ` is the action taken from `s_τ`,
+//!   i.e. the paper's `q(s_{τ-1} = j) 1[a_τ = i]` with its action index shifted by one).
+//!
+//! The base policy is `π_o(u|s) = ν[u,s] / Σ_u ν[u,s]`, and `ν` starts as
+//! `ν0 σ(Q[s,·]/T)` (DESIGN §5).
+
+use crate::maths::softmax_in_place;
+use crate::model::WorldModel;
+use nalgebra::DMatrix;
+
+/// `a[o,s] += lr q[s]` for observation `o` (§V-A, one term of the sum).
+pub fn update_a(counts: &mut DMatrix<f64>, o: usize, q: &[f64], lr: f64) {
+    for (s, p) in q.iter().enumerate() {
+        if *p != 0.0 {
+            counts[(o, s)] += lr * p;
+        }
+    }
+}
+
+/// Add the expected factor-CPT counts of one transition `q_prev --u--> q_next` under the
+/// mean-field pairwise posterior `q_prev ⊗ q_next` (§V-B, factored form). Each factor
+/// receives total mass `lr`. Call [`WorldModel::materialize`] afterwards.
+pub fn update_cpts(model: &mut WorldModel, q_prev: &[f64], u: usize, q_next: &[f64], lr: f64) {
+    let st = model.structure().clone();
+    let nf = st.factors().len();
+    let na = model.n_actions();
+    let mut prev = vec![0; nf];
+    let mut next = vec![0; nf];
+    for (s, ps) in q_prev.iter().enumerate() {
+        if *ps == 0.0 {
+            continue;
+        }
+        st.decode_into(s, &mut prev);
+        for (s2, pn) in q_next.iter().enumerate() {
+            if *pn == 0.0 {
+                continue;
+            }
+            st.decode_into(s2, &mut next);
+            let w = lr * ps * pn;
+            for f in 0..nf {
+                let size = st.factors()[f].size;
+                let cfg = st.config_index(f, &prev, &next, u, na);
+                model.cpt_counts_mut(f)[cfg * size + next[f]] += w;
+            }
+        }
+    }
+}
+
+/// `ν[s,u] += lr q[s]` for the action `u` taken from belief `q` (§V-C). `nu` is laid out
+/// `[s * n_actions + u]`.
+pub fn update_nu(nu: &mut [f64], n_actions: usize, q: &[f64], u: usize, lr: f64) {
+    for (s, p) in q.iter().enumerate() {
+        if *p != 0.0 {
+            nu[s * n_actions + u] += lr * p;
+        }
+    }
+}
+
+/// `π_o(·|s) = ν[s,·] / Σ_u ν[s,u]` (Dirichlet mean, §V-C) into `out`.
+pub fn pi_o_state(nu: &[f64], n_actions: usize, s: usize, out: &mut [f64]) {
+    out.copy_from_slice(&nu[s * n_actions..(s + 1) * n_actions]);
+    crate::maths::normalize_in_place(out);
+}
+
+/// `π_o(·|q) = Σ_s q[s] π_o(·|s)` (the base policy under a belief, DESIGN §6 "scaled").
+pub fn pi_o_belief(nu: &[f64], n_actions: usize, q: &[f64], out: &mut [f64]) {
+    out.iter_mut().for_each(|v| *v = 0.0);
+    for (s, p) in q.iter().enumerate() {
+        if *p != 0.0 {
+            let row = &nu[s * n_actions..(s + 1) * n_actions];
+            let z: f64 = row.iter().sum();
+            for (o, r) in out.iter_mut().zip(row) {
+                *o += p * r / z;
+            }
+        }
+    }
+}
+
+/// `ν = ν0 σ(Q[s,·]/T)` per state (DESIGN §5, end of training), laid out `[s * n_actions + u]`.
+pub fn nu_from_q(q_table: &[f64], n_actions: usize, nu0: f64, temperature: f64) -> Vec<f64> {
+    let mut nu: Vec<f64> = q_table.iter().map(|q| q / temperature).collect();
+    for row in nu.chunks_mut(n_actions) {
+        softmax_in_place(row);
+        row.iter_mut().for_each(|v| *v *= nu0);
+    }
+    nu
+}

@@ -1,0 +1,169 @@
+//! Planning as inference (§IV): expected free energy of every policy of horizon H
+//! (Prop. 1, eq. "EFE_0"), `q(π) = σ(-γ G)` (Cor. 1), the first-action marginal
+//! `ψ(u) = Σ_{π: π_1 = u} q(π)`, and `Q_S(u) = -(1/γ) ln ψ(u)` (Theorem 1).
+//!
+//! All policies start from `q_t`: `s_1 = B[π_1] q_t`, `s_k = B[π_k] s_{k-1}`, `o_k = A s_k`,
+//! `G(π) = Σ_k [ o_k·(ln o_k - C) + s_k·H_A ]` (risk + ambiguity). The tree shares
+//! prefixes: `U + U^2 + ... + U^H` mat-vecs instead of `H U^H`. Policies are ordered
+//! lexicographically (first action most significant): `[0,0], [0,1], ...`.
+
+use crate::maths::{ln, softmax_in_place};
+use crate::model::GenerativeModel;
+use crate::surprise::matvec_sparse_x;
+
+/// Risk and ambiguity of one future step with predicted state belief `s`
+/// (Prop. 1: `risk = KL[A s || c]`, `ambiguity = s·H_A`). `obuf` is scratch of size n_obs.
+pub fn step_efe(gm: &GenerativeModel, s: &[f64], obuf: &mut [f64]) -> (f64, f64) {
+    let o: &[f64] = if gm.a_identity {
+        s
+    } else {
+        matvec_sparse_x(gm.a.as_slice(), gm.n_obs(), s, obuf);
+        obuf
+    };
+    let mut risk = 0.0;
+    for (oi, ci) in o.iter().zip(&gm.c) {
+        if *oi > 0.0 {
+            risk += oi * (ln(*oi) - ci);
+        }
+    }
+    let ambiguity = if gm.a_identity { 0.0 } else { s.iter().zip(&gm.h_a).map(|(a, b)| a * b).sum() };
+    (risk, ambiguity)
+}
+
+/// The long form of one step's EFE from the proof of Prop. 1 (Appendix B):
+/// `Σ_{o,s} p(o|s) q(s) ln(q(o)/p(o|C)) - Σ_{o,s} p(o|s) q(s) ln p(o|s)`. Test oracle.
+pub fn step_efe_long_form(gm: &GenerativeModel, s: &[f64]) -> f64 {
+    let (no, ns) = (gm.n_obs(), gm.n_states());
+    let qo: Vec<f64> = (0..no).map(|o| (0..ns).map(|j| gm.a[(o, j)] * s[j]).sum()).collect();
+    let mut g = 0.0;
+    for o in 0..no {
+        for j in 0..ns {
+            let w = gm.a[(o, j)] * s[j];
+            if w > 0.0 {
+                g += w * (ln(qo[o]) - gm.c[o]) - w * ln(gm.a[(o, j)]);
+            }
+        }
+    }
+    g
+}
+
+/// All action sequences of length `horizon` in lexicographic order.
+pub fn policies(n_actions: usize, horizon: usize) -> Vec<Vec<usize>> {
+    let count = n_actions.pow(horizon as u32);
+    (0..count)
+        .map(|mut i| {
+            let mut p = vec![0; horizon];
+            for k in (0..horizon).rev() {
+                p[k] = i % n_actions;
+                i /= n_actions;
+            }
+            p
+        })
+        .collect()
+}
+
+/// `G(π)` of one policy by direct rollout (brute-force oracle for the tree), eq. "EFE_0".
+pub fn efe_brute_force(gm: &GenerativeModel, q_t: &[f64], policy: &[usize]) -> f64 {
+    let n = gm.n_states();
+    let mut s = q_t.to_vec();
+    let mut next = vec![0.0; n];
+    let mut obuf = vec![0.0; gm.n_obs()];
+    let mut g = 0.0;
+    for u in policy {
+        matvec_sparse_x(gm.b[*u].as_slice(), n, &s, &mut next);
+        std::mem::swap(&mut s, &mut next);
+        let (r, a) = step_efe(gm, &s, &mut obuf);
+        g += r + a;
+    }
+    g
+}
+
+/// `q(π) = σ(-γ G)` (Cor. 1) into `out`.
+pub fn q_pi_into(g: &[f64], gamma: f64, out: &mut [f64]) {
+    for (o, gi) in out.iter_mut().zip(g) {
+        *o = -gamma * gi;
+    }
+    softmax_in_place(out);
+}
+
+/// `ψ(u) = Σ_{π: π_1 = u} q(π)` for lexicographically ordered policies (§IV).
+pub fn psi_into(q_pi: &[f64], n_actions: usize, out: &mut [f64]) {
+    let block = q_pi.len() / n_actions;
+    for (u, o) in out.iter_mut().enumerate().take(n_actions) {
+        *o = q_pi[u * block..(u + 1) * block].iter().sum();
+    }
+}
+
+/// `Q_S(u) = -(1/γ) ln ψ(u)` (Theorem 1: ψ approximates `exp(-γ Q_S)`), floored log.
+pub fn q_s(psi: &[f64], gamma: f64) -> Vec<f64> {
+    psi.iter().map(|p| -ln(*p) / gamma).collect()
+}
+
+/// Preallocated EFE tree evaluator for a fixed (n_states, n_obs, n_actions, H).
+#[derive(Debug, Clone)]
+pub struct EfeTree {
+    n_actions: usize,
+    horizon: usize,
+    /// `bufs[k]` is the predicted state belief at depth k (bufs[0] = q_t).
+    bufs: Vec<Vec<f64>>,
+    obuf: Vec<f64>,
+    /// `G(π)` per policy, lexicographic.
+    pub g: Vec<f64>,
+    /// `q(π)`.
+    pub q_pi: Vec<f64>,
+    /// `ψ(u)`.
+    pub psi: Vec<f64>,
+    /// Mat-vecs performed by the last evaluation (U + ... + U^H).
+    pub matvecs: usize,
+}
+
+impl EfeTree {
+    /// Buffers for `n_states` states, `n_obs` observations, `n_actions` actions, horizon `H >= 1`.
+    pub fn new(n_states: usize, n_obs: usize, n_actions: usize, horizon: usize) -> Self {
+        let horizon = horizon.max(1);
+        let np = n_actions.pow(horizon as u32);
+        EfeTree {
+            n_actions,
+            horizon,
+            bufs: vec![vec![0.0; n_states]; horizon + 1],
+            obuf: vec![0.0; n_obs],
+            g: vec![0.0; np],
+            q_pi: vec![0.0; np],
+            psi: vec![0.0; n_actions],
+            matvecs: 0,
+        }
+    }
+
+    /// Horizon H.
+    pub fn horizon(&self) -> usize {
+        self.horizon
+    }
+
+    /// Evaluate `G`, `q(π)` and `ψ` from `q_t` with precision `γ` (§IV, Prop. 1, Cor. 1).
+    pub fn evaluate(&mut self, gm: &GenerativeModel, q_t: &[f64], gamma: f64) {
+        self.bufs[0].copy_from_slice(q_t);
+        self.matvecs = 0;
+        self.recurse(gm, 0, 0.0, 0);
+        q_pi_into(&self.g, gamma, &mut self.q_pi);
+        psi_into(&self.q_pi, self.n_actions, &mut self.psi);
+    }
+
+    fn recurse(&mut self, gm: &GenerativeModel, depth: usize, g_acc: f64, idx: usize) {
+        let n = self.bufs[0].len();
+        for u in 0..self.n_actions {
+            {
+                let (lo, hi) = self.bufs.split_at_mut(depth + 1);
+                matvec_sparse_x(gm.b[u].as_slice(), n, &lo[depth], &mut hi[0]);
+            }
+            self.matvecs += 1;
+            let (r, a) = step_efe(gm, &self.bufs[depth + 1], &mut self.obuf);
+            let g = g_acc + r + a;
+            let child = idx * self.n_actions + u;
+            if depth + 1 == self.horizon {
+                self.g[child] = g;
+            } else {
+                self.recurse(gm, depth + 1, g, child);
+            }
+        }
+    }
+}

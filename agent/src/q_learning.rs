@@ -1,0 +1,134 @@
+//! Tabular Q-learning, the base learner and first baseline (§VI): ε-greedy training,
+//! Q initialised with a bias toward speeding up (the paper's velocity preference).
+
+use crate::controller::{Controller, Decision, one_hot};
+use crate::error::{AgentError, ParamError};
+use crate::maths::argmax;
+use crate::params::QParams;
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+
+/// A Q-table over `n_states x n_actions`, laid out `[s * n_actions + a]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct QLearning {
+    n_states: usize,
+    n_actions: usize,
+    params: QParams,
+    epsilon: f64,
+    table: Vec<f64>,
+}
+
+impl QLearning {
+    /// A table with `Q = 0` except `Q[s, bias_action] = bias` (§VI). Never panics: an
+    /// out-of-range `bias_action` is ignored; validate with [`QParams::check`] or use
+    /// [`QLearning::try_new`] for typed errors.
+    pub fn new(n_states: usize, n_actions: usize, params: QParams) -> QLearning {
+        let mut table = vec![0.0; n_states * n_actions];
+        if let Some(b) = params.bias_action.filter(|b| *b < n_actions) {
+            for s in 0..n_states {
+                table[s * n_actions + b] = params.bias;
+            }
+        }
+        QLearning {
+            n_states,
+            n_actions,
+            epsilon: params.epsilon,
+            params,
+            table,
+        }
+    }
+
+    /// Like [`QLearning::new`] but checks the parameters and sizes.
+    pub fn try_new(n_states: usize, n_actions: usize, params: QParams) -> Result<QLearning, AgentError> {
+        params.check()?;
+        if n_states == 0 {
+            return Err(ParamError::new("n_states", 0, ">= 1").into());
+        }
+        if n_actions == 0 {
+            return Err(ParamError::new("n_actions", 0, ">= 1").into());
+        }
+        if let Some(b) = params.bias_action.filter(|b| *b >= n_actions) {
+            return Err(ParamError::new("bias_action", b, "< n_actions").into());
+        }
+        Ok(QLearning::new(n_states, n_actions, params))
+    }
+
+    /// Number of states.
+    pub fn n_states(&self) -> usize {
+        self.n_states
+    }
+    /// Number of actions.
+    pub fn n_actions(&self) -> usize {
+        self.n_actions
+    }
+    /// Parameters.
+    pub fn params(&self) -> &QParams {
+        &self.params
+    }
+    /// Current exploration rate.
+    pub fn epsilon(&self) -> f64 {
+        self.epsilon
+    }
+    /// The whole table, `[s * n_actions + a]`.
+    pub fn table(&self) -> &[f64] {
+        &self.table
+    }
+
+    /// `Q[s, ·]`.
+    pub fn q(&self, s: usize) -> &[f64] {
+        &self.table[s * self.n_actions..(s + 1) * self.n_actions]
+    }
+
+    /// Greedy action, ties broken by the lowest index.
+    pub fn greedy(&self, s: usize) -> usize {
+        argmax(self.q(s))
+    }
+
+    /// ε-greedy action with the current ε.
+    pub fn act_epsilon_greedy(&self, s: usize, rng: &mut impl rand::Rng) -> usize {
+        if rng.random::<f64>() < self.epsilon {
+            rng.random_range(0..self.n_actions)
+        } else {
+            self.greedy(s)
+        }
+    }
+
+    /// `Q[s,a] += α (r + γ max_a' Q[s',a'] (0 if done) - Q[s,a])`.
+    pub fn update(&mut self, s: usize, a: usize, r: f64, s_next: usize, done: bool) {
+        let future = if done {
+            0.0
+        } else {
+            self.q(s_next).iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        };
+        let target = r + self.params.discount * future;
+        let cell = &mut self.table[s * self.n_actions + a];
+        *cell += self.params.alpha * (target - *cell);
+    }
+
+    /// `ε <- max(ε_min, ε · decay)`; call once per training episode.
+    pub fn decay_epsilon(&mut self) {
+        self.epsilon = (self.epsilon * self.params.epsilon_decay).max(self.params.epsilon_min);
+    }
+
+    /// Set the exploration rate directly (e.g. a custom schedule).
+    pub fn set_epsilon(&mut self, epsilon: f64) {
+        self.epsilon = epsilon.clamp(0.0, 1.0);
+    }
+}
+
+impl Controller for QLearning {
+    fn name(&self) -> &'static str {
+        "q-learning"
+    }
+    fn begin_episode(&mut self, _seed: u64) {}
+    /// Greedy; never reasons.
+    fn act(&mut self, obs: usize) -> Decision {
+        let action = self.greedy(obs);
+        Decision {
+            action,
+            reasoned: false,
+            policy: one_hot(self.n_actions, action),
+            ..Default::default()
+        }
+    }
+}
