@@ -1,0 +1,79 @@
+//! The maps shipped in `maps/`, compiled into the binary. Bases named in an
+//! embedded map (e.g. `base: "jaywalk.ron"`) resolve among these.
+
+use crate::load::{Diagnostic, MapError};
+use crate::map::Map;
+
+/// `maps/intersection.ron`: the training intersection (pedestrians cross on red only).
+pub const INTERSECTION: &str = include_str!("../../maps/intersection.ron");
+/// `maps/jaywalk.ron`: the paper's test (a pedestrian crosses on green in front of the car).
+pub const JAYWALK: &str = include_str!("../../maps/jaywalk.ron");
+/// `maps/jaywalk_late.ron`: a faster jaywalker who steps out later.
+pub const JAYWALK_LATE: &str = include_str!("../../maps/jaywalk_late.ron");
+/// `maps/two_pedestrians.ron`: jaywalkers from both kerbs.
+pub const TWO_PEDESTRIANS: &str = include_str!("../../maps/two_pedestrians.ron");
+/// `maps/stuck_green.ron`: the light never leaves green, plus a jaywalker.
+pub const STUCK_GREEN: &str = include_str!("../../maps/stuck_green.ron");
+/// `maps/stop_midway.ron`: a jaywalker who stops in the car's lane.
+pub const STOP_MIDWAY: &str = include_str!("../../maps/stop_midway.ron");
+
+const ALL: &[(&str, &str)] = &[
+    ("intersection", INTERSECTION),
+    ("jaywalk", JAYWALK),
+    ("jaywalk_late", JAYWALK_LATE),
+    ("two_pedestrians", TWO_PEDESTRIANS),
+    ("stuck_green", STUCK_GREEN),
+    ("stop_midway", STOP_MIDWAY),
+];
+
+const NAMES: &[&str] = &[
+    "intersection",
+    "jaywalk",
+    "jaywalk_late",
+    "two_pedestrians",
+    "stuck_green",
+    "stop_midway",
+];
+
+/// Names of the embedded maps (without `.ron`).
+pub fn names() -> &'static [&'static str] {
+    NAMES
+}
+
+/// The text of an embedded map, by name with or without `.ron`.
+pub fn source(name: &str) -> Option<&'static str> {
+    let name = name.strip_prefix("maps/").unwrap_or(name);
+    let name = name.strip_suffix(".ron").unwrap_or(name);
+    ALL.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
+}
+
+/// Load an embedded map by name (`"jaywalk"` or `"jaywalk.ron"`).
+pub fn load(name: &str) -> Result<Map, MapError> {
+    let Some(src) = source(name) else {
+        return Err(MapError::new(vec![Diagnostic {
+            file: name.to_string(),
+            position: None,
+            path: String::new(),
+            message: "no embedded map by this name".into(),
+            hint: Some(format!("embedded maps: {}", NAMES.join(", "))),
+        }]));
+    };
+    let stem = name.strip_suffix(".ron").unwrap_or(name);
+    Map::from_str_named(&format!("{stem}.ron"), src, &|base| {
+        source(base).map(|s| {
+            let b = base.strip_suffix(".ron").unwrap_or(base);
+            (format!("{b}.ron"), s.to_string())
+        })
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_embedded_map_loads() {
+        for name in super::names() {
+            let m = super::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(&m.name, name);
+        }
+    }
+}

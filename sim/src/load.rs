@@ -1,0 +1,614 @@
+//! Reading map files: syntax, unknown fields, types, base maps, then semantic
+//! validation. Bad input never panics: every problem becomes a [`Diagnostic`]
+//! naming the file and either `line:column` or the field path, and a
+//! [`MapError`] carries all of them.
+
+use std::cell::Cell;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use serde::de::{self, Deserializer, Visitor};
+
+use crate::map::{
+    BinsPatch, CrosswalkPatch, EpisodePatch, Expectation, LightPatch, Map, MapPatch, Pause, Phase, RewardPatch,
+    RoadPatch, SpawnRule, VehiclePatch,
+};
+use crate::validate;
+
+/// Largest map file accepted, bytes.
+pub const MAX_FILE_BYTES: usize = 1 << 20;
+/// Deepest nesting of brackets accepted.
+pub const MAX_NESTING: usize = 32;
+/// Longest chain of base maps accepted.
+pub const MAX_BASE_DEPTH: usize = 16;
+
+/// One problem found in a map file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// The file (or embedded map name) the problem is in.
+    pub file: String,
+    /// 1-based line and column, for syntax and type errors.
+    pub position: Option<(usize, usize)>,
+    /// Field path such as `road.lane_width` or `pedestrians[0].speed`; empty when not about a field.
+    pub path: String,
+    /// What is wrong.
+    pub message: String,
+    /// How to fix it, when there is something useful to say.
+    pub hint: Option<String>,
+}
+
+impl Diagnostic {
+    fn new(file: &str, path: &str, message: impl Into<String>, hint: Option<String>) -> Self {
+        Diagnostic {
+            file: file.to_string(),
+            position: None,
+            path: path.to_string(),
+            message: message.into(),
+            hint,
+        }
+    }
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.position {
+            Some((line, col)) => write!(f, "{}:{line}:{col}: ", self.file)?,
+            None => write!(f, "{}: ", self.file)?,
+        }
+        if !self.path.is_empty() {
+            write!(f, "{}: ", self.path)?;
+        }
+        f.write_str(&self.message)?;
+        if let Some(h) = &self.hint {
+            write!(f, " (hint: {h})")?;
+        }
+        Ok(())
+    }
+}
+
+/// Every problem found while loading one map. `Display` prints one diagnostic per line.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MapError {
+    diagnostics: Vec<Diagnostic>,
+}
+
+impl MapError {
+    pub(crate) fn new(diagnostics: Vec<Diagnostic>) -> Self {
+        debug_assert!(!diagnostics.is_empty());
+        MapError { diagnostics }
+    }
+
+    fn one(d: Diagnostic) -> Self {
+        MapError::new(vec![d])
+    }
+
+    /// All diagnostics, in the order found.
+    pub fn diagnostics(&self) -> &[Diagnostic] {
+        &self.diagnostics
+    }
+}
+
+impl fmt::Display for MapError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, d) in self.diagnostics.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "{d}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for MapError {}
+
+/// A base map found by a resolver.
+pub(crate) struct Resolved {
+    /// Name used in diagnostics.
+    pub origin: String,
+    /// Identity used to detect cycles (e.g. a canonical path).
+    pub key: String,
+    /// The text, or what went wrong reading it.
+    pub text: Result<String, Diagnostic>,
+}
+
+/// Finds base maps: `(including map's origin, base as written) -> Resolved`.
+pub(crate) type Resolver<'a> = dyn Fn(&str, &str) -> Option<Resolved> + 'a;
+
+impl Map {
+    /// Load a map file; a `base` is resolved relative to the file's folder.
+    pub fn load(path: &Path) -> Result<Map, MapError> {
+        let origin = path.display().to_string();
+        let text = read_text(path, &origin).map_err(MapError::one)?;
+        let key = canonical_key(path);
+        let resolve = |including: &str, base: &str| -> Option<Resolved> {
+            let dir = Path::new(including).parent().map(Path::to_path_buf).unwrap_or_default();
+            let p: PathBuf = dir.join(base);
+            if !p.is_file() {
+                return None;
+            }
+            let origin = p.display().to_string();
+            Some(Resolved {
+                text: read_text(&p, &origin),
+                origin,
+                key: canonical_key(&p),
+            })
+        };
+        load_top(&origin, &key, &text, &resolve)
+    }
+
+    /// Parse map text. `origin` names it in diagnostics (and gives the default
+    /// name); `bases` maps a base as written (e.g. `"intersection.ron"`) to
+    /// `(origin, text)`, or `None` if there is no such map.
+    pub fn from_str_named(
+        origin: &str,
+        src: &str,
+        bases: &dyn Fn(&str) -> Option<(String, String)>,
+    ) -> Result<Map, MapError> {
+        let resolve = |_including: &str, base: &str| -> Option<Resolved> {
+            bases(base).map(|(origin, text)| Resolved {
+                key: origin.clone(),
+                text: check_text(&origin, &text).map(|()| text),
+                origin,
+            })
+        };
+        load_top(origin, origin, src, &resolve)
+    }
+}
+
+fn canonical_key(p: &Path) -> String {
+    std::fs::canonicalize(p)
+        .unwrap_or_else(|_| p.to_path_buf())
+        .display()
+        .to_string()
+}
+
+/// Read a file as text, refusing huge and binary files without reading them whole.
+fn read_text(path: &Path, origin: &str) -> Result<String, Diagnostic> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)
+        .map_err(|e| Diagnostic::new(origin, "", format!("cannot read the file: {e}"), None))?;
+    let mut bytes = Vec::new();
+    file.take(MAX_FILE_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| Diagnostic::new(origin, "", format!("cannot read the file: {e}"), None))?;
+    if bytes.len() > MAX_FILE_BYTES {
+        return Err(too_large(origin));
+    }
+    let text = String::from_utf8(bytes).map_err(|e| {
+        Diagnostic::new(
+            origin,
+            "",
+            format!(
+                "not a text file: invalid UTF-8 at byte {}",
+                e.utf8_error().valid_up_to()
+            ),
+            Some("a map is a RON text file".into()),
+        )
+    })?;
+    check_text(origin, &text)?;
+    Ok(text)
+}
+
+fn too_large(origin: &str) -> Diagnostic {
+    Diagnostic::new(
+        origin,
+        "",
+        format!("file is too large (more than {MAX_FILE_BYTES} bytes)"),
+        Some("a map is a few kilobytes of RON; is this the right file?".into()),
+    )
+}
+
+/// Checks that need no parsing: size, emptiness, binary content, nesting depth.
+fn check_text(origin: &str, text: &str) -> Result<(), Diagnostic> {
+    if text.len() > MAX_FILE_BYTES {
+        return Err(too_large(origin));
+    }
+    if let Some(i) = text
+        .bytes()
+        .position(|b| b == 0 || (b < 0x20 && !matches!(b, b'\n' | b'\r' | b'\t')))
+    {
+        return Err(Diagnostic::new(
+            origin,
+            "",
+            format!("not a text file: control byte at offset {i}"),
+            Some("a map is a RON text file".into()),
+        ));
+    }
+    if strip_comments(text).trim().is_empty() {
+        return Err(Diagnostic::new(
+            origin,
+            "",
+            "the file is empty",
+            Some("a map is at least `Map()` (all defaults) or `Map(base: \"intersection.ron\")`".into()),
+        ));
+    }
+    if let Some((line, col)) = too_deep(text) {
+        return Err(Diagnostic {
+            position: Some((line, col)),
+            ..Diagnostic::new(
+                origin,
+                "",
+                format!("nested more than {MAX_NESTING} levels deep"),
+                Some("maps need only a few levels of brackets".into()),
+            )
+        });
+    }
+    Ok(())
+}
+
+/// Remove `//` and `/* */` comments (approximately: enough to tell whether anything is left).
+fn strip_comments(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars().peekable();
+    let mut in_str = false;
+    while let Some(c) = chars.next() {
+        if in_str {
+            out.push(c);
+            if c == '\\' {
+                if let Some(n) = chars.next() {
+                    out.push(n);
+                }
+            } else if c == '"' {
+                in_str = false;
+            }
+            continue;
+        }
+        match (c, chars.peek()) {
+            ('"', _) => {
+                in_str = true;
+                out.push(c);
+            }
+            ('/', Some('/')) => {
+                for n in chars.by_ref() {
+                    if n == '\n' {
+                        out.push('\n');
+                        break;
+                    }
+                }
+            }
+            ('/', Some('*')) => {
+                chars.next();
+                let mut prev = ' ';
+                for n in chars.by_ref() {
+                    if prev == '*' && n == '/' {
+                        break;
+                    }
+                    prev = n;
+                }
+                out.push(' ');
+            }
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// Position of the first bracket nested deeper than [`MAX_NESTING`] (outside strings).
+fn too_deep(text: &str) -> Option<(usize, usize)> {
+    let (mut depth, mut line, mut col) = (0usize, 1usize, 0usize);
+    let mut in_str = false;
+    let mut escaped = false;
+    for c in text.chars() {
+        col += 1;
+        if c == '\n' {
+            line += 1;
+            col = 0;
+        }
+        if in_str {
+            if escaped {
+                escaped = false;
+            } else if c == '\\' {
+                escaped = true;
+            } else if c == '"' {
+                in_str = false;
+            }
+            continue;
+        }
+        match c {
+            '"' => in_str = true,
+            '(' | '[' | '{' => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Some((line, col));
+                }
+            }
+            ')' | ']' | '}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    None
+}
+
+fn ron_options() -> ron::Options {
+    ron::Options::default().with_recursion_limit(MAX_NESTING * 2)
+}
+
+fn spanned(origin: &str, path: &str, e: &ron::error::SpannedError) -> Diagnostic {
+    let hint = match &e.code {
+        ron::Error::Eof => Some("the file ends early: is it truncated or missing a `)`?".into()),
+        ron::Error::ExceededRecursionLimit => Some("maps need only a few levels of brackets".into()),
+        _ => None,
+    };
+    Diagnostic {
+        position: Some((e.span.start.line, e.span.start.col)),
+        ..Diagnostic::new(origin, path, e.code.to_string(), hint)
+    }
+}
+
+fn load_top(origin: &str, key: &str, src: &str, resolve: &Resolver) -> Result<Map, MapError> {
+    let mut chain = vec![key.to_string()];
+    let map = build(origin, src, resolve, &mut chain)?;
+    let problems = validate::validate(&map);
+    if problems.is_empty() {
+        Ok(map)
+    } else {
+        Err(MapError::new(
+            problems
+                .into_iter()
+                .map(|p| Diagnostic::new(origin, &p.path, p.message, p.hint))
+                .collect(),
+        ))
+    }
+}
+
+/// Default map name: the file name without folders and `.ron`.
+fn stem(origin: &str) -> String {
+    let name = origin.rsplit(['/', '\\']).next().unwrap_or(origin);
+    name.strip_suffix(".ron").unwrap_or(name).to_string()
+}
+
+fn build(origin: &str, src: &str, resolve: &Resolver, chain: &mut Vec<String>) -> Result<Map, MapError> {
+    check_text(origin, src).map_err(MapError::one)?;
+    let patch = parse_patch(origin, src)?;
+    let base = match &patch.base {
+        None => Map::default(),
+        Some(base_name) => {
+            let including = chain.last().cloned().unwrap_or_default();
+            let Some(found) = resolve(origin, base_name) else {
+                return Err(MapError::one(Diagnostic::new(
+                    origin,
+                    "base",
+                    format!("base map {base_name:?} not found"),
+                    Some("a base is a file name relative to this map's folder, e.g. \"intersection.ron\"".into()),
+                )));
+            };
+            if found.key == including {
+                return Err(MapError::one(Diagnostic::new(
+                    origin,
+                    "base",
+                    format!("the map names itself ({base_name:?}) as its base"),
+                    Some("a base must be a different map".into()),
+                )));
+            }
+            if chain.contains(&found.key) {
+                let mut names: Vec<String> = chain.iter().map(|k| stem(k)).collect();
+                names.push(stem(&found.key));
+                return Err(MapError::one(Diagnostic::new(
+                    origin,
+                    "base",
+                    format!("base maps include each other: {}", names.join(" -> ")),
+                    Some("remove the cycle of `base` fields".into()),
+                )));
+            }
+            if chain.len() >= MAX_BASE_DEPTH {
+                return Err(MapError::one(Diagnostic::new(
+                    origin,
+                    "base",
+                    format!("more than {MAX_BASE_DEPTH} levels of base maps"),
+                    None,
+                )));
+            }
+            let text = found.text.map_err(MapError::one)?;
+            chain.push(found.key.clone());
+            let base = build(&found.origin, &text, resolve, chain);
+            chain.pop();
+            base?
+        }
+    };
+    Ok(patch.apply(base, &stem(origin)))
+}
+
+/// Syntax check, unknown-field scan (all of them), then typed parse.
+fn parse_patch(origin: &str, src: &str) -> Result<MapPatch, MapError> {
+    let opts = ron_options();
+    let value: ron::Value = opts.from_str(src).map_err(|e| MapError::one(spanned(origin, "", &e)))?;
+    let mut unknown = Vec::new();
+    walk(&value, Kind::Map, "", origin, &mut unknown);
+    if !unknown.is_empty() {
+        return Err(MapError::new(unknown));
+    }
+    let mut de =
+        ron::Deserializer::from_str_with_options(src, &opts).map_err(|e| MapError::one(spanned(origin, "", &e)))?;
+    let patch: MapPatch = match serde_path_to_error::deserialize(&mut de) {
+        Ok(p) => p,
+        Err(e) => {
+            let path = e.path().to_string();
+            let path = if path == "." { String::new() } else { path };
+            let err = de.span_error(e.into_inner());
+            return Err(MapError::one(spanned(origin, &path, &err)));
+        }
+    };
+    de.end()
+        .map_err(|e| MapError::one(spanned(origin, "", &de.span_error(e))))?;
+    Ok(patch)
+}
+
+// ---------------------------------------------------------------------------
+// Unknown-field scan over the untyped value, so that every unknown field is
+// reported, not only the first one serde stops at. Field lists come from the
+// serde derives themselves (see `field_names`), so they cannot drift.
+
+#[derive(Clone, Copy)]
+enum Kind {
+    Map,
+    Road,
+    Crosswalk,
+    Light,
+    Phase,
+    Vehicle,
+    Rule,
+    Pause,
+    Bins,
+    Reward,
+    Episode,
+    Expect,
+    Leaf,
+}
+
+fn fields_of(kind: Kind) -> &'static [&'static str] {
+    match kind {
+        Kind::Map => field_names::<MapPatch>(),
+        Kind::Road => field_names::<RoadPatch>(),
+        Kind::Crosswalk => field_names::<CrosswalkPatch>(),
+        Kind::Light => field_names::<LightPatch>(),
+        Kind::Phase => field_names::<Phase>(),
+        Kind::Vehicle => field_names::<VehiclePatch>(),
+        Kind::Rule => field_names::<SpawnRule>(),
+        Kind::Pause => field_names::<Pause>(),
+        Kind::Bins => field_names::<BinsPatch>(),
+        Kind::Reward => field_names::<RewardPatch>(),
+        Kind::Episode => field_names::<EpisodePatch>(),
+        Kind::Expect => field_names::<Expectation>(),
+        Kind::Leaf => &[],
+    }
+}
+
+fn child(kind: Kind, field: &str) -> Kind {
+    match (kind, field) {
+        (Kind::Map, "road") => Kind::Road,
+        (Kind::Map, "crosswalk") => Kind::Crosswalk,
+        (Kind::Map, "light") => Kind::Light,
+        (Kind::Map, "vehicle") => Kind::Vehicle,
+        (Kind::Map, "pedestrians") => Kind::Rule,
+        (Kind::Map, "bins") => Kind::Bins,
+        (Kind::Map, "reward") => Kind::Reward,
+        (Kind::Map, "episode") => Kind::Episode,
+        (Kind::Map, "expect") => Kind::Expect,
+        (Kind::Light, "cycle") => Kind::Phase,
+        (Kind::Rule, "pause") => Kind::Pause,
+        _ => Kind::Leaf,
+    }
+}
+
+fn walk(v: &ron::Value, kind: Kind, path: &str, origin: &str, out: &mut Vec<Diagnostic>) {
+    if matches!(kind, Kind::Leaf) {
+        return;
+    }
+    match v {
+        ron::Value::Option(Some(inner)) => walk(inner, kind, path, origin, out),
+        ron::Value::Seq(items) => {
+            for (i, item) in items.iter().enumerate() {
+                walk(item, kind, &format!("{path}[{i}]"), origin, out);
+            }
+        }
+        ron::Value::Map(m) => {
+            let known = fields_of(kind);
+            for (k, val) in m.iter() {
+                let ron::Value::String(name) = k else {
+                    continue;
+                };
+                let here = if path.is_empty() {
+                    name.clone()
+                } else {
+                    format!("{path}.{name}")
+                };
+                if known.contains(&name.as_str()) {
+                    walk(val, child(kind, name), &here, origin, out);
+                } else {
+                    out.push(Diagnostic::new(
+                        origin,
+                        &here,
+                        format!("unknown field `{name}`"),
+                        Some(suggest(name, known)),
+                    ));
+                }
+            }
+        }
+        _ => {}
+    }
+}
+
+fn suggest(name: &str, known: &[&str]) -> String {
+    let best = known
+        .iter()
+        .map(|k| (edit_distance(name, k), *k))
+        .min_by_key(|(d, _)| *d);
+    match best {
+        Some((d, k)) if d <= 2 => format!("did you mean `{k}`?"),
+        _ => format!("expected one of: {}", known.join(", ")),
+    }
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// The field names serde's derive gives a struct, captured by a deserializer
+/// that records `deserialize_struct`'s `fields` argument and stops.
+pub(crate) fn field_names<'de, T: Deserialize<'de>>() -> &'static [&'static str] {
+    struct Capture<'a>(&'a Cell<&'static [&'static str]>);
+    impl<'de> Deserializer<'de> for Capture<'_> {
+        type Error = de::value::Error;
+        fn deserialize_any<V: Visitor<'de>>(self, _: V) -> Result<V::Value, Self::Error> {
+            Err(de::Error::custom("not a struct"))
+        }
+        fn deserialize_struct<V: Visitor<'de>>(
+            self,
+            _name: &'static str,
+            fields: &'static [&'static str],
+            _visitor: V,
+        ) -> Result<V::Value, Self::Error> {
+            self.0.set(fields);
+            Err(de::Error::custom("captured"))
+        }
+        serde::forward_to_deserialize_any! {
+            bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string
+            bytes byte_buf option unit unit_struct newtype_struct seq tuple
+            tuple_struct map enum identifier ignored_any
+        }
+    }
+    let cell = Cell::new(&[][..]);
+    let _ = T::deserialize(Capture(&cell));
+    cell.get()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn field_names_come_from_serde() {
+        assert_eq!(
+            field_names::<RoadPatch>(),
+            &["lane_width", "lanes", "sidewalk_width", "goal_x"]
+        );
+        assert!(field_names::<MapPatch>().contains(&"pedestrians"));
+        assert!(field_names::<SpawnRule>().contains(&"pause"));
+    }
+
+    #[test]
+    fn suggestions() {
+        assert_eq!(
+            suggest("lane_widht", field_names::<RoadPatch>()),
+            "did you mean `lane_width`?"
+        );
+        assert!(suggest("zzzzzz", &["a", "b"]).starts_with("expected one of"));
+    }
+
+    #[test]
+    fn comments_only_is_empty() {
+        assert_eq!(strip_comments("// x\n/* y */ ").trim(), "");
+        assert_eq!(strip_comments("\"//\"").trim(), "\"//\"");
+    }
+}

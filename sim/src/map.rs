@@ -1,0 +1,573 @@
+//! The map: every parameter of one scenario, in real units (metres, seconds,
+//! m/s, m/s², kg). Every field has a default; the defaults are the training
+//! intersection of the paper (see `maps/intersection.ron` and `maps/README.md`).
+//!
+//! Coordinates: the road runs along +x; y = 0 is the road's centre line. The
+//! car drives in the lane on the negative-y side ("near" side); pedestrians
+//! cross along y.
+
+use serde::{Deserialize, Serialize};
+
+use crate::light::LightPhase;
+
+/// Defines a configuration struct with documented defaults, plus a crate-private
+/// "patch" twin whose fields are all optional: a scenario built on a base map
+/// only sets the fields that differ, and `apply` copies them over the base.
+macro_rules! config_struct {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident / $patch:ident as $ron_name:literal {
+            $(
+                $(#[$fmeta:meta])*
+                $field:ident : $ty:ty = $default:expr
+            ),* $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq, Serialize)]
+        pub struct $name {
+            $(
+                $(#[$fmeta])*
+                pub $field: $ty,
+            )*
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self { $( $field: $default, )* }
+            }
+        }
+
+        #[doc = concat!("Partial `", $ron_name, "`: only the fields a map file sets.")]
+        #[derive(Debug, Clone, Default, Deserialize)]
+        #[serde(deny_unknown_fields, rename = $ron_name)]
+        pub(crate) struct $patch {
+            $(
+                #[serde(default)]
+                $field: Option<$ty>,
+            )*
+        }
+
+        impl $patch {
+            /// Overwrite the fields of `base` that this patch sets.
+            pub(crate) fn apply(self, base: &mut $name) {
+                $( if let Some(v) = self.$field { base.$field = v; } )*
+            }
+        }
+    };
+}
+
+config_struct! {
+    /// The straight road from the start to the destination.
+    pub struct Road / RoadPatch as "Road" {
+        /// Width of one lane, m. Default 3.5.
+        lane_width: f64 = 3.5,
+        /// Number of lanes (the car drives in the first lane on the near, negative-y side). Default 2.
+        lanes: u32 = 2,
+        /// Width of each sidewalk beyond the kerb, m (pedestrians wait and finish there). Default 2.0.
+        sidewalk_width: f64 = 2.0,
+        /// x of the destination line, m; the episode succeeds when the car's front reaches it. Default 90.0.
+        goal_x: f64 = 90.0,
+    }
+}
+
+config_struct! {
+    /// The zebra crossing that pedestrians use.
+    pub struct Crosswalk / CrosswalkPatch as "Crosswalk" {
+        /// x of the crosswalk's centre line, m. Default 66.0 (24 m before the destination).
+        x: f64 = 66.0,
+        /// Width of the crosswalk along the road, m. Default 4.0 (so it spans x 64–68).
+        width: f64 = 4.0,
+    }
+}
+
+/// One phase of the traffic-light cycle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Phase {
+    /// Which light is shown.
+    pub phase: LightPhase,
+    /// How long it is shown, s (> 0).
+    pub duration: f64,
+}
+
+/// Where in its cycle the light is at time 0.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Offset {
+    /// Seconds into the cycle at time 0 (taken modulo the cycle length).
+    Fixed(f64),
+    /// Uniformly random over the cycle, drawn from the episode seed.
+    Random,
+}
+
+fn default_cycle() -> Vec<Phase> {
+    vec![
+        Phase {
+            phase: LightPhase::Green,
+            duration: 12.0,
+        },
+        Phase {
+            phase: LightPhase::Amber,
+            duration: 2.0,
+        },
+        Phase {
+            phase: LightPhase::Red,
+            duration: 10.0,
+        },
+    ]
+}
+
+config_struct! {
+    /// The traffic light at the crosswalk.
+    pub struct Light / LightPatch as "Light" {
+        /// Phases in order, repeated forever. Default green 12 s, amber 2 s, red 10 s.
+        cycle: Vec<Phase> = default_cycle(),
+        /// Position in the cycle at time 0. Default `Fixed(0.0)` (the start of green).
+        offset: Offset = Offset::Fixed(0.0),
+    }
+}
+
+config_struct! {
+    /// The ego car: a dynamic rigid body driven by longitudinal forces.
+    pub struct Vehicle / VehiclePatch as "Vehicle" {
+        /// Body length, m. Default 4.5.
+        length: f64 = 4.5,
+        /// Body width, m. Default 1.8.
+        width: f64 = 1.8,
+        /// Mass, kg. Default 1500.
+        mass: f64 = 1500.0,
+        /// x of the front bumper at time 0, m. Default 0.0.
+        start_x: f64 = 0.0,
+        /// Speed at time 0, m/s. Default 3.0.
+        start_speed: f64 = 3.0,
+        /// Acceleration of "speed up", m/s². Default 3.0.
+        max_accel: f64 = 3.0,
+        /// Deceleration of "slow down", m/s² (never below 0 m/s). Default 3.0.
+        max_brake: f64 = 3.0,
+        /// Speed cap, m/s. Default 9.0.
+        max_speed: f64 = 9.0,
+        /// Linear damping coefficient, 1/s (0 = "maintain" holds speed exactly). Default 0.0.
+        damping: f64 = 0.0,
+    }
+}
+
+config_struct! {
+    /// Discretizer bins (the paper's d and v factors).
+    pub struct Bins / BinsPatch as "Bins" {
+        /// Edges on distance-to-goal, m, strictly increasing; d = number of edges e with D > e.
+        /// Default [0, 30, 60]: d = 0 arrived, 1 within 30 m, 2 30–60 m, 3 beyond 60 m.
+        distance_edges: Vec<f64> = vec![0.0, 30.0, 60.0],
+        /// Edges on speed, m/s, strictly increasing; v = number of edges e with speed >= e.
+        /// Default [1.5, 4.5, 7.5].
+        speed_edges: Vec<f64> = vec![1.5, 4.5, 7.5],
+        /// Probability in [0, 1) that an observed factor is misreported. Default 0.
+        observation_noise: f64 = 0.0,
+    }
+}
+
+config_struct! {
+    /// Reward per decision tick (used by the runner, not by the physics).
+    pub struct Reward / RewardPatch as "Reward" {
+        /// Reward per metre of progress along +x. Default 0.5.
+        progress_per_metre: f64 = 0.5,
+        /// Reward on reaching the destination. Default 50.
+        goal: f64 = 50.0,
+        /// Reward on a collision with a pedestrian. Default -25.
+        crash: f64 = -25.0,
+        /// Cost subtracted every decision tick. Default 1.
+        step_cost: f64 = 1.0,
+    }
+}
+
+config_struct! {
+    /// Episode timing.
+    pub struct Episode / EpisodePatch as "Episode" {
+        /// Seconds of simulated time per decision tick. Default 1.0.
+        decision_dt: f64 = 1.0,
+        /// Physics sub-steps per second; decision_dt × physics_hz must be a whole number. Default 60.
+        physics_hz: f64 = 60.0,
+        /// Decision ticks before the episode times out. Default 40.
+        max_steps: u32 = 40,
+    }
+}
+
+/// What starts a pedestrian crossing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Trigger {
+    /// At the start of every red phase (repeats each cycle).
+    RedStarts,
+    /// At the start of every green phase (repeats each cycle).
+    GreenStarts,
+    /// Once, at this episode time, s.
+    AtTime(f64),
+    /// Once, when the car's front is between `min` and `max` metres before the
+    /// crosswalk's near edge.
+    CarWithin {
+        /// Closest distance, m.
+        min: f64,
+        /// Farthest distance, m.
+        max: f64,
+    },
+    /// Once, when the car (still before the crosswalk) would reach the
+    /// crosswalk's near edge within this many seconds at its current speed.
+    CarArrivesWithin(f64),
+}
+
+/// Which light the trigger requires when it fires.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum LightCondition {
+    /// Any phase.
+    #[default]
+    Any,
+    /// Only while the light is green (a jaywalker).
+    Green,
+    /// Only while the light is amber or red.
+    Red,
+}
+
+/// The kerb a pedestrian starts from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Side {
+    /// The car's side (negative y): steps straight into the car's lane.
+    Near,
+    /// The opposite side (positive y): crosses the other lane first.
+    Far,
+    /// Either, with equal probability, drawn from the seed.
+    #[default]
+    Random,
+}
+
+/// A pause in the middle of a crossing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pause {
+    /// Metres walked (from the start point) before stopping.
+    pub after: f64,
+    /// Seconds standing still.
+    pub duration: f64,
+}
+
+/// A rule that spawns pedestrians crossing the crosswalk.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SpawnRule {
+    /// When the rule fires. Default `RedStarts`.
+    pub trigger: Trigger,
+    /// Light required when it fires. Default `Any`.
+    pub light: LightCondition,
+    /// Probability that a firing spawns a pedestrian, in [0, 1]. Default 1.0.
+    pub probability: f64,
+    /// Start kerb. Default `Random`.
+    pub side: Side,
+    /// Walking speed range (min, max), m/s, uniform. Default (1.1, 1.5).
+    pub speed: (f64, f64),
+    /// Delay between firing and starting to walk (min, max), s, uniform. Default (0.0, 0.0).
+    pub delay: (f64, f64),
+    /// Offset of the walking line from the crosswalk's centre line along x (min, max), m. Default (0.0, 0.0).
+    pub x_offset: (f64, f64),
+    /// Metres behind the kerb where the pedestrian starts (and past the far kerb where it leaves). Default 0.5.
+    pub start_back: f64,
+    /// Body radius, m. Default 0.3.
+    pub radius: f64,
+    /// Optional stop in the middle of the crossing. Default `None`.
+    pub pause: Option<Pause>,
+}
+
+impl Default for SpawnRule {
+    fn default() -> Self {
+        SpawnRule {
+            trigger: Trigger::RedStarts,
+            light: LightCondition::Any,
+            probability: 1.0,
+            side: Side::Random,
+            speed: (1.1, 1.5),
+            delay: (0.0, 0.0),
+            x_offset: (0.0, 0.0),
+            start_back: 0.5,
+            radius: 0.3,
+            pause: None,
+        }
+    }
+}
+
+/// Methods the runner compares (names as written in maps).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum MethodName {
+    /// Tabular Q-learning.
+    QLearning,
+    /// Model-based Bayesian RL.
+    BayesRl,
+    /// The paper's method: surprise-triggered reasoning and test-time scaling.
+    Scaled,
+}
+
+/// Expected outcome of a batch run of one method on this map (checked by the runner).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Expectation {
+    /// Which method.
+    pub method: MethodName,
+    /// Lowest acceptable success rate, in [0, 1].
+    #[serde(default)]
+    pub min_success: Option<f64>,
+    /// Highest acceptable success rate, in [0, 1].
+    #[serde(default)]
+    pub max_success: Option<f64>,
+    /// Lowest acceptable mean return.
+    #[serde(default)]
+    pub min_reward: Option<f64>,
+    /// Highest acceptable mean return.
+    #[serde(default)]
+    pub max_reward: Option<f64>,
+    /// Highest acceptable collision rate, in [0, 1].
+    #[serde(default)]
+    pub max_collision: Option<f64>,
+    /// Highest acceptable share of ticks that ran planning, in [0, 1].
+    #[serde(default)]
+    pub max_inference_rate: Option<f64>,
+}
+
+/// A complete scenario. `Map::default()` is the training intersection without
+/// pedestrians.
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct Map {
+    /// Short name. Default: the file name without `.ron` (not inherited from a base).
+    pub name: String,
+    /// One-line description (not inherited from a base). Default "".
+    pub description: String,
+    /// The base map this one was built on, as written in the file (informational).
+    pub base: Option<String>,
+    /// Road geometry.
+    pub road: Road,
+    /// Crosswalk geometry.
+    pub crosswalk: Crosswalk,
+    /// Traffic light.
+    pub light: Light,
+    /// The ego car.
+    pub vehicle: Vehicle,
+    /// Pedestrian spawn rules (a map that sets this list replaces the base's list). Default [].
+    pub pedestrians: Vec<SpawnRule>,
+    /// Discretizer bins.
+    pub bins: Bins,
+    /// Reward.
+    pub reward: Reward,
+    /// Episode timing.
+    pub episode: Episode,
+    /// Expected batch results (replaces the base's list when set). Default [].
+    pub expect: Vec<Expectation>,
+}
+
+/// Partial map as read from a file, before it is laid over its base.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Map")]
+pub(crate) struct MapPatch {
+    #[serde(default)]
+    pub(crate) base: Option<String>,
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    description: Option<String>,
+    #[serde(default)]
+    road: Option<RoadPatch>,
+    #[serde(default)]
+    crosswalk: Option<CrosswalkPatch>,
+    #[serde(default)]
+    light: Option<LightPatch>,
+    #[serde(default)]
+    vehicle: Option<VehiclePatch>,
+    #[serde(default)]
+    pedestrians: Option<Vec<SpawnRule>>,
+    #[serde(default)]
+    bins: Option<BinsPatch>,
+    #[serde(default)]
+    reward: Option<RewardPatch>,
+    #[serde(default)]
+    episode: Option<EpisodePatch>,
+    #[serde(default)]
+    expect: Option<Vec<Expectation>>,
+}
+
+impl MapPatch {
+    /// Lay this patch over `base`. `default_name` is used when the patch has no name.
+    pub(crate) fn apply(self, mut base: Map, default_name: &str) -> Map {
+        base.name = self.name.unwrap_or_else(|| default_name.to_string());
+        base.description = self.description.unwrap_or_default();
+        base.base = self.base;
+        if let Some(p) = self.road {
+            p.apply(&mut base.road);
+        }
+        if let Some(p) = self.crosswalk {
+            p.apply(&mut base.crosswalk);
+        }
+        if let Some(p) = self.light {
+            p.apply(&mut base.light);
+        }
+        if let Some(p) = self.vehicle {
+            p.apply(&mut base.vehicle);
+        }
+        if let Some(p) = self.pedestrians {
+            base.pedestrians = p;
+        }
+        if let Some(p) = self.bins {
+            p.apply(&mut base.bins);
+        }
+        if let Some(p) = self.reward {
+            p.apply(&mut base.reward);
+        }
+        if let Some(p) = self.episode {
+            p.apply(&mut base.episode);
+        }
+        if let Some(p) = self.expect {
+            base.expect = p;
+        }
+        base
+    }
+}
+
+impl Road {
+    /// Half the paved width (kerb to kerb), m.
+    pub fn half_width(&self) -> f64 {
+        self.lanes as f64 * self.lane_width / 2.0
+    }
+
+    /// y of the car's lane centre (the first lane on the near side), m.
+    pub fn car_lane_y(&self) -> f64 {
+        -self.half_width() + self.lane_width / 2.0
+    }
+}
+
+impl Light {
+    /// Total cycle length, s.
+    pub fn cycle_length(&self) -> f64 {
+        self.cycle.iter().map(|p| p.duration).sum()
+    }
+}
+
+impl Episode {
+    /// Physics sub-steps per decision tick (decision_dt × physics_hz, rounded).
+    pub fn substeps(&self) -> u32 {
+        (self.decision_dt * self.physics_hz).round().max(1.0) as u32
+    }
+}
+
+impl Map {
+    /// Distances to the goal of the crosswalk's near (first met) and far edge, m:
+    /// `(goal_x - (x - width/2), goal_x - (x + width/2))`. Defaults: (26, 22).
+    pub fn crosswalk_distance_to_goal(&self) -> (f64, f64) {
+        let half = self.crosswalk.width / 2.0;
+        (
+            self.road.goal_x - (self.crosswalk.x - half),
+            self.road.goal_x - (self.crosswalk.x + half),
+        )
+    }
+
+    /// x of the crosswalk's near edge, m.
+    pub fn crosswalk_near_x(&self) -> f64 {
+        self.crosswalk.x - self.crosswalk.width / 2.0
+    }
+
+    /// A multi-line, human-readable summary of the scenario.
+    pub fn summary(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let _ = writeln!(s, "map {}", self.name);
+        if !self.description.is_empty() {
+            let _ = writeln!(s, "  {}", self.description);
+        }
+        if let Some(b) = &self.base {
+            let _ = writeln!(s, "  based on {b}");
+        }
+        let r = &self.road;
+        let (near, far) = self.crosswalk_distance_to_goal();
+        let _ = writeln!(
+            s,
+            "road: {} lane(s) x {} m, sidewalks {} m, destination at x = {} m",
+            r.lanes, r.lane_width, r.sidewalk_width, r.goal_x
+        );
+        let _ = writeln!(
+            s,
+            "crosswalk: x = {} m, {} m wide (distance to goal {near}..{far} m)",
+            self.crosswalk.x, self.crosswalk.width
+        );
+        let v = &self.vehicle;
+        let _ = writeln!(
+            s,
+            "car: {} x {} m, {} kg, front at x = {} m, {} m/s; accel {} m/s², brake {} m/s², max {} m/s, damping {}",
+            v.length, v.width, v.mass, v.start_x, v.start_speed, v.max_accel, v.max_brake, v.max_speed, v.damping
+        );
+        let cycle: Vec<String> = self
+            .light
+            .cycle
+            .iter()
+            .map(|p| format!("{} {} s", p.phase, p.duration))
+            .collect();
+        let offset = match self.light.offset {
+            Offset::Fixed(o) => format!("offset {o} s"),
+            Offset::Random => "random offset".to_string(),
+        };
+        let _ = writeln!(s, "light: {} ({offset})", cycle.join(", "));
+        if self.pedestrians.is_empty() {
+            let _ = writeln!(s, "pedestrians: none");
+        }
+        for (i, p) in self.pedestrians.iter().enumerate() {
+            let trig = match p.trigger {
+                Trigger::RedStarts => "at each red start".to_string(),
+                Trigger::GreenStarts => "at each green start".to_string(),
+                Trigger::AtTime(t) => format!("at t = {t} s"),
+                Trigger::CarWithin { min, max } => {
+                    format!("when the car is {min}..{max} m before the crosswalk")
+                }
+                Trigger::CarArrivesWithin(t) => {
+                    format!("when the car would reach the crosswalk within {t} s")
+                }
+            };
+            let pause = match p.pause {
+                Some(pa) => format!(", stops {} s after {} m", pa.duration, pa.after),
+                None => String::new(),
+            };
+            let _ = writeln!(
+                s,
+                "pedestrian rule {i}: {trig}, light {:?}, p = {}, side {:?}, {}..{} m/s, delay {}..{} s, radius {} m{pause}",
+                p.light, p.probability, p.side, p.speed.0, p.speed.1, p.delay.0, p.delay.1, p.radius
+            );
+        }
+        let b = &self.bins;
+        let _ = writeln!(
+            s,
+            "bins: distance {:?} m, speed {:?} m/s, observation noise {}",
+            b.distance_edges, b.speed_edges, b.observation_noise
+        );
+        let w = &self.reward;
+        let _ = writeln!(
+            s,
+            "reward: {} per metre, goal {}, crash {}, step cost {}",
+            w.progress_per_metre, w.goal, w.crash, w.step_cost
+        );
+        let e = &self.episode;
+        let _ = writeln!(
+            s,
+            "episode: {} s per tick, {} Hz physics ({} sub-steps), at most {} ticks",
+            e.decision_dt,
+            e.physics_hz,
+            e.substeps(),
+            e.max_steps
+        );
+        for x in &self.expect {
+            let mut parts = Vec::new();
+            for (label, val) in [
+                ("min_success", x.min_success),
+                ("max_success", x.max_success),
+                ("min_reward", x.min_reward),
+                ("max_reward", x.max_reward),
+                ("max_collision", x.max_collision),
+                ("max_inference_rate", x.max_inference_rate),
+            ] {
+                if let Some(v) = val {
+                    parts.push(format!("{label} {v}"));
+                }
+            }
+            let _ = writeln!(s, "expect {:?}: {}", x.method, parts.join(", "));
+        }
+        s
+    }
+}

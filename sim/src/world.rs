@@ -1,0 +1,543 @@
+//! The Rapier world built from a map: the car (a dynamic body pushed by
+//! longitudinal forces), pedestrians (kinematic bodies with sensor colliders),
+//! the traffic light, spawn rules, and the episode's end.
+
+use std::sync::Mutex;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rapier2d::prelude::*;
+
+use crate::light::{LightPhase, light_at};
+use crate::map::{LightCondition, Map, Offset, Pause, Side, Trigger};
+
+/// The three longitudinal actions of the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Action {
+    /// Hold the current speed.
+    Maintain = 0,
+    /// Accelerate at `vehicle.max_accel` (up to `vehicle.max_speed`).
+    SpeedUp = 1,
+    /// Brake at `vehicle.max_brake` (never below 0 m/s).
+    SlowDown = 2,
+}
+
+impl Action {
+    /// All actions, in index order.
+    pub const ALL: [Action; 3] = [Action::Maintain, Action::SpeedUp, Action::SlowDown];
+
+    /// The action with this index (0 maintain, 1 speed up, 2 slow down).
+    pub fn from_index(i: usize) -> Option<Action> {
+        Action::ALL.get(i).copied()
+    }
+
+    /// This action's index.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl std::fmt::Display for Action {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Action::Maintain => "maintain",
+            Action::SpeedUp => "speed up",
+            Action::SlowDown => "slow down",
+        })
+    }
+}
+
+/// One pedestrian as seen by an observer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PedestrianSnapshot {
+    /// Position, m.
+    pub x: f64,
+    /// Position, m (the car's lane is at negative y).
+    pub y: f64,
+    /// Velocity, m/s.
+    pub vx: f64,
+    /// Velocity, m/s.
+    pub vy: f64,
+    /// Whether the centre is within the road part of the crosswalk (kerb to kerb).
+    pub on_crosswalk: bool,
+}
+
+/// Everything an observer (the discretizer) may look at after a tick.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Snapshot {
+    /// Decision ticks done.
+    pub step: u32,
+    /// Simulated time, s.
+    pub time: f64,
+    /// x of the car's front bumper, m.
+    pub car_x: f64,
+    /// Speed along +x, m/s (>= 0).
+    pub car_speed: f64,
+    /// `road.goal_x - car_x`, m; <= 0 once arrived.
+    pub distance_to_goal: f64,
+    /// Light shown now.
+    pub light: LightPhase,
+    /// Seconds until the light changes.
+    pub light_time_left: f64,
+    /// Pedestrians currently in the world (spawned and not yet gone).
+    pub pedestrians: Vec<PedestrianSnapshot>,
+}
+
+impl Snapshot {
+    /// Whether any pedestrian is on the road part of the crosswalk.
+    pub fn pedestrian_on_crosswalk(&self) -> bool {
+        self.pedestrians.iter().any(|p| p.on_crosswalk)
+    }
+}
+
+/// What one decision tick did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepOutcome {
+    /// Decision ticks done (after this one).
+    pub step: u32,
+    /// The car touched a pedestrian (reported by Rapier's collision events).
+    pub collision: bool,
+    /// The car's front reached the destination (and there was no collision).
+    pub goal: bool,
+    /// The step limit was reached without goal or collision.
+    pub timeout: bool,
+    /// Metres the car's front advanced during this tick.
+    pub progress: f64,
+}
+
+impl StepOutcome {
+    /// Whether the episode is over.
+    pub fn done(&self) -> bool {
+        self.collision || self.goal || self.timeout
+    }
+}
+
+/// Collects Rapier's collision-start events during a step.
+#[derive(Default)]
+struct Events(Mutex<Vec<(ColliderHandle, ColliderHandle)>>);
+
+impl EventHandler for Events {
+    fn handle_collision_event(
+        &self,
+        _bodies: &RigidBodySet,
+        _colliders: &ColliderSet,
+        event: CollisionEvent,
+        _contact_pair: Option<&ContactPair>,
+    ) {
+        if let CollisionEvent::Started(a, b, _) = event
+            && let Ok(mut v) = self.0.lock()
+        {
+            v.push((a, b));
+        }
+    }
+
+    fn handle_contact_force_event(
+        &self,
+        _dt: Real,
+        _bodies: &RigidBodySet,
+        _colliders: &ColliderSet,
+        _contact_pair: &ContactPair,
+        _total_force_magnitude: Real,
+    ) {
+    }
+
+    fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
+}
+
+impl Events {
+    fn touches(&self, c: ColliderHandle) -> bool {
+        match self.0.lock() {
+            Ok(mut v) => {
+                let hit = v.iter().any(|&(a, b)| a == c || b == c);
+                v.clear();
+                hit
+            }
+            Err(_) => false,
+        }
+    }
+}
+
+/// A pedestrian walking across the crosswalk.
+struct Pedestrian {
+    body: RigidBodyHandle,
+    x: f64,
+    y0: f64,
+    /// +1 walking towards +y, -1 towards -y.
+    dir: f64,
+    speed: f64,
+    walked: f64,
+    length: f64,
+    pause: Option<Pause>,
+    pause_left: f64,
+    moving: bool,
+}
+
+/// A pedestrian decided by a rule, waiting for its start time.
+struct Pending {
+    at_substep: u64,
+    rule: usize,
+    side_far: bool,
+    speed: f64,
+    x_offset: f64,
+}
+
+/// The simulated intersection. Drive it with [`World::step`].
+///
+/// ```
+/// use unforeseen_sim::{embedded, Action, World};
+/// let map = embedded::load("intersection").unwrap();
+/// let mut world = World::from_map(&map, 7);
+/// while !world.is_done() {
+///     let out = world.step(Action::SpeedUp);
+///     assert!(out.progress >= 0.0);
+/// }
+/// assert!(world.snapshot().distance_to_goal <= 0.0 || world.snapshot().step == map.episode.max_steps);
+/// ```
+pub struct World {
+    map: Map,
+    phys: PhysicsWorld,
+    car: RigidBodyHandle,
+    car_collider: ColliderHandle,
+    rng: ChaCha8Rng,
+    light_offset: f64,
+    substeps: u32,
+    substep: u64,
+    step: u32,
+    fired: Vec<bool>,
+    pending: Vec<Pending>,
+    peds: Vec<Pedestrian>,
+    prev_phase: LightPhase,
+    terminal: Option<StepOutcome>,
+}
+
+impl World {
+    /// Build the world for one episode. All randomness (light offset, spawn
+    /// draws) comes from `seed`. The map should be valid (as returned by the
+    /// loaders); invalid numbers are not checked here again.
+    pub fn from_map(map: &Map, seed: u64) -> World {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let cycle = map.light.cycle_length();
+        let light_offset = match map.light.offset {
+            Offset::Fixed(o) => o,
+            Offset::Random => rng.random_range(0.0..1.0) * cycle,
+        };
+        let mut phys = PhysicsWorld::new();
+        phys.gravity = Vector::ZERO;
+        phys.integration_parameters.dt = (1.0 / map.episode.physics_hz) as Real;
+
+        let v = &map.vehicle;
+        let body = RigidBodyBuilder::dynamic()
+            .translation(Vector::new(
+                (v.start_x - v.length / 2.0) as Real,
+                map.road.car_lane_y() as Real,
+            ))
+            .linvel(Vector::new(v.start_speed as Real, 0.0))
+            .linear_damping(v.damping as Real)
+            .angular_damping(0.0)
+            // The car stays in its lane and pointed along +x.
+            .enabled_translations(true, false)
+            .lock_rotations()
+            .can_sleep(false);
+        let collider = ColliderBuilder::cuboid((v.length / 2.0) as Real, (v.width / 2.0) as Real)
+            .mass(v.mass as Real)
+            .friction(0.0)
+            .active_events(ActiveEvents::COLLISION_EVENTS);
+        let (car, car_collider) = phys.insert(body, collider);
+        let prev_phase = light_at(&map.light, light_offset, 0.0).0;
+        World {
+            map: map.clone(),
+            phys,
+            car,
+            car_collider,
+            rng,
+            light_offset,
+            substeps: map.episode.substeps(),
+            substep: 0,
+            step: 0,
+            fired: vec![false; map.pedestrians.len()],
+            pending: Vec::new(),
+            peds: Vec::new(),
+            prev_phase,
+            terminal: None,
+        }
+    }
+
+    /// The map this world was built from.
+    pub fn map(&self) -> &Map {
+        &self.map
+    }
+
+    /// Whether the episode has ended (goal, collision or time-out).
+    pub fn is_done(&self) -> bool {
+        self.terminal.is_some()
+    }
+
+    /// The light's cycle offset used in this episode, s.
+    pub fn light_offset(&self) -> f64 {
+        self.light_offset
+    }
+
+    fn time_at(&self, substep: u64) -> f64 {
+        substep as f64 / self.map.episode.physics_hz
+    }
+
+    fn car_front(&self) -> f64 {
+        self.phys.bodies[self.car].translation().x as f64 + self.map.vehicle.length / 2.0
+    }
+
+    fn car_speed(&self) -> f64 {
+        (self.phys.bodies[self.car].linvel().x as f64).max(0.0)
+    }
+
+    /// Advance one decision tick (`episode.decision_dt` seconds in
+    /// `decision_dt × physics_hz` sub-steps) with `action` held throughout.
+    /// Stepping a finished world changes nothing and returns the terminal outcome again.
+    pub fn step(&mut self, action: Action) -> StepOutcome {
+        if let Some(t) = self.terminal {
+            return t;
+        }
+        let start_x = self.car_front();
+        let events = Events::default();
+        let mut collision = false;
+        let mut goal = false;
+        for _ in 0..self.substeps {
+            self.spawn_due();
+            self.move_pedestrians();
+            self.control_car(action);
+            self.phys.step_with_events(&(), &events);
+            self.substep += 1;
+            self.after_substep();
+            // Sensor events arrive one sub-step after the overlap (RAPIER.md §6.4);
+            // a collision is therefore detected at most 1/physics_hz late.
+            if events.touches(self.car_collider) {
+                collision = true;
+                break;
+            }
+            if self.car_front() >= self.map.road.goal_x {
+                goal = true;
+                break;
+            }
+        }
+        if !collision {
+            // Flush the late sensor event of the last sub-step, so a collision
+            // is never reported a whole tick late.
+            self.phys.detect_collisions(&(), &events);
+            if events.touches(self.car_collider) {
+                collision = true;
+                goal = false;
+            }
+        }
+        self.step += 1;
+        let timeout = !collision && !goal && self.step >= self.map.episode.max_steps;
+        let out = StepOutcome {
+            step: self.step,
+            collision,
+            goal,
+            timeout,
+            progress: self.car_front() - start_x,
+        };
+        if out.done() {
+            self.terminal = Some(out);
+        }
+        out
+    }
+
+    /// Apply the action as a longitudinal force for one sub-step: `m·a`,
+    /// reduced near `max_speed` and near standstill so that the speed lands
+    /// exactly on the limit and never goes negative.
+    fn control_car(&mut self, action: Action) {
+        let v = &self.map.vehicle;
+        let h = 1.0 / self.map.episode.physics_hz;
+        let body = &mut self.phys.bodies[self.car];
+        let speed = body.linvel().x as f64;
+        let dv = match action {
+            Action::Maintain => 0.0,
+            Action::SpeedUp => (v.max_accel * h).min(v.max_speed - speed).max(0.0),
+            Action::SlowDown => -(v.max_brake * h).min(speed.max(0.0)),
+        };
+        body.reset_forces(true);
+        if dv != 0.0 {
+            body.add_force(Vector::new((v.mass * dv / h) as Real, 0.0), true);
+        }
+    }
+
+    /// Keep the car's speed within [0, max_speed] after f32 integration.
+    fn after_substep(&mut self) {
+        let max = self.map.vehicle.max_speed as Real;
+        let body = &mut self.phys.bodies[self.car];
+        let vx = body.linvel().x;
+        if vx < 0.0 {
+            body.set_linvel(Vector::ZERO, true);
+        } else if vx > max {
+            body.set_linvel(Vector::new(max, 0.0), true);
+        }
+        // Remove pedestrians that reached the far sidewalk.
+        let mut i = 0;
+        while i < self.peds.len() {
+            if self.peds[i].walked >= self.peds[i].length {
+                let p = self.peds.swap_remove(i);
+                self.phys.remove_body_with_colliders(p.body, true);
+            } else {
+                i += 1;
+            }
+        }
+    }
+
+    /// Fire spawn rules whose trigger holds at the current sub-step, and create
+    /// pedestrians whose delay has elapsed.
+    fn spawn_due(&mut self) {
+        let t = self.time_at(self.substep);
+        let (phase, _) = light_at(&self.map.light, self.light_offset, t);
+        let front = self.car_front();
+        let speed = self.car_speed();
+        let near_x = self.map.crosswalk_near_x();
+        let to_cross = near_x - front;
+        let h = 1.0 / self.map.episode.physics_hz;
+        for i in 0..self.map.pedestrians.len() {
+            let rule = &self.map.pedestrians[i];
+            let fires = match rule.trigger {
+                Trigger::RedStarts => phase == LightPhase::Red && self.prev_phase != LightPhase::Red,
+                Trigger::GreenStarts => phase == LightPhase::Green && self.prev_phase != LightPhase::Green,
+                Trigger::AtTime(at) => !self.fired[i] && t + 1e-9 >= at,
+                Trigger::CarWithin { min, max } => !self.fired[i] && to_cross >= min && to_cross <= max,
+                Trigger::CarArrivesWithin(secs) => {
+                    !self.fired[i] && to_cross > 0.0 && speed > 1e-3 && to_cross <= secs * speed
+                }
+            };
+            let light_ok = match rule.light {
+                LightCondition::Any => true,
+                LightCondition::Green => phase.is_green(),
+                LightCondition::Red => !phase.is_green(),
+            };
+            if !(fires && light_ok) {
+                continue;
+            }
+            self.fired[i] = true;
+            let rule = rule.clone();
+            if self.rng.random_range(0.0..1.0) >= rule.probability {
+                continue;
+            }
+            let side_far = match rule.side {
+                Side::Near => false,
+                Side::Far => true,
+                Side::Random => self.rng.random_range(0.0..1.0) < 0.5,
+            };
+            let speed = uniform(&mut self.rng, rule.speed);
+            let delay = uniform(&mut self.rng, rule.delay);
+            let x_offset = uniform(&mut self.rng, rule.x_offset);
+            self.pending.push(Pending {
+                at_substep: self.substep + (delay / h).round() as u64,
+                rule: i,
+                side_far,
+                speed,
+                x_offset,
+            });
+        }
+        self.prev_phase = phase;
+
+        let mut k = 0;
+        while k < self.pending.len() {
+            if self.pending[k].at_substep <= self.substep {
+                let p = self.pending.remove(k);
+                self.spawn(p);
+            } else {
+                k += 1;
+            }
+        }
+    }
+
+    fn spawn(&mut self, p: Pending) {
+        let rule = &self.map.pedestrians[p.rule];
+        let half = self.map.road.half_width();
+        let dir = if p.side_far { -1.0 } else { 1.0 };
+        let y0 = -dir * (half + rule.start_back);
+        let x = self.map.crosswalk.x + p.x_offset;
+        let body = RigidBodyBuilder::kinematic_position_based().translation(Vector::new(x as Real, y0 as Real));
+        let collider = ColliderBuilder::ball(rule.radius as Real).sensor(true);
+        let (body, _) = self.phys.insert(body, collider);
+        self.peds.push(Pedestrian {
+            body,
+            x,
+            y0,
+            dir,
+            speed: p.speed,
+            walked: 0.0,
+            length: 2.0 * (half + rule.start_back),
+            pause: rule.pause,
+            pause_left: 0.0,
+            moving: true,
+        });
+    }
+
+    /// Set each pedestrian's kinematic target for the coming sub-step.
+    fn move_pedestrians(&mut self) {
+        let h = 1.0 / self.map.episode.physics_hz;
+        for p in &mut self.peds {
+            if p.pause_left > 0.0 {
+                p.pause_left -= h;
+                p.moving = false;
+            } else {
+                let mut next = p.walked + p.speed * h;
+                if let Some(pa) = p.pause
+                    && p.walked < pa.after
+                    && next >= pa.after
+                {
+                    next = pa.after;
+                    p.pause_left = pa.duration;
+                    p.pause = None;
+                }
+                p.moving = next > p.walked;
+                p.walked = next.min(p.length);
+            }
+            let target = Vector::new(p.x as Real, (p.y0 + p.dir * p.walked) as Real);
+            self.phys.bodies[p.body].set_next_kinematic_translation(target);
+        }
+    }
+
+    /// The observable state after the last tick.
+    pub fn snapshot(&self) -> Snapshot {
+        let t = self.time_at(self.substep);
+        let (light, left) = light_at(&self.map.light, self.light_offset, t);
+        let car_x = self.car_front();
+        let half = self.map.road.half_width();
+        let cw = &self.map.crosswalk;
+        let pedestrians = self
+            .peds
+            .iter()
+            .map(|p| {
+                let pos = self.phys.bodies[p.body].translation();
+                let (x, y) = (pos.x as f64, pos.y as f64);
+                let vy = if p.moving && p.pause_left <= 0.0 {
+                    p.dir * p.speed
+                } else {
+                    0.0
+                };
+                PedestrianSnapshot {
+                    x,
+                    y,
+                    vx: 0.0,
+                    vy,
+                    on_crosswalk: (x - cw.x).abs() <= cw.width / 2.0 && y.abs() <= half,
+                }
+            })
+            .collect();
+        Snapshot {
+            step: self.step,
+            time: t,
+            car_x,
+            car_speed: self.car_speed(),
+            distance_to_goal: self.map.road.goal_x - car_x,
+            light,
+            light_time_left: left,
+            pedestrians,
+        }
+    }
+}
+
+fn uniform(rng: &mut ChaCha8Rng, (lo, hi): (f64, f64)) -> f64 {
+    if hi > lo {
+        lo + rng.random_range(0.0..1.0) * (hi - lo)
+    } else {
+        lo
+    }
+}
