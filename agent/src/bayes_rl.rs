@@ -1,0 +1,244 @@
+//! The Bayesian-RL baseline (§VI): a Dirichlet posterior over joint transitions (flat,
+//! or the factored model as an ablation), a learned mean reward, and planning on every
+//! tick on the posterior-mean MDP (value iteration warm-started from the last values,
+//! or finite-horizon lookahead). Terminal transitions lead to an absorbing state of value 0.
+
+use crate::controller::{Controller, Decision, one_hot};
+use crate::error::{AgentError, ParamError};
+use crate::maths::argmax;
+use crate::model::WorldModel;
+use crate::params::{BayesModel, BayesRlParams, ModelPriors, Planner};
+use serde::{Deserialize, Serialize};
+
+/// Model-based Bayesian RL.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BayesRl {
+    n_states: usize,
+    n_actions: usize,
+    params: BayesRlParams,
+    /// Successor counts `[(s * A + a) * N + s']` (non-terminal transitions).
+    counts: Vec<f64>,
+    /// Terminal-transition counts `[s * A + a]`.
+    terminal: Vec<f64>,
+    /// Visits `[s * A + a]` (all transitions).
+    visits: Vec<f64>,
+    /// Reward sums `[s * A + a]`.
+    reward_sum: Vec<f64>,
+    /// The factored model, if `params.model` is `Factored`.
+    factored: Option<WorldModel>,
+    #[serde(skip)]
+    cache: Option<Cache>,
+    #[serde(skip)]
+    last: Option<(usize, usize)>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Cache {
+    /// Posterior-mean transition to non-terminal successors `[(s * A + a) * N + s']`.
+    p: Vec<f64>,
+    r: Vec<f64>,
+    v: Vec<f64>,
+    qv: Vec<f64>,
+    dirty: bool,
+}
+
+impl BayesRl {
+    /// A posterior with prior counts only.
+    pub fn new(n_states: usize, n_actions: usize, params: BayesRlParams) -> Result<BayesRl, AgentError> {
+        params.check()?;
+        if n_states == 0 || n_actions == 0 {
+            return Err(ParamError::new("n_states/n_actions", 0, ">= 1").into());
+        }
+        let factored = match &params.model {
+            BayesModel::Flat => None,
+            BayesModel::Factored(st) => {
+                if st.joint_size() != n_states {
+                    return Err(AgentError::SizeMismatch {
+                        what: "factored structure joint size".into(),
+                        expected: n_states,
+                        found: st.joint_size(),
+                    });
+                }
+                let priors = ModelPriors {
+                    transition_concentration: params.prior_concentration,
+                    ..Default::default()
+                };
+                Some(WorldModel::new(st.clone(), n_actions, &priors)?)
+            }
+        };
+        let sa = n_states * n_actions;
+        Ok(BayesRl {
+            n_states,
+            n_actions,
+            counts: vec![0.0; sa * n_states],
+            terminal: vec![0.0; sa],
+            visits: vec![0.0; sa],
+            reward_sum: vec![0.0; sa],
+            factored,
+            params,
+            cache: None,
+            last: None,
+        })
+    }
+
+    /// Parameters.
+    pub fn params(&self) -> &BayesRlParams {
+        &self.params
+    }
+
+    /// Update the Dirichlet counts and the running mean reward with one transition.
+    /// A terminal transition (`done`) goes to the absorbing state (value 0).
+    pub fn observe_transition(&mut self, s: usize, a: usize, r: f64, s_next: usize, done: bool) {
+        let (n, na) = (self.n_states, self.n_actions);
+        if s >= n || a >= na || s_next >= n {
+            return;
+        }
+        let i = s * na + a;
+        self.visits[i] += 1.0;
+        self.reward_sum[i] += r;
+        if done {
+            self.terminal[i] += 1.0;
+        } else {
+            self.counts[i * n + s_next] += 1.0;
+            if let Some(m) = self.factored.as_mut() {
+                m.observe_transition(s, a, s_next);
+            }
+        }
+        if let Some(c) = self.cache.as_mut() {
+            c.dirty = true;
+        }
+    }
+
+    /// Posterior-mean reward of `(s, a)` (the prior mean if unvisited).
+    pub fn mean_reward(&self, s: usize, a: usize) -> f64 {
+        let i = s * self.n_actions + a;
+        if self.visits[i] > 0.0 { self.reward_sum[i] / self.visits[i] } else { self.params.reward_prior }
+    }
+
+    fn rebuild(&mut self) {
+        let (n, na) = (self.n_states, self.n_actions);
+        let prior = self.params.prior_concentration;
+        if let Some(m) = self.factored.as_mut() {
+            m.materialize();
+        }
+        let cache = self.cache.get_or_insert_with(|| Cache {
+            p: vec![0.0; n * na * n],
+            r: vec![0.0; n * na],
+            v: vec![0.0; n],
+            qv: vec![0.0; n * na],
+            dirty: true,
+        });
+        for s in 0..n {
+            for a in 0..na {
+                let i = s * na + a;
+                let total = self.visits[i] + prior * n as f64;
+                let row = &mut cache.p[i * n..(i + 1) * n];
+                if total <= 0.0 {
+                    row.iter_mut().for_each(|x| *x = 1.0 / n as f64);
+                } else if let Some(m) = self.factored.as_ref() {
+                    let keep = (total - self.terminal[i]) / total;
+                    let col = &m.b(a).as_slice()[s * n..(s + 1) * n];
+                    for (x, b) in row.iter_mut().zip(col) {
+                        *x = keep * b;
+                    }
+                } else {
+                    for (x, c) in row.iter_mut().zip(&self.counts[i * n..(i + 1) * n]) {
+                        *x = (c + prior) / total;
+                    }
+                }
+                cache.r[i] = if self.visits[i] > 0.0 {
+                    self.reward_sum[i] / self.visits[i]
+                } else {
+                    self.params.reward_prior
+                };
+            }
+        }
+        cache.dirty = false;
+    }
+
+    /// Plan on the posterior-mean MDP (value iteration or lookahead) and return `Q(s, ·)`.
+    pub fn plan(&mut self, s: usize) -> &[f64] {
+        if self.cache.as_ref().is_none_or(|c| c.dirty) {
+            self.rebuild();
+        }
+        let (n, na) = (self.n_states, self.n_actions);
+        let gamma = self.params.discount;
+        let planner = self.params.planner.clone();
+        let Some(c) = self.cache.as_mut() else {
+            unreachable!("cache built above")
+        };
+        let sweep = |c: &mut Cache| -> f64 {
+            let mut delta: f64 = 0.0;
+            for s in 0..n {
+                let mut best = f64::NEG_INFINITY;
+                for a in 0..na {
+                    let i = s * na + a;
+                    let row = &c.p[i * n..(i + 1) * n];
+                    let ev: f64 = row.iter().zip(&c.v).map(|(p, v)| p * v).sum();
+                    let q = c.r[i] + gamma * ev;
+                    c.qv[i] = q;
+                    best = best.max(q);
+                }
+                delta = delta.max((best - c.v[s]).abs());
+                c.v[s] = best;
+            }
+            delta
+        };
+        match planner {
+            Planner::ValueIteration { iterations, tol } => {
+                for _ in 0..iterations {
+                    if sweep(c) < tol {
+                        break;
+                    }
+                }
+            }
+            Planner::Lookahead { horizon } => {
+                c.v.iter_mut().for_each(|v| *v = 0.0);
+                for _ in 0..horizon {
+                    // Synchronous backward induction: compute from a snapshot of V.
+                    let v_old = c.v.clone();
+                    for s in 0..n {
+                        let mut best = f64::NEG_INFINITY;
+                        for a in 0..na {
+                            let i = s * na + a;
+                            let row = &c.p[i * n..(i + 1) * n];
+                            let ev: f64 = row.iter().zip(&v_old).map(|(p, v)| p * v).sum();
+                            c.qv[i] = c.r[i] + gamma * ev;
+                            best = best.max(c.qv[i]);
+                        }
+                        c.v[s] = best;
+                    }
+                }
+            }
+        }
+        &c.qv[s * na..(s + 1) * na]
+    }
+}
+
+impl Controller for BayesRl {
+    fn name(&self) -> &'static str {
+        "bayes-rl"
+    }
+    fn begin_episode(&mut self, _seed: u64) {
+        self.last = None;
+    }
+    /// Plans on every tick (inference rate 100%), then acts greedily (ties: lowest index).
+    fn act(&mut self, obs: usize) -> Decision {
+        let obs = obs.min(self.n_states - 1);
+        let action = argmax(self.plan(obs));
+        self.last = Some((obs, action));
+        Decision {
+            action,
+            reasoned: true,
+            policy: one_hot(self.n_actions, action),
+            ..Default::default()
+        }
+    }
+    fn observe(&mut self, reward: f64, next_obs: usize, done: bool) {
+        if self.params.learn_online {
+            if let Some((s, a)) = self.last {
+                self.observe_transition(s, a, reward, next_obs, done);
+            }
+        }
+    }
+}

@@ -1,0 +1,354 @@
+//! The paper's agent (§II–§V): Q-learning's policy as the habitual `π_o`, surprise-
+//! triggered reasoning (VMP perception, EFE planning, test-time scaling), and
+//! test-time learning at the end of each episode.
+//!
+//! Feed-forward ticks (`θ_t <= ε`) are cheap: `q_t` by one exact Bayes step and the
+//! action from `π_o(·|q_t)`; no VMP and no planning (§II footnote). Reasoning ticks:
+//! VMP over the window -> `q_t`, EFE tree -> `ψ`, scaling `π_o(·|q_t)` -> `π'`, act.
+
+use crate::controller::{Controller, Decision};
+use crate::error::AgentError;
+use crate::learning;
+use crate::maths::argmax;
+use crate::model::WorldModel;
+use crate::params::{ActionSelection, ReasoningMode, ScaledParams, ScalingMode};
+use crate::perception::{VmpWorkspace, vmp};
+use crate::planning::{EfeTree, q_s};
+use crate::q_learning::QLearning;
+use crate::scaling::{scale_closed_form, scale_iterative};
+use crate::surprise::{bayes_step, predict_into, surprise, theta};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// What the last reasoning tick computed (buffers reused between ticks).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReasoningTrace {
+    /// Free energy at the end of VMP (nats).
+    pub free_energy: f64,
+    /// VMP sweeps.
+    pub vmp_iters: u32,
+    /// `G(π)` per policy (lexicographic).
+    pub g: Vec<f64>,
+    /// `q(π)`.
+    pub q_pi: Vec<f64>,
+    /// `ψ(u)`.
+    pub psi: Vec<f64>,
+    /// `Q_S(u) = -(1/γ) ln ψ(u)`.
+    pub q_s: Vec<f64>,
+    /// `π_o(·|q_t)`.
+    pub pi_o: Vec<f64>,
+    /// `π'`.
+    pub pi_scaled: Vec<f64>,
+    /// `KL[π_o || ψ]`.
+    pub kl_initial: f64,
+    /// `KL[π' || ψ]`.
+    pub kl_final: f64,
+}
+
+/// The scaled active-inference agent (DESIGN §5–6 "scaled").
+#[derive(Debug, Clone)]
+pub struct ScaledAgent {
+    model: WorldModel,
+    params: ScaledParams,
+    n_states: usize,
+    n_actions: usize,
+    /// Policy counts `ν`, `[s * n_actions + u]`.
+    nu: Vec<f64>,
+    rng: ChaCha8Rng,
+    tree: EfeTree,
+    vmp_ws: VmpWorkspace,
+    s_hat: Vec<f64>,
+    q_cur: Vec<f64>,
+    pi: Vec<f64>,
+    window_q: Vec<Vec<f64>>,
+    window_obs: Vec<usize>,
+    /// Episode history.
+    hist_obs: Vec<usize>,
+    hist_act: Vec<usize>,
+    hist_q: Vec<f64>,
+    hist_surprise: Vec<f64>,
+    hist_reasoned: Vec<bool>,
+    final_obs: Option<usize>,
+    /// One-hot index of the last posterior, if it was one-hot.
+    prev_one_hot: Option<usize>,
+    last: ReasoningTrace,
+}
+
+impl ScaledAgent {
+    /// Build the agent from a trained world model and Q-table: `ν = ν0 σ(Q[s,·]/T)` (DESIGN §5).
+    pub fn new(model: WorldModel, q: &QLearning, params: ScaledParams) -> Result<ScaledAgent, AgentError> {
+        params.check()?;
+        let n = model.n_states();
+        let na = model.n_actions();
+        if q.n_states() != n {
+            return Err(AgentError::SizeMismatch {
+                what: "Q-table states vs world-model states".into(),
+                expected: n,
+                found: q.n_states(),
+            });
+        }
+        if q.n_actions() != na {
+            return Err(AgentError::SizeMismatch {
+                what: "Q-table actions vs world-model actions".into(),
+                expected: na,
+                found: q.n_actions(),
+            });
+        }
+        let nu = learning::nu_from_q(q.table(), na, params.nu0, params.nu_temperature);
+        let n_obs = model.generative().n_obs();
+        Ok(ScaledAgent {
+            tree: EfeTree::new(n, n_obs, na, params.horizon),
+            window_q: vec![vec![0.0; n]; params.vmp_window],
+            window_obs: Vec::with_capacity(params.vmp_window),
+            rng: ChaCha8Rng::seed_from_u64(0),
+            vmp_ws: VmpWorkspace::default(),
+            s_hat: vec![0.0; n],
+            q_cur: vec![0.0; n],
+            pi: vec![0.0; na],
+            hist_obs: Vec::with_capacity(256),
+            hist_act: Vec::with_capacity(256),
+            hist_q: Vec::with_capacity(256 * n),
+            hist_surprise: Vec::with_capacity(256),
+            hist_reasoned: Vec::with_capacity(256),
+            final_obs: None,
+            prev_one_hot: None,
+            last: ReasoningTrace::default(),
+            model,
+            params,
+            n_states: n,
+            n_actions: na,
+            nu,
+        })
+    }
+
+    /// The world model.
+    pub fn model(&self) -> &WorldModel {
+        &self.model
+    }
+    /// Parameters.
+    pub fn params(&self) -> &ScaledParams {
+        &self.params
+    }
+    /// Policy counts `ν`, `[s * n_actions + u]` (§V-C).
+    pub fn nu(&self) -> &[f64] {
+        &self.nu
+    }
+    /// `π_o(·|s)` (Dirichlet mean of `ν`, §V-C).
+    pub fn pi_o(&self, s: usize) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_actions];
+        learning::pi_o_state(&self.nu, self.n_actions, s, &mut out);
+        out
+    }
+    /// Surprise (nats) of every tick of the current (or last) episode.
+    pub fn last_surprise_history(&self) -> &[f64] {
+        &self.hist_surprise
+    }
+    /// Whether each tick of the current (or last) episode reasoned.
+    pub fn reasoned_history(&self) -> &[bool] {
+        &self.hist_reasoned
+    }
+    /// What the last reasoning tick computed.
+    pub fn last_reasoning(&self) -> &ReasoningTrace {
+        &self.last
+    }
+
+    fn select(&mut self, dist: &[f64]) -> usize {
+        match self.params.action_selection {
+            ActionSelection::Mode => argmax(dist),
+            ActionSelection::Sample => {
+                let r: f64 = self.rng.random();
+                let mut acc = 0.0;
+                for (i, p) in dist.iter().enumerate() {
+                    acc += p;
+                    if r < acc {
+                        return i;
+                    }
+                }
+                argmax(dist)
+            }
+        }
+    }
+
+    /// Perception, planning and scaling on a reasoning tick (§III–§IV). Leaves `q_t` in
+    /// `self.q_cur` and `π'` in `self.pi`; returns scaling iterations.
+    fn reason(&mut self, obs: usize, th: f64) -> u32 {
+        let gm = self.model.generative();
+        let n = self.n_states;
+        let t = self.hist_obs.len();
+        let w = self.params.vmp_window.min(t + 1);
+        let first = t + 1 - w;
+        // Prior of the first window slot.
+        if first == 0 {
+            self.s_hat.copy_from_slice(&gm.d);
+        } else {
+            let q_before = &self.hist_q[(first - 1) * n..first * n];
+            predict_into(gm, Some((q_before, self.hist_act[first - 1])), &mut self.s_hat);
+        }
+        self.window_obs.clear();
+        self.window_obs.extend_from_slice(&self.hist_obs[first..t]);
+        self.window_obs.push(obs);
+        for k in 0..w - 1 {
+            self.window_q[k].copy_from_slice(&self.hist_q[(first + k) * n..(first + k + 1) * n]);
+        }
+        self.window_q[w - 1].copy_from_slice(&self.q_cur);
+        let out = vmp(
+            gm,
+            &self.s_hat,
+            &self.window_obs,
+            &self.hist_act[first..t],
+            &mut self.window_q[..w],
+            self.params.vmp_kappa,
+            self.params.vmp_tol,
+            self.params.vmp_max_iters,
+            &mut self.vmp_ws,
+            None,
+        );
+        for k in 0..w - 1 {
+            self.hist_q[(first + k) * n..(first + k + 1) * n].copy_from_slice(&self.window_q[k]);
+        }
+        self.q_cur.copy_from_slice(&self.window_q[w - 1]);
+        // Planning (§IV).
+        self.tree.evaluate(gm, &self.q_cur, self.params.gamma);
+        learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
+        let tr = &mut self.last;
+        tr.free_energy = out.free_energy;
+        tr.vmp_iters = out.iterations;
+        tr.g.clone_from(&self.tree.g);
+        tr.q_pi.clone_from(&self.tree.q_pi);
+        tr.psi.clone_from(&self.tree.psi);
+        tr.q_s = q_s(&self.tree.psi, self.params.gamma);
+        tr.pi_o.clone_from(&self.pi);
+        tr.pi_scaled.resize(self.n_actions, 0.0);
+        // Scaling (Theorem 1).
+        let iters = match self.params.scaling_mode {
+            ScalingMode::Iterative => {
+                let o = scale_iterative(
+                    &self.pi,
+                    &self.tree.psi,
+                    th,
+                    self.params.kappa_pi,
+                    self.params.varsigma,
+                    self.params.max_scaling_iters,
+                    &mut tr.pi_scaled,
+                    None,
+                );
+                tr.kl_initial = o.kl_initial;
+                tr.kl_final = o.kl_final;
+                o.iterations
+            }
+            ScalingMode::ClosedForm => {
+                scale_closed_form(&self.pi, &self.tree.psi, th, &mut tr.pi_scaled);
+                tr.kl_initial = crate::maths::kl(&self.pi, &self.tree.psi);
+                tr.kl_final = crate::maths::kl(&tr.pi_scaled, &self.tree.psi);
+                0
+            }
+        };
+        self.pi.copy_from_slice(&tr.pi_scaled);
+        iters
+    }
+}
+
+impl Controller for ScaledAgent {
+    fn name(&self) -> &'static str {
+        "scaled"
+    }
+
+    fn begin_episode(&mut self, seed: u64) {
+        self.rng = ChaCha8Rng::seed_from_u64(seed);
+        self.hist_obs.clear();
+        self.hist_act.clear();
+        self.hist_q.clear();
+        self.hist_surprise.clear();
+        self.hist_reasoned.clear();
+        self.final_obs = None;
+        self.prev_one_hot = None;
+    }
+
+    fn act(&mut self, obs: usize) -> Decision {
+        let n = self.n_states;
+        let obs = obs.min(self.model.generative().n_obs() - 1);
+        let t = self.hist_obs.len();
+        // Prediction ŝ_t = B[a_{t-1}] q_{t-1} (one-hot q: a column copy).
+        {
+            let gm = self.model.generative();
+            if t == 0 {
+                self.s_hat.copy_from_slice(&gm.d);
+            } else if let Some(j) = self.prev_one_hot {
+                let u = self.hist_act[t - 1];
+                self.s_hat.copy_from_slice(&gm.b[u].as_slice()[j * n..(j + 1) * n]);
+            } else {
+                let u = self.hist_act[t - 1];
+                predict_into(gm, Some((&self.hist_q[(t - 1) * n..t * n], u)), &mut self.s_hat);
+            }
+        }
+        let gm = self.model.generative();
+        let s = surprise(gm, obs, &self.s_hat);
+        let th = theta(s, self.params.omega);
+        let reasoned = self.params.reasoning == ReasoningMode::Always || th > self.params.epsilon;
+        bayes_step(gm, obs, &self.s_hat, &mut self.q_cur);
+        let mut scaling_iters = 0;
+        if reasoned {
+            scaling_iters = self.reason(obs, th);
+        } else if gm.a_identity {
+            learning::pi_o_state(&self.nu, self.n_actions, obs, &mut self.pi);
+        } else {
+            learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
+        }
+        let pi = std::mem::take(&mut self.pi);
+        let action = self.select(&pi);
+        self.pi = pi;
+        self.prev_one_hot = if self.q_cur[obs] == 1.0 { Some(obs) } else { None };
+        self.hist_obs.push(obs);
+        self.hist_act.push(action);
+        self.hist_q.extend_from_slice(&self.q_cur);
+        self.hist_surprise.push(s);
+        self.hist_reasoned.push(reasoned);
+        Decision {
+            action,
+            reasoned,
+            surprise: Some(s),
+            theta: Some(th),
+            policy: self.pi.clone(),
+            psi: reasoned.then(|| self.tree.psi.clone()),
+            scaling_iters,
+        }
+    }
+
+    fn observe(&mut self, _reward: f64, next_obs: usize, done: bool) {
+        if done {
+            self.final_obs = Some(next_obs);
+        }
+    }
+
+    /// Test-time learning (§V): A, factor CPTs and ν from the episode's posteriors.
+    fn end_episode(&mut self) {
+        if !self.params.learning || self.hist_obs.is_empty() {
+            return;
+        }
+        let n = self.n_states;
+        let lr = self.params.learning_rate;
+        let na = self.n_actions;
+        let steps = self.hist_obs.len();
+        for k in 0..steps {
+            let q = &self.hist_q[k * n..(k + 1) * n];
+            learning::update_a(self.model.a_counts_mut(), self.hist_obs[k], q, lr);
+            learning::update_nu(&mut self.nu, na, q, self.hist_act[k], lr);
+            if k > 0 {
+                let qp = &self.hist_q[(k - 1) * n..k * n];
+                learning::update_cpts(&mut self.model, qp, self.hist_act[k - 1], q, lr);
+            }
+        }
+        if let Some(o) = self.final_obs.filter(|o| *o < self.model.generative().n_obs()) {
+            let gm = self.model.generative();
+            let qp = self.hist_q[(steps - 1) * n..steps * n].to_vec();
+            let u = self.hist_act[steps - 1];
+            let mut pred = vec![0.0; n];
+            predict_into(gm, Some((&qp, u)), &mut pred);
+            let mut qf = vec![0.0; n];
+            bayes_step(gm, o, &pred, &mut qf);
+            learning::update_a(self.model.a_counts_mut(), o, &qf, lr);
+            learning::update_cpts(&mut self.model, &qp, u, &qf, lr);
+        }
+        self.model.materialize();
+    }
+}
