@@ -4,7 +4,7 @@
 //! way there is a crosswalk with a traffic light (a cycle of green, amber and
 //! red phases). The car is a dynamic rigid body; the three actions of the
 //! paper ([`Action`]: maintain, speed up, slow down) act on it through
-//! longitudinal forces. Pedestrians are kinematic bodies with sensor colliders
+//! longitudinal velocity control (Rapier integrates it and finds contacts). Pedestrians are kinematic bodies with sensor colliders
 //! that cross the crosswalk when the map's spawn rules say so. Collisions come
 //! from Rapier's collision events.
 //!

@@ -322,7 +322,10 @@ fn too_deep(text: &str) -> Option<(usize, usize)> {
 }
 
 fn ron_options() -> ron::Options {
-    ron::Options::default().with_recursion_limit(MAX_NESTING * 2)
+    // Implicit `Some`: `base: "intersection.ron"` and `min_success: 0.9` need no `Some(..)`.
+    ron::Options::default()
+        .with_recursion_limit(MAX_NESTING * 2)
+        .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
 }
 
 fn spanned(origin: &str, path: &str, e: &ron::error::SpannedError) -> Diagnostic {

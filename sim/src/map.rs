@@ -128,7 +128,7 @@ config_struct! {
 }
 
 config_struct! {
-    /// The ego car: a dynamic rigid body driven by longitudinal forces.
+    /// The ego car: a dynamic rigid body under longitudinal velocity control.
     pub struct Vehicle / VehiclePatch as "Vehicle" {
         /// Body length, m. Default 4.5.
         length: f64 = 4.5,

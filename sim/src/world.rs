@@ -1,5 +1,5 @@
-//! The Rapier world built from a map: the car (a dynamic body pushed by
-//! longitudinal forces), pedestrians (kinematic bodies with sensor colliders),
+//! The Rapier world built from a map: the car (a dynamic body under
+//! longitudinal velocity control), pedestrians (kinematic bodies with sensor colliders),
 //! the traffic light, spawn rules, and the episode's end.
 
 use std::sync::Mutex;
@@ -300,10 +300,11 @@ impl World {
         let events = Events::default();
         let mut collision = false;
         let mut goal = false;
-        for _ in 0..self.substeps {
+        let v0 = self.car_speed();
+        for k in 1..=self.substeps {
             self.spawn_due();
             self.move_pedestrians();
-            self.control_car(action);
+            self.control_car(action, v0, k);
             self.phys.step_with_events(&(), &events);
             self.substep += 1;
             self.after_substep();
@@ -342,23 +343,29 @@ impl World {
         out
     }
 
-    /// Apply the action as a longitudinal force for one sub-step: `m·a`,
-    /// reduced near `max_speed` and near standstill so that the speed lands
-    /// exactly on the limit and never goes negative.
-    fn control_car(&mut self, action: Action) {
+    /// Velocity control for sub-step `k` (1-based) of a tick that began at
+    /// speed `v0`: the body's velocity is set to the speed integrated at
+    /// `max_accel` / `max_brake`, clamped to [0, `max_speed`]; Rapier then
+    /// integrates the position and detects contacts. Without damping the target
+    /// is planned from `v0` (so ticks land exactly on `v0 ± a·dt` and f32
+    /// rounding never accumulates); with damping it builds on the body's
+    /// current, damped speed.
+    fn control_car(&mut self, action: Action, v0: f64, k: u32) {
         let v = &self.map.vehicle;
         let h = 1.0 / self.map.episode.physics_hz;
         let body = &mut self.phys.bodies[self.car];
-        let speed = body.linvel().x as f64;
-        let dv = match action {
+        let rate = match action {
             Action::Maintain => 0.0,
-            Action::SpeedUp => (v.max_accel * h).min(v.max_speed - speed).max(0.0),
-            Action::SlowDown => -(v.max_brake * h).min(speed.max(0.0)),
+            Action::SpeedUp => v.max_accel,
+            Action::SlowDown => -v.max_brake,
         };
-        body.reset_forces(true);
-        if dv != 0.0 {
-            body.add_force(Vector::new((v.mass * dv / h) as Real, 0.0), true);
-        }
+        let target = if v.damping == 0.0 {
+            v0 + rate * h * k as f64
+        } else {
+            body.linvel().x as f64 + rate * h
+        };
+        let target = target.clamp(0.0, v.max_speed);
+        body.set_linvel(Vector::new(target as Real, 0.0), true);
     }
 
     /// Keep the car's speed within [0, max_speed] after f32 integration.

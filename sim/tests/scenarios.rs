@@ -1,0 +1,126 @@
+//! The shipped scenarios behave as designed: on the training map pedestrians
+//! cross only on red; in jaywalk.ron (and the other unforeseen maps) a car that
+//! never brakes hits the jaywalker for every seed, and a car that brakes as soon
+//! as a pedestrian is on the crosswalk at a decision tick stops before the
+//! crosswalk, is not hit, and then reaches the destination.
+
+mod common;
+
+use common::{brake_for_pedestrians, run};
+use unforeseen_sim::{Action, LightPhase, World, embedded};
+
+const SEEDS: u64 = 60;
+
+#[test]
+fn training_pedestrians_cross_only_on_red() {
+    let map = embedded::load("intersection").unwrap();
+    let mut seen = 0;
+    for seed in 0..SEEDS {
+        let mut world = World::from_map(&map, seed);
+        // A car that waits before the crosswalk sees a whole light cycle.
+        let (snaps, _) = run(&mut world, |_| Action::SlowDown);
+        for s in &snaps {
+            if s.pedestrian_on_crosswalk() {
+                seen += 1;
+                assert_eq!(s.light, LightPhase::Red, "seed {seed}, t = {}", s.time);
+            }
+        }
+    }
+    assert!(seen > SEEDS, "pedestrians should cross on most red phases");
+}
+
+/// A car that never brakes hits the jaywalker, whatever its speed (6 or 9 m/s).
+fn never_braking_hits(name: &str, policy: fn(&unforeseen_sim::Snapshot) -> Action) {
+    let map = embedded::load(name).unwrap();
+    for seed in 0..SEEDS {
+        let mut world = World::from_map(&map, seed);
+        let (snaps, out) = run(&mut world, policy);
+        let last = snaps.last().unwrap();
+        assert!(
+            out.collision,
+            "{name} seed {seed}: no collision (car at {:.2} m, goal {})",
+            last.car_x, out.goal
+        );
+        // The collision happens at the crosswalk, with the pedestrian in the road.
+        let near = map.crosswalk_near_x();
+        assert!(last.car_x >= near && last.car_x <= near + map.crosswalk.width + map.vehicle.length + 1.0);
+    }
+}
+
+/// The careful driver stops before the crosswalk and is never hit.
+fn braking_is_safe(name: &str) {
+    let map = embedded::load(name).unwrap();
+    let near = map.crosswalk_near_x();
+    for seed in 0..SEEDS {
+        let mut world = World::from_map(&map, seed);
+        let (snaps, out) = run(&mut world, brake_for_pedestrians);
+        assert!(!out.collision, "{name} seed {seed}: hit");
+        assert!(out.goal, "{name} seed {seed}: did not arrive in {} ticks", out.step);
+        // It came to a full stop before the crosswalk while someone was on it.
+        assert!(
+            snaps
+                .iter()
+                .any(|s| s.car_speed == 0.0 && s.car_x < near && s.pedestrian_on_crosswalk()),
+            "{name} seed {seed}: never waited"
+        );
+        for s in &snaps {
+            if s.pedestrian_on_crosswalk() {
+                assert!(
+                    s.car_x < near,
+                    "{name} seed {seed}: entered the crosswalk at t = {}",
+                    s.time
+                );
+            }
+        }
+    }
+}
+
+fn speed_up(_: &unforeseen_sim::Snapshot) -> Action {
+    Action::SpeedUp
+}
+
+/// Speed up once (to 6 m/s), then hold.
+fn six_metres_per_second(s: &unforeseen_sim::Snapshot) -> Action {
+    if s.car_speed < 5.0 {
+        Action::SpeedUp
+    } else {
+        Action::Maintain
+    }
+}
+
+fn keep_speed(_: &unforeseen_sim::Snapshot) -> Action {
+    Action::Maintain
+}
+
+#[test]
+fn jaywalk_never_braking_car_hits_the_pedestrian() {
+    never_braking_hits("jaywalk", speed_up);
+    never_braking_hits("jaywalk", six_metres_per_second);
+}
+
+#[test]
+fn jaywalk_braking_car_stops_before_the_crosswalk() {
+    braking_is_safe("jaywalk");
+}
+
+#[test]
+fn jaywalker_appears_on_green_at_distance_bin_2() {
+    let map = embedded::load("jaywalk").unwrap();
+    for seed in 0..10 {
+        let mut world = World::from_map(&map, seed);
+        let (snaps, _) = run(&mut world, brake_for_pedestrians);
+        let first = snaps.iter().find(|s| s.pedestrian_on_crosswalk()).unwrap();
+        assert_eq!(first.light, LightPhase::Green);
+        assert!(first.distance_to_goal > 30.0 && first.distance_to_goal < 60.0);
+    }
+}
+
+#[test]
+fn other_unforeseen_scenarios() {
+    for name in ["jaywalk_late", "two_pedestrians", "stop_midway", "stuck_green"] {
+        never_braking_hits(name, speed_up);
+        braking_is_safe(name);
+    }
+    // With the light stuck on green even a slow car meets the jaywalker.
+    never_braking_hits("stuck_green", keep_speed);
+}
