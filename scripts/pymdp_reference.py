@@ -13,7 +13,10 @@ Conventions converted here (and checked by agent/tests/pymdp_crossval.rs):
     applies log_softmax to C too, so both use the same normalised preferences.
   * pymdp's q_pi = softmax(gamma * neg_efe + ln E) with E uniform = softmax(-gamma G).
   * pymdp logs add EPS 1e-16 (log(x + 1e-16)); ours floors (log(max(x, 1e-16))). All
-    probabilities here are far from 0, so the difference is below 1e-12.
+    probabilities here are far from 0, so the difference is below 1e-12. But pymdp's
+    state info gain (spm_MDP_G) adds exp(-16) ~ 1.1e-7 inside its logs, so its G is off
+    by ~1e-6 from the exact value; the Rust test compares G, q_pi, psi at 1e-5
+    (qs, F and surprise at 1e-8).
   * qs: exact filtering with pymdp's `update_posterior_states` (vanilla FPI, exact for
     one factor and one modality) using prior = B[u] q_{t-1} (D at t = 1).
   * F: pymdp's `calc_free_energy(qs, prior, 1, likelihood)` at the last step, which for

@@ -112,7 +112,11 @@ impl BayesRl {
     /// Posterior-mean reward of `(s, a)` (the prior mean if unvisited).
     pub fn mean_reward(&self, s: usize, a: usize) -> f64 {
         let i = s * self.n_actions + a;
-        if self.visits[i] > 0.0 { self.reward_sum[i] / self.visits[i] } else { self.params.reward_prior }
+        if self.visits[i] > 0.0 {
+            self.reward_sum[i] / self.visits[i]
+        } else {
+            self.params.reward_prior
+        }
     }
 
     fn rebuild(&mut self) {
@@ -235,10 +239,10 @@ impl Controller for BayesRl {
         }
     }
     fn observe(&mut self, reward: f64, next_obs: usize, done: bool) {
-        if self.params.learn_online {
-            if let Some((s, a)) = self.last {
-                self.observe_transition(s, a, reward, next_obs, done);
-            }
+        if self.params.learn_online
+            && let Some((s, a)) = self.last
+        {
+            self.observe_transition(s, a, reward, next_obs, done);
         }
     }
 }

@@ -61,8 +61,14 @@ fn invalid(msg: String) -> InspectError {
 }
 
 fn check_dist(name: &str, v: &[f64]) -> Result<(), InspectError> {
-    if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !(**x >= 0.0) || !x.is_finite()) {
-        return Err(invalid(format!("{name} entry {i} is {x} (must be a finite probability >= 0)")));
+    if let Some((i, x)) = v
+        .iter()
+        .enumerate()
+        .find(|(_, x)| x.is_nan() || **x < 0.0 || !x.is_finite())
+    {
+        return Err(invalid(format!(
+            "{name} entry {i} is {x} (must be a finite probability >= 0)"
+        )));
     }
     let z: f64 = v.iter().sum();
     if (z - 1.0).abs() > 1e-9 {
@@ -83,7 +89,10 @@ pub fn validate(m: &InspectModel) -> Result<GenerativeModel, InspectError> {
     }
     for (o, row) in m.A.iter().enumerate() {
         if row.len() != ns {
-            return Err(invalid(format!("A[{o}] has {} entries (expected {ns} states)", row.len())));
+            return Err(invalid(format!(
+                "A[{o}] has {} entries (expected {ns} states)",
+                row.len()
+            )));
         }
     }
     let a = DMatrix::from_fn(no, ns, |o, s| m.A[o][s]);
@@ -107,7 +116,10 @@ pub fn validate(m: &InspectModel) -> Result<GenerativeModel, InspectError> {
         b.push(mat);
     }
     if m.C.len() != no {
-        return Err(invalid(format!("C has {} entries (expected {no} observations)", m.C.len())));
+        return Err(invalid(format!(
+            "C has {} entries (expected {no} observations)",
+            m.C.len()
+        )));
     }
     if m.C.iter().any(|c| !c.is_finite()) {
         return Err(invalid("C has a non-finite entry".into()));
@@ -130,7 +142,10 @@ pub fn validate(m: &InspectModel) -> Result<GenerativeModel, InspectError> {
         )));
     }
     if let Some((i, u)) = m.actions.iter().enumerate().find(|(_, u)| **u >= m.B.len()) {
-        return Err(invalid(format!("actions[{i}] = {u} out of range ({} actions)", m.B.len())));
+        return Err(invalid(format!(
+            "actions[{i}] = {u} out of range ({} actions)",
+            m.B.len()
+        )));
     }
     if !(1..=8).contains(&m.policy_len) {
         return Err(invalid(format!("policy_len = {} (must be in 1..=8)", m.policy_len)));

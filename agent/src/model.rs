@@ -166,7 +166,9 @@ impl WorldModel {
         }
         let n = structure.joint_size();
         let cpt = (0..structure.factors().len())
-            .map(|f| vec![priors.transition_concentration; structure.n_configs(f, n_actions) * structure.factors()[f].size])
+            .map(|f| {
+                vec![priors.transition_concentration; structure.n_configs(f, n_actions) * structure.factors()[f].size]
+            })
             .collect();
         let mut a_counts = DMatrix::from_element(n, n, 0.0);
         for s in 0..n {
@@ -352,7 +354,7 @@ impl WorldModel {
                 found: d.len(),
             });
         }
-        if d.iter().any(|x| !(*x >= 0.0)) || (d.iter().sum::<f64>() - 1.0).abs() > 1e-9 {
+        if d.iter().any(|x| x.is_nan() || *x < 0.0) || (d.iter().sum::<f64>() - 1.0).abs() > 1e-9 {
             return Err(ParamError::new("d", format!("{d:?}"), "non-negative and summing to 1").into());
         }
         let mass = self.d_counts.iter().sum::<f64>().max(1.0);
@@ -377,13 +379,22 @@ impl WorldModel {
         let Some(fac) = self.structure.factors().get(factor) else {
             return f64::NAN;
         };
-        if child_value >= fac.size || parent_values.len() != fac.parents.len() || action.is_some_and(|a| a >= self.n_actions) {
+        if child_value >= fac.size
+            || parent_values.len() != fac.parents.len()
+            || action.is_some_and(|a| a >= self.n_actions)
+        {
             return f64::NAN;
         }
-        let cfg = self.structure.config_from_parent_values(factor, parent_values, action, self.n_actions);
+        let cfg = self
+            .structure
+            .config_from_parent_values(factor, parent_values, action, self.n_actions);
         let row = &self.cpt[factor][cfg * fac.size..(cfg + 1) * fac.size];
         let z: f64 = row.iter().sum();
-        if z > 0.0 { row[child_value] / z } else { 1.0 / fac.size as f64 }
+        if z > 0.0 {
+            row[child_value] / z
+        } else {
+            1.0 / fac.size as f64
+        }
     }
 }
 

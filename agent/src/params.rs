@@ -86,7 +86,7 @@ impl ModelPriors {
         }
         if let Some(d) = &self.d {
             let s: f64 = d.iter().sum();
-            if d.iter().any(|x| !(*x >= 0.0)) || (s - 1.0).abs() > 1e-9 {
+            if d.iter().any(|x| x.is_nan() || *x < 0.0) || (s - 1.0).abs() > 1e-9 {
                 return Err(ParamError::new("d", format!("{d:?}"), "non-negative and summing to 1"));
             }
         }

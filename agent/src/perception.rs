@@ -35,7 +35,15 @@ pub struct VmpWorkspace {
     v: Vec<f64>,
 }
 
-fn message_into(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: &[usize], qs: &[Vec<f64>], tau: usize, v: &mut [f64]) {
+fn message_into(
+    gm: &GenerativeModel,
+    s_hat: &[f64],
+    obs: &[usize],
+    actions: &[usize],
+    qs: &[Vec<f64>],
+    tau: usize,
+    v: &mut [f64],
+) {
     let n = gm.n_states();
     let last = obs.len() - 1;
     // Message 1: forward.
@@ -84,7 +92,11 @@ pub fn free_energy(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: 
             }
         }
         if tau == 0 {
-            f -= q.iter().zip(s_hat).map(|(p, sh)| if *p > 0.0 { p * ln(*sh) } else { 0.0 }).sum::<f64>();
+            f -= q
+                .iter()
+                .zip(s_hat)
+                .map(|(p, sh)| if *p > 0.0 { p * ln(*sh) } else { 0.0 })
+                .sum::<f64>();
         } else {
             let lb = gm.ln_b[actions[tau - 1]].as_slice();
             for (j, qj) in qs[tau - 1].iter().enumerate() {

@@ -40,7 +40,12 @@ fn corrupt(e: ron::error::SpannedError) -> PersistError {
 
 impl AgentBundle {
     /// A bundle at the current format version.
-    pub fn new(q_learning: QLearning, world_model: WorldModel, bayes_rl: BayesRl, meta: BTreeMap<String, String>) -> Self {
+    pub fn new(
+        q_learning: QLearning,
+        world_model: WorldModel,
+        bayes_rl: BayesRl,
+        meta: BTreeMap<String, String>,
+    ) -> Self {
         AgentBundle {
             format_version: FORMAT_VERSION,
             q_learning,

@@ -26,7 +26,11 @@ pub fn step_efe(gm: &GenerativeModel, s: &[f64], obuf: &mut [f64]) -> (f64, f64)
             risk += oi * (ln(*oi) - ci);
         }
     }
-    let ambiguity = if gm.a_identity { 0.0 } else { s.iter().zip(&gm.h_a).map(|(a, b)| a * b).sum() };
+    let ambiguity = if gm.a_identity {
+        0.0
+    } else {
+        s.iter().zip(&gm.h_a).map(|(a, b)| a * b).sum()
+    };
     (risk, ambiguity)
 }
 
@@ -36,11 +40,11 @@ pub fn step_efe_long_form(gm: &GenerativeModel, s: &[f64]) -> f64 {
     let (no, ns) = (gm.n_obs(), gm.n_states());
     let qo: Vec<f64> = (0..no).map(|o| (0..ns).map(|j| gm.a[(o, j)] * s[j]).sum()).collect();
     let mut g = 0.0;
-    for o in 0..no {
-        for j in 0..ns {
-            let w = gm.a[(o, j)] * s[j];
+    for (o, qo_o) in qo.iter().enumerate() {
+        for (j, sj) in s.iter().enumerate() {
+            let w = gm.a[(o, j)] * sj;
             if w > 0.0 {
-                g += w * (ln(qo[o]) - gm.c[o]) - w * ln(gm.a[(o, j)]);
+                g += w * (ln(*qo_o) - gm.c[o]) - w * ln(gm.a[(o, j)]);
             }
         }
     }

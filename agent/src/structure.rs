@@ -78,7 +78,10 @@ impl Structure {
                     )));
                 }
                 if f.parents[..i].contains(p) {
-                    return Err(AgentError::Structure(format!("factor `{}` lists parent {p:?} twice", f.name)));
+                    return Err(AgentError::Structure(format!(
+                        "factor `{}` lists parent {p:?} twice",
+                        f.name
+                    )));
                 }
             }
         }
@@ -88,7 +91,10 @@ impl Structure {
             for p in &f.parents {
                 if let Parent::Next(j) = p {
                     if *j == c {
-                        return Err(AgentError::Structure(format!("factor `{}` is its own next-time parent", f.name)));
+                        return Err(AgentError::Structure(format!(
+                            "factor `{}` is its own next-time parent",
+                            f.name
+                        )));
                     }
                     indeg[c] += 1;
                 }
@@ -140,7 +146,12 @@ impl Structure {
             f("d", sizes[0], vec![Parent::Prev(0), Parent::Next(1)], false),
             f("v", sizes[1], vec![Parent::Prev(1)], true),
             f("L", sizes[2], vec![Parent::Prev(2)], false),
-            f("p", sizes[3], vec![Parent::Prev(3), Parent::Next(2), Parent::Next(0)], false),
+            f(
+                "p",
+                sizes[3],
+                vec![Parent::Prev(3), Parent::Next(2), Parent::Next(0)],
+                false,
+            ),
         ])
     }
 
@@ -219,7 +230,13 @@ impl Structure {
     }
 
     /// Parent-configuration index from explicit parent values (in parent order) and action.
-    pub fn config_from_parent_values(&self, f: usize, parent_values: &[usize], action: Option<usize>, n_actions: usize) -> usize {
+    pub fn config_from_parent_values(
+        &self,
+        f: usize,
+        parent_values: &[usize],
+        action: Option<usize>,
+        n_actions: usize,
+    ) -> usize {
         let fac = &self.factors[f];
         let mut idx = 0;
         for (p, v) in fac.parents.iter().zip(parent_values) {
@@ -228,7 +245,11 @@ impl Structure {
             };
             idx = idx * self.factors[j].size + v;
         }
-        if fac.action_parent { idx * n_actions + action.unwrap_or(0) } else { idx }
+        if fac.action_parent {
+            idx * n_actions + action.unwrap_or(0)
+        } else {
+            idx
+        }
     }
 }
 

@@ -29,18 +29,20 @@ fn inspect_matches_pymdp() {
     for c in &r.cases {
         let rep = inspect(&c.model).unwrap();
         let e = &c.expected;
-        let cmp = |name: &str, ours: &[f64], theirs: Vec<f64>| {
+        let cmp = |name: &str, ours: &[f64], theirs: Vec<f64>, tol: f64| {
             assert_eq!(ours.len(), theirs.len(), "{name}");
             for (a, b) in ours.iter().zip(&theirs) {
-                assert!((a - b).abs() < 1e-8, "{name}: {a} vs pymdp {b}");
+                assert!((a - b).abs() < tol, "{name}: {a} vs pymdp {b}");
             }
         };
-        cmp("qs", &rep.qs, vec_of(&e["qs"]));
-        cmp("G", &rep.G, vec_of(&e["G"]));
-        cmp("q_pi", &rep.q_pi, vec_of(&e["q_pi"]));
-        cmp("psi", &rep.psi, vec_of(&e["psi"]));
-        cmp("F", &[rep.F], vec![e["F"].as_f64().unwrap()]);
-        cmp("surprise", &[rep.surprise], vec![e["surprise"].as_f64().unwrap()]);
+        cmp("qs", &rep.qs, vec_of(&e["qs"]), 1e-8);
+        cmp("F", &[rep.F], vec![e["F"].as_f64().unwrap()], 1e-8);
+        cmp("surprise", &[rep.surprise], vec![e["surprise"].as_f64().unwrap()], 1e-8);
+        // pymdp's state info gain (spm_MDP_G) adds exp(-16) ~ 1.1e-7 inside its logs, so
+        // its G differs from the exact value by ~1e-6: compare G, q(π), ψ at 1e-5.
+        cmp("G", &rep.G, vec_of(&e["G"]), 1e-5);
+        cmp("q_pi", &rep.q_pi, vec_of(&e["q_pi"]), 1e-5);
+        cmp("psi", &rep.psi, vec_of(&e["psi"]), 1e-5);
         let pols: Vec<Vec<usize>> = serde_json::from_value(e["policies"].clone()).unwrap();
         assert_eq!(rep.policies, pols);
     }
