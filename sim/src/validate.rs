@@ -70,7 +70,7 @@ impl Check {
 
     /// A probability in [lo, hi] (hi inclusive unless `open`).
     fn probability(&mut self, path: &str, v: f64, open: bool) {
-        if !v.is_finite() || v < 0.0 || v > 1.0 || (open && v >= 1.0) {
+        if !v.is_finite() || !(0.0..=1.0).contains(&v) || (open && v >= 1.0) {
             let range = if open { "[0, 1)" } else { "[0, 1]" };
             self.fail(path, format!("must be in {range}, got {v}"), "a probability or a rate");
         }

@@ -1,0 +1,240 @@
+//! Bad map files are rejected with clear messages, never a panic: one test per
+//! class of problem, each asserting that the message names the file and the
+//! place (line:column for syntax, the field path for semantics).
+
+use std::path::{Path, PathBuf};
+
+use proptest::prelude::*;
+use unforeseen_sim::{Map, MapError};
+
+/// Write `files` into a fresh folder and load the first one.
+fn load_files(files: &[(&str, &[u8])]) -> (tempfile::TempDir, PathBuf, Result<Map, MapError>) {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let path = dir.path().join(files[0].0);
+    let result = Map::load(&path);
+    (dir, path, result)
+}
+
+/// Load a single map file that must be rejected; return the error's lines.
+fn reject(text: &str) -> (String, Vec<String>) {
+    let (_dir, path, result) = load_files(&[("bad.ron", text.as_bytes())]);
+    let err = result.expect_err("the map should be rejected");
+    let lines: Vec<String> = err.to_string().lines().map(str::to_string).collect();
+    assert_eq!(lines.len(), err.diagnostics().len());
+    for l in &lines {
+        assert!(
+            l.starts_with(&path.display().to_string()),
+            "does not name the file: {l}"
+        );
+    }
+    (path.display().to_string(), lines)
+}
+
+fn has(lines: &[String], needles: &[&str]) -> bool {
+    lines.iter().any(|l| needles.iter().all(|n| l.contains(n)))
+}
+
+#[test]
+fn syntax_error_names_line_and_column() {
+    let (file, lines) = reject("Map(\n    road: (lane_width: 3.5,,),\n)\n");
+    assert_eq!(lines.len(), 1);
+    assert!(lines[0].starts_with(&format!("{file}:2:")), "{lines:?}");
+}
+
+#[test]
+fn nan_size_is_rejected() {
+    let (_, lines) = reject("Map(road: (lane_width: NaN))");
+    assert!(has(&lines, &["road.lane_width", "finite"]), "{lines:?}");
+}
+
+#[test]
+fn negative_size_is_rejected() {
+    let (_, lines) = reject("Map(vehicle: (length: -4.5, mass: 0.0))");
+    assert!(has(&lines, &["vehicle.length", "greater than 0", "hint:"]), "{lines:?}");
+    assert!(has(&lines, &["vehicle.mass"]), "{lines:?}");
+}
+
+#[test]
+fn crosswalk_beyond_destination_is_rejected() {
+    let (_, lines) = reject("Map(crosswalk: (x: 95.0))");
+    assert!(has(&lines, &["crosswalk.x", "beyond the destination"]), "{lines:?}");
+}
+
+#[test]
+fn empty_light_cycle_is_rejected() {
+    let (_, lines) = reject("Map(light: (cycle: []))");
+    assert!(has(&lines, &["light.cycle", "empty", "hint:"]), "{lines:?}");
+}
+
+#[test]
+fn non_increasing_bin_edges_are_rejected() {
+    let (_, lines) = reject("Map(bins: (distance_edges: [0.0, 60.0, 30.0], speed_edges: [1.0, 1.0]))");
+    assert!(
+        has(&lines, &["bins.distance_edges[2]", "strictly increasing"]),
+        "{lines:?}"
+    );
+    assert!(
+        has(&lines, &["bins.speed_edges[1]", "strictly increasing"]),
+        "{lines:?}"
+    );
+}
+
+#[test]
+fn every_unknown_field_is_listed() {
+    let (_, lines) =
+        reject("Map(\n  road: (lane_widht: 3.5),\n  colour: \"red\",\n  pedestrians: [(speeed: (1.0, 1.2))],\n)");
+    assert_eq!(lines.len(), 3, "{lines:?}");
+    assert!(has(
+        &lines,
+        &["road.lane_widht", "unknown field", "did you mean `lane_width`?"]
+    ));
+    assert!(has(&lines, &["colour", "unknown field", "expected one of"]));
+    assert!(has(&lines, &["pedestrians[0].speeed", "did you mean `speed`?"]));
+}
+
+#[test]
+fn all_semantic_errors_are_listed() {
+    let (_, lines) = reject(
+        "Map(road: (lane_width: -1.0), light: (cycle: []), bins: (speed_edges: [3.0, 2.0]), episode: (max_steps: 0))",
+    );
+    for path in [
+        "road.lane_width",
+        "light.cycle",
+        "bins.speed_edges[1]",
+        "episode.max_steps",
+    ] {
+        assert!(has(&lines, &[path]), "{path} missing from {lines:?}");
+    }
+}
+
+#[test]
+fn missing_base_is_rejected() {
+    let (_, lines) = reject("Map(base: \"nowhere.ron\")");
+    assert!(
+        has(&lines, &["base", "\"nowhere.ron\" not found", "hint:"]),
+        "{lines:?}"
+    );
+}
+
+#[test]
+fn base_including_itself_is_rejected() {
+    let (_, lines) = reject("Map(base: \"bad.ron\")");
+    assert!(has(&lines, &["base", "names itself"]), "{lines:?}");
+}
+
+#[test]
+fn base_cycle_is_rejected() {
+    let (_dir, _path, result) = load_files(&[("a.ron", b"Map(base: \"b.ron\")"), ("b.ron", b"Map(base: \"a.ron\")")]);
+    let msg = result.unwrap_err().to_string();
+    assert!(
+        msg.contains("b.ron: base: base maps include each other: a -> b -> a"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn error_in_a_base_names_the_base_file() {
+    let (_dir, _path, result) = load_files(&[
+        ("child.ron", b"Map(base: \"parent.ron\")"),
+        ("parent.ron", b"Map(road: (lanes: \"two\"))"),
+    ]);
+    let msg = result.unwrap_err().to_string();
+    assert!(msg.contains("parent.ron:1:"), "{msg}");
+    assert!(msg.contains("road.lanes"), "{msg}");
+}
+
+#[test]
+fn wrong_type_names_line_column_and_field() {
+    let (file, lines) = reject("Map(\n  episode: (max_steps: \"forty\"),\n)");
+    assert!(lines[0].starts_with(&format!("{file}:2:")), "{lines:?}");
+    assert!(lines[0].contains("episode.max_steps"), "{lines:?}");
+}
+
+#[test]
+fn empty_file_is_rejected() {
+    let (_, lines) = reject("");
+    assert!(has(&lines, &["empty"]), "{lines:?}");
+    let (_, lines) = reject("// only a comment\n");
+    assert!(has(&lines, &["empty"]), "{lines:?}");
+}
+
+#[test]
+fn binary_file_is_rejected() {
+    let (_dir, path, result) = load_files(&[("bin.ron", &[0x7f, 0x45, 0x4c, 0x46, 0x02, 0x00, 0x00, 0xff])]);
+    let msg = result.unwrap_err().to_string();
+    assert!(
+        msg.starts_with(&path.display().to_string()) && msg.contains("not a text file"),
+        "{msg}"
+    );
+    let (_dir, _, result) = load_files(&[("latin1.ron", b"Map(name: \"caf\xe9\")")]);
+    assert!(result.unwrap_err().to_string().contains("invalid UTF-8"));
+}
+
+#[test]
+fn truncated_file_is_rejected() {
+    let full = unforeseen_sim::embedded::INTERSECTION;
+    let cut = &full[..full.len() / 2];
+    let (_, lines) = reject(cut);
+    assert!(has(&lines, &["truncated"]) || has(&lines, &["end"]), "{lines:?}");
+    assert!(
+        lines[0].split(':').nth(1).is_some_and(|l| l.parse::<usize>().is_ok()),
+        "{lines:?}"
+    );
+}
+
+#[test]
+fn absurdly_nested_file_is_rejected() {
+    let text = format!("Map(name: {}1{})", "[".repeat(10_000), "]".repeat(10_000));
+    let (_, lines) = reject(&text);
+    assert!(has(&lines, &["nested more than"]), "{lines:?}");
+}
+
+#[test]
+fn huge_file_is_rejected() {
+    let text = format!("Map(description: \"{}\")", "x".repeat(2 << 20));
+    let (_, lines) = reject(&text);
+    assert!(has(&lines, &["too large"]), "{lines:?}");
+}
+
+#[test]
+fn missing_file_is_an_error_not_a_panic() {
+    let err = Map::load(Path::new("/nonexistent/map.ron")).unwrap_err();
+    assert!(
+        err.to_string().starts_with("/nonexistent/map.ron: cannot read"),
+        "{err}"
+    );
+}
+
+#[test]
+fn shipped_maps_load_from_disk_with_bases() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../maps");
+    for name in unforeseen_sim::embedded::names() {
+        let m = Map::load(&dir.join(format!("{name}.ron"))).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m, unforeseen_sim::embedded::load(name).unwrap());
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Arbitrary text never panics the loader.
+    #[test]
+    fn arbitrary_text_never_panics(src in "\\PC{0,200}") {
+        let _ = Map::from_str_named("fuzz.ron", &src, &|_| None);
+    }
+
+    /// Mutations of a real map never panic the loader.
+    #[test]
+    fn mutated_maps_never_panic(cut in 0usize..3000, junk in "[\\[\\](){}:,\"a-z0-9.-]{0,8}") {
+        let src = unforeseen_sim::embedded::JAYWALK;
+        let cut = cut.min(src.len());
+        let cut = (0..=cut).rev().find(|&i| src.is_char_boundary(i)).unwrap_or(0);
+        let text = format!("{}{}{}", &src[..cut], junk, &src[cut..]);
+        let _ = Map::from_str_named("fuzz.ron", &text, &|b| {
+            unforeseen_sim::embedded::source(b).map(|s| (b.to_string(), s.to_string()))
+        });
+    }
+}
