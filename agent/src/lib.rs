@@ -1,4 +1,29 @@
-//! placeholder
+//! # unforeseen-agent
+//!
+//! The math of "Active Inference as the Test-Time Scaling Law for Physical AI Agents"
+//! (no physics, no maps): a factored world model with Dirichlet counts, surprise and the
+//! reasoning trigger, VMP perception, EFE planning, test-time policy scaling, test-time
+//! learning, and the two baselines (tabular Q-learning, Bayesian RL). All three methods
+//! implement [`controller::Controller`].
+//!
+//! Module map (named after the paper): [`maths`], [`params`], [`structure`], [`model`],
+//! [`surprise`] (§II), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
+//! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
+//! [`scaled`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`].
+//!
+//! ```
+//! use unforeseen_agent::{controller::Controller, model::WorldModel, params::*,
+//!     q_learning::QLearning, scaled::ScaledAgent, structure::Structure};
+//! let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
+//! let mut w = WorldModel::new(st.clone(), 3, &ModelPriors::default()).unwrap();
+//! w.observe_transition(st.encode(&[3, 1, 1, 0]), 0, st.encode(&[2, 1, 1, 0]));
+//! w.materialize();
+//! let q = QLearning::new(64, 3, QParams::default());
+//! let mut agent = ScaledAgent::new(w, &q, ScaledParams::default()).unwrap();
+//! agent.begin_episode(1);
+//! let d = agent.act(st.encode(&[3, 1, 1, 0]));
+//! assert!(d.action < 3);
+//! ```
 pub mod bayes_rl;
 pub mod controller;
 pub mod error;
