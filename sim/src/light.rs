@@ -37,6 +37,10 @@ impl std::fmt::Display for LightPhase {
 /// durations (checked by validation).
 pub fn light_at(light: &Light, offset: f64, t: f64) -> (LightPhase, f64) {
     let total = light.cycle_length();
+    if light.cycle.is_empty() || !(total > 0.0 && total.is_finite()) {
+        // Only an unvalidated map gets here: treat it as a light stuck on green.
+        return (LightPhase::Green, f64::INFINITY);
+    }
     let mut pos = (offset + t).rem_euclid(total);
     for p in &light.cycle {
         if pos < p.duration {

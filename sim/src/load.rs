@@ -615,3 +615,65 @@ mod tests {
         assert_eq!(strip_comments("\"//\"").trim(), "\"//\"");
     }
 }
+
+#[cfg(test)]
+mod doc_tests {
+    use super::*;
+
+    /// maps/README.md and the reference map document every field of every struct.
+    #[test]
+    fn every_field_is_documented() {
+        let readme = include_str!("../../maps/README.md");
+        let reference = include_str!("../../maps/intersection.ron");
+        let kinds = [
+            Kind::Map,
+            Kind::Road,
+            Kind::Crosswalk,
+            Kind::Light,
+            Kind::Phase,
+            Kind::Vehicle,
+            Kind::Rule,
+            Kind::Pause,
+            Kind::Bins,
+            Kind::Reward,
+            Kind::Episode,
+            Kind::Expect,
+        ];
+        for k in kinds {
+            for f in fields_of(k) {
+                assert!(readme.contains(&format!("`{f}`")), "README lacks `{f}`");
+                assert!(reference.contains(f), "intersection.ron lacks {f}");
+            }
+        }
+    }
+
+    #[test]
+    fn summary_mentions_the_essentials() {
+        let m = crate::embedded::load("jaywalk").unwrap();
+        let s = m.summary();
+        for needle in [
+            "map jaywalk",
+            "destination at x = 90 m",
+            "distance to goal 26..22 m",
+            "green 12 s, amber 2 s, red 10 s",
+            "within 4.8 s",
+            "speed [1.5, 4.5, 7.5]",
+            "expect Scaled: min_success 0.9",
+        ] {
+            assert!(s.contains(needle), "summary lacks {needle:?}:\n{s}");
+        }
+        assert_eq!(m.crosswalk_distance_to_goal(), (26.0, 22.0));
+    }
+
+    #[test]
+    fn empty_map_is_the_default() {
+        let m = Map::from_str_named("plain.ron", "Map()", &|_| None).unwrap();
+        assert_eq!(
+            m,
+            Map {
+                name: "plain".into(),
+                ..Map::default()
+            }
+        );
+    }
+}
