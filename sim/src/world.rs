@@ -174,7 +174,9 @@ struct Pedestrian {
 
 /// A pedestrian decided by a rule, waiting for its start time.
 struct Pending {
-    at_substep: u64,
+    /// Sub-step at which it starts walking; earlier than now means it is
+    /// placed part-way across.
+    at_substep: i64,
     rule: usize,
     side_far: bool,
     speed: f64,
@@ -402,9 +404,25 @@ impl World {
         let h = 1.0 / self.map.episode.physics_hz;
         for i in 0..self.map.pedestrians.len() {
             let rule = &self.map.pedestrians[i];
+            // A phase-start rule at time 0 inside its phase fires "in the past":
+            // the pedestrian is placed where it would be had the world been
+            // running (so an episode that starts mid-red can meet one).
+            let at_start = self.substep == 0;
+            let mut elapsed = 0.0;
             let fires = match rule.trigger {
-                Trigger::RedStarts => phase == LightPhase::Red && self.prev_phase != LightPhase::Red,
-                Trigger::GreenStarts => phase == LightPhase::Green && self.prev_phase != LightPhase::Green,
+                Trigger::RedStarts | Trigger::GreenStarts => {
+                    let want = if rule.trigger == Trigger::RedStarts {
+                        LightPhase::Red
+                    } else {
+                        LightPhase::Green
+                    };
+                    if at_start && phase == want {
+                        elapsed = self.phase_elapsed(t);
+                        true
+                    } else {
+                        phase == want && self.prev_phase != want
+                    }
+                }
                 Trigger::AtTime(at) => !self.fired[i] && t + 1e-9 >= at,
                 Trigger::CarWithin { min, max } => !self.fired[i] && to_cross >= min && to_cross <= max,
                 Trigger::CarArrivesWithin(secs) => {
@@ -433,7 +451,7 @@ impl World {
             let delay = uniform(&mut self.rng, rule.delay);
             let x_offset = uniform(&mut self.rng, rule.x_offset);
             self.pending.push(Pending {
-                at_substep: self.substep + (delay / h).round() as u64,
+                at_substep: self.substep as i64 + ((delay - elapsed) / h).round() as i64,
                 rule: i,
                 side_far,
                 speed,
@@ -444,7 +462,7 @@ impl World {
 
         let mut k = 0;
         while k < self.pending.len() {
-            if self.pending[k].at_substep <= self.substep {
+            if self.pending[k].at_substep <= self.substep as i64 {
                 let p = self.pending.remove(k);
                 self.spawn(p);
             } else {
@@ -456,6 +474,13 @@ impl World {
     fn spawn(&mut self, p: Pending) {
         let rule = &self.map.pedestrians[p.rule];
         let half = self.map.road.half_width();
+        let length = 2.0 * (half + rule.start_back);
+        let h = 1.0 / self.map.episode.physics_hz;
+        let walked = (self.substep as i64 - p.at_substep).max(0) as f64 * h * p.speed;
+        if walked >= length {
+            return; // it would already have crossed
+        }
+        let pause = rule.pause.filter(|pa| pa.after > walked);
         let dir = if p.side_far { -1.0 } else { 1.0 };
         let y0 = -dir * (half + rule.start_back);
         let x = self.map.crosswalk.x + p.x_offset;
@@ -468,12 +493,25 @@ impl World {
             y0,
             dir,
             speed: p.speed,
-            walked: 0.0,
-            length: 2.0 * (half + rule.start_back),
-            pause: rule.pause,
+            walked,
+            length,
+            pause,
             pause_left: 0.0,
             moving: true,
         });
+    }
+
+    /// Seconds since the current light phase began.
+    fn phase_elapsed(&self, t: f64) -> f64 {
+        let total = self.map.light.cycle_length();
+        let mut pos = (self.light_offset + t).rem_euclid(total);
+        for p in &self.map.light.cycle {
+            if pos < p.duration {
+                return pos;
+            }
+            pos -= p.duration;
+        }
+        0.0
     }
 
     /// Set each pedestrian's kinematic target for the coming sub-step.

@@ -115,3 +115,22 @@ fn collision_is_reported_when_the_shapes_touch() {
     assert_eq!(out.step, 22);
     assert!((s.time - 21.9).abs() <= 2.0 * h, "t = {}", s.time);
 }
+
+#[test]
+fn episode_starting_mid_red_has_a_pedestrian_already_crossing() {
+    // 3 s into the red phase at time 0; the red-start pedestrian left at its start.
+    let m =
+        map("Map(light: (offset: Fixed(17.0)), pedestrians: [(trigger: RedStarts, side: Near, speed: (1.0, 1.0))])");
+    let w = World::from_map(&m, 0);
+    assert!(w.snapshot().pedestrians.is_empty(), "spawned during the first sub-step");
+    let mut w = w;
+    w.step(Action::SlowDown);
+    let p = w.snapshot().pedestrians[0];
+    // Walked 3 s + 1 s at 1 m/s from y = -4.0.
+    assert!((p.y - 0.0).abs() < 0.02, "y = {}", p.y);
+    // Too late in red: it would already have crossed, so nobody appears.
+    let late = map("Map(light: (offset: Fixed(23.5)), pedestrians: [(trigger: RedStarts, speed: (1.0, 1.0))])");
+    let mut w = World::from_map(&late, 0);
+    w.step(Action::SlowDown);
+    assert!(w.snapshot().pedestrians.is_empty());
+}
