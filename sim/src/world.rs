@@ -586,3 +586,16 @@ fn uniform(rng: &mut ChaCha8Rng, (lo, hi): (f64, f64)) -> f64 {
         lo
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runners may drive worlds on several threads (one world per thread).
+    #[test]
+    fn world_is_send() {
+        fn send<T: Send>() {}
+        send::<World>();
+        send::<Snapshot>();
+    }
+}
