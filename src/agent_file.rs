@@ -1,7 +1,6 @@
 //! Agent files: a trained [`AgentBundle`] as RON, written atomically; a missing,
 //! corrupt or incompatible file is a clear error naming the file and the fix.
 
-use anyhow::Context;
 use std::path::Path;
 use unforeseen_agent::persist::AgentBundle;
 
@@ -10,19 +9,33 @@ use crate::report::write_atomic;
 
 /// Saves `bundle` to `path` (temporary file + rename).
 pub fn save(path: &Path, bundle: &AgentBundle) -> anyhow::Result<()> {
-    let text = bundle.to_ron_string().context("cannot serialize the agent")?;
+    let text = bundle.to_ron_string();
     write_atomic(path, text.as_bytes())
 }
 
 /// Loads an agent file; every failure is a [`BadInput`] naming the file.
 pub fn load(path: &Path) -> anyhow::Result<AgentBundle> {
     let text = std::fs::read(path).map_err(|e| {
-        BadInput(format!("{}: cannot read the agent file ({e}); create one with `unforeseen train --out {}`", path.display(), path.display()))
+        BadInput(format!(
+            "{}: cannot read the agent file ({e}); create one with `unforeseen train --out {}`",
+            path.display(),
+            path.display()
+        ))
     })?;
-    let text = String::from_utf8(text)
-        .map_err(|_| BadInput(format!("{}: not an agent file (not UTF-8 text); create one with `unforeseen train`", path.display())))?;
-    AgentBundle::from_ron_str(&text)
-        .map_err(|e| BadInput(format!("{}: {e}; retrain with `unforeseen train --out {}`", path.display(), path.display())).into())
+    let text = String::from_utf8(text).map_err(|_| {
+        BadInput(format!(
+            "{}: not an agent file (not UTF-8 text); create one with `unforeseen train`",
+            path.display()
+        ))
+    })?;
+    AgentBundle::from_ron_str(&text).map_err(|e| {
+        BadInput(format!(
+            "{}: {e}; retrain with `unforeseen train --out {}`",
+            path.display(),
+            path.display()
+        ))
+        .into()
+    })
 }
 
 /// Checks that an agent trained on `agent_states` states can drive a map whose bins

@@ -43,7 +43,11 @@ impl ParamSet {
         if self.0.is_empty() {
             "default".into()
         } else {
-            self.0.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(",")
+            self.0
+                .iter()
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect::<Vec<_>>()
+                .join(",")
         }
     }
 }
@@ -93,7 +97,12 @@ pub fn units(n_scenarios: usize, methods: &[Method], params: &[ParamSet]) -> Vec
     for scenario in 0..n_scenarios {
         for &method in methods {
             for p in params {
-                out.push(Unit { index: out.len(), scenario, method, params: p.clone() });
+                out.push(Unit {
+                    index: out.len(),
+                    scenario,
+                    method,
+                    params: p.clone(),
+                });
             }
         }
     }
@@ -114,7 +123,10 @@ impl std::str::FromStr for Shard {
     fn from_str(s: &str) -> Result<Self, String> {
         let bad = || format!("'{s}': expected I/N with 1 <= I <= N, e.g. 2/8");
         let (i, n) = s.split_once('/').ok_or_else(bad)?;
-        let (index, count): (usize, usize) = (i.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+        let (index, count): (usize, usize) = (
+            i.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
         if count == 0 || index == 0 || index > count {
             return Err(bad());
         }
@@ -207,7 +219,13 @@ pub fn check_expectations(map: &Map, method: Method, agg: &Aggregate) -> Vec<Che
         let mut add = |figure: &str, bound: &str, limit: Option<f64>, value: f64| {
             if let Some(limit) = limit {
                 let pass = if bound == "min" { value >= limit } else { value <= limit };
-                checks.push(Check { figure: figure.into(), bound: bound.into(), limit, value, pass });
+                checks.push(Check {
+                    figure: figure.into(),
+                    bound: bound.into(),
+                    limit,
+                    value,
+                    pass,
+                });
             }
         };
         add("success_rate", "min", e.min_success, agg.success_rate);
@@ -251,11 +269,20 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine
     let sets: Vec<String> = unit.params.0.iter().map(|(k, v)| format!("{k}={v}")).collect();
     let params: ScaledParams = crate::cli::params::apply(ScaledParams::default(), &sets)?;
     let run = |controller: &mut dyn unforeseen_agent::controller::Controller, ep: u64| {
-        run_episode(map, &disc, controller, eval_seeds(cfg.seed, map, unit.method, ep), false).0
+        run_episode(
+            map,
+            &disc,
+            controller,
+            eval_seeds(cfg.seed, map, unit.method, ep),
+            false,
+        )
+        .0
     };
     let results = if unit.method.learns_across_episodes(&params) {
         let mut controller = unit.method.controller(cfg.bundle, &params)?;
-        (0..cfg.episodes).map(|ep| run(controller.as_mut(), ep)).collect::<Vec<_>>()
+        (0..cfg.episodes)
+            .map(|ep| run(controller.as_mut(), ep))
+            .collect::<Vec<_>>()
     } else {
         (0..cfg.episodes)
             .into_par_iter()
@@ -264,7 +291,10 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine
     };
     let agg = Aggregate::of(&results);
     let tree: usize = (1..=params.horizon).map(|k| 3usize.pow(k as u32)).sum();
-    let plans_by_efe = matches!(unit.method, Method::Scaled | Method::ScaledAlways | Method::ScaledNoLearning);
+    let plans_by_efe = matches!(
+        unit.method,
+        Method::Scaled | Method::ScaledAlways | Method::ScaledNoLearning
+    );
     Ok(ResultLine {
         unit: unit.index,
         scenario: map.name.clone(),
@@ -279,7 +309,11 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine
         collision_rate: agg.collision_rate,
         timeout_rate: agg.timeout_rate,
         inference_rate: agg.inference_rate,
-        efe_matvecs_per_tick: if plans_by_efe { agg.inference_rate * tree as f64 } else { 0.0 },
+        efe_matvecs_per_tick: if plans_by_efe {
+            agg.inference_rate * tree as f64
+        } else {
+            0.0
+        },
         mean_ticks: agg.mean_ticks,
         checks: check_expectations(map, unit.method, &agg),
         timing_us_per_tick: agg.us_per_tick,
@@ -299,8 +333,13 @@ pub fn read_lines(path: &Path) -> anyhow::Result<Vec<ResultLine>> {
         if !line.ends_with('\n') {
             break; // truncated by a kill: redo that unit
         }
-        let parsed: ResultLine = serde_json::from_str(line.trim_end())
-            .map_err(|e| BadInput(format!("{}:{}: not a batch result line ({e}); remove the line or the file", path.display(), i + 1)))?;
+        let parsed: ResultLine = serde_json::from_str(line.trim_end()).map_err(|e| {
+            BadInput(format!(
+                "{}:{}: not a batch result line ({e}); remove the line or the file",
+                path.display(),
+                i + 1
+            ))
+        })?;
         lines.push(parsed);
     }
     Ok(lines)
@@ -321,12 +360,21 @@ pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, quiet: bool) -> anyh
     let mine = &all[range];
     let kept: Vec<ResultLine> = if resume { read_lines(out)? } else { Vec::new() };
     let done: BTreeSet<_> = kept.iter().map(ResultLine::key).collect();
-    let label = |u: &Unit| (cfg.scenarios[u.scenario].map.name.clone(), u.method.name().to_string(), u.params.label());
+    let label = |u: &Unit| {
+        (
+            cfg.scenarios[u.scenario].map.name.clone(),
+            u.method.name().to_string(),
+            u.params.label(),
+        )
+    };
     let todo: Vec<&Unit> = mine.iter().filter(|u| !done.contains(&label(u))).collect();
 
     // Keep only complete lines, then stream new ones as they finish.
     crate::report::write_atomic(out, kept.iter().map(to_line).collect::<String>().as_bytes())?;
-    let file = std::fs::OpenOptions::new().append(true).open(out).with_context(|| format!("cannot append to {}", out.display()))?;
+    let file = std::fs::OpenOptions::new()
+        .append(true)
+        .open(out)
+        .with_context(|| format!("cannot append to {}", out.display()))?;
     let sink = Mutex::new(file);
     let bar = crate::progress::bar(todo.len() as u64, "batch units", quiet);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(cfg.jobs.max(1)).build()?;
@@ -355,7 +403,12 @@ pub fn load_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
     if paths.is_empty() {
         return unforeseen_sim::embedded::names()
             .iter()
-            .map(|n| Ok(Scenario { map: unforeseen_sim::embedded::load(n)?, source: format!("embedded:{n}") }))
+            .map(|n| {
+                Ok(Scenario {
+                    map: unforeseen_sim::embedded::load(n)?,
+                    source: format!("embedded:{n}"),
+                })
+            })
             .collect();
     }
     let mut scenarios = Vec::new();
@@ -368,13 +421,22 @@ pub fn load_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
                 .collect();
             found.sort();
             for f in found {
-                scenarios.push(Scenario { map: Map::load(&f)?, source: f.display().to_string() });
+                scenarios.push(Scenario {
+                    map: Map::load(&f)?,
+                    source: f.display().to_string(),
+                });
             }
         } else if p.exists() {
-            scenarios.push(Scenario { map: Map::load(p)?, source: p.display().to_string() });
+            scenarios.push(Scenario {
+                map: Map::load(p)?,
+                source: p.display().to_string(),
+            });
         } else {
             let map = crate::maps::load(&p.to_string_lossy())?;
-            scenarios.push(Scenario { source: format!("embedded:{}", map.name), map });
+            scenarios.push(Scenario {
+                source: format!("embedded:{}", map.name),
+                map,
+            });
         }
     }
     Ok(scenarios)

@@ -3,8 +3,8 @@
 
 use serde::Serialize;
 use unforeseen_agent::controller::Controller;
-use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_discretizer::{Discretizer, State};
 use unforeseen_sim::{Action, Map};
@@ -115,7 +115,13 @@ pub fn trace(
     let disc = Discretizer::new(&map.bins)?;
     check_compatible(bundle, &map.name, disc.n_states())?;
     let mut controller = method.controller(bundle, params)?;
-    Ok(run_episode(map, &disc, controller.as_mut(), eval_seeds(seed, map, method, 0), true))
+    Ok(run_episode(
+        map,
+        &disc,
+        controller.as_mut(),
+        eval_seeds(seed, map, method, 0),
+        true,
+    ))
 }
 
 /// One point of the test-time learning curves (Fig. 9).
@@ -142,27 +148,55 @@ pub struct LearnPoint {
 
 /// Runs the scaled agent (with test-time learning) for `episodes` episodes on `map`,
 /// recording after each the quantities of Fig. 9.
-pub fn learn(bundle: &AgentBundle, params: &ScaledParams, map: &Map, episodes: u64, seed: u64, quiet: bool) -> anyhow::Result<Vec<LearnPoint>> {
+pub fn learn(
+    bundle: &AgentBundle,
+    params: &ScaledParams,
+    map: &Map,
+    episodes: u64,
+    seed: u64,
+    quiet: bool,
+) -> anyhow::Result<Vec<LearnPoint>> {
     let disc = Discretizer::new(&map.bins)?;
     check_compatible(bundle, &map.name, disc.n_states())?;
-    let mut agent = ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, ScaledParams { learning: true, ..params.clone() })?;
+    let mut agent = ScaledAgent::new(
+        bundle.world_model.clone(),
+        &bundle.q_learning,
+        ScaledParams {
+            learning: true,
+            ..params.clone()
+        },
+    )?;
     let bar = progress::bar(episodes, "learning", quiet);
     let mut jay_state: Option<usize> = None;
     let mut points = Vec::new();
     for ep in 0..episodes {
         let (result, ticks) = run_episode(map, &disc, &mut agent, eval_seeds(seed, map, Method::Scaled, ep), true);
         if jay_state.is_none() {
-            jay_state = ticks.iter().find(|t| t.state.p == 1 && t.state.l == 1).map(|t| disc.encode(t.state));
+            jay_state = ticks
+                .iter()
+                .find(|t| t.state.p == 1 && t.state.l == 1)
+                .map(|t| disc.encode(t.state));
         }
         let slow = Action::SlowDown.index();
-        let js = jay_state.unwrap_or_else(|| disc.encode(State { d: 2.min(disc.factor_sizes()[0] - 1), v: 0, l: 1, p: 1 }));
+        let js = jay_state.unwrap_or_else(|| {
+            disc.encode(State {
+                d: 2.min(disc.factor_sizes()[0] - 1),
+                v: 0,
+                l: 1,
+                p: 1,
+            })
+        });
         points.push(LearnPoint {
             episode: ep,
             jaywalk_surprise_bits: result.jaywalk_surprise.map(|s| s / std::f64::consts::LN_2),
             p_appear_green_d2: pedestrian_prob(&agent, 0),
             p_stay_green_d2: pedestrian_prob(&agent, 1),
             p_slow_down: agent.pi_o(js)[slow],
-            inference_rate: if result.ticks == 0 { 0.0 } else { f64::from(result.reasoning_ticks) / f64::from(result.ticks) },
+            inference_rate: if result.ticks == 0 {
+                0.0
+            } else {
+                f64::from(result.reasoning_ticks) / f64::from(result.ticks)
+            },
             success: result.success,
             reward: result.ret,
         });

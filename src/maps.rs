@@ -8,7 +8,9 @@ use unforeseen_sim::{Map, MapError, embedded};
 #[derive(Debug, thiserror::Error)]
 pub enum MapLookupError {
     /// Neither a readable file nor an embedded map of that name.
-    #[error("{arg}: no such map file, and no embedded map of that name (embedded maps: {names}); pass a path to a .ron map file")]
+    #[error(
+        "{arg}: no such map file, and no embedded map of that name (embedded maps: {names}); pass a path to a .ron map file"
+    )]
     NotFound {
         /// What the user passed.
         arg: String,
@@ -31,5 +33,8 @@ pub fn load(arg: &str) -> Result<Map, MapLookupError> {
     if embedded::names().contains(&name) {
         return Ok(embedded::load(name)?);
     }
-    Err(MapLookupError::NotFound { arg: arg.to_string(), names: embedded::names().join(", ") })
+    Err(MapLookupError::NotFound {
+        arg: arg.to_string(),
+        names: embedded::names().join(", "),
+    })
 }

@@ -1,14 +1,15 @@
 //! The methods compared in §VI, and the ablations of DESIGN.md §6, built from one
 //! trained [`AgentBundle`] so every method shares the same training data.
 
-use unforeseen_agent::bayes_rl::BayesRl;
 use unforeseen_agent::controller::Controller;
-use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::params::{ReasoningMode, ScaledParams};
+use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 
 /// A method (or ablation) the runner can drive.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Tabular Q-learning, greedy on its Q-table; never reasons.
@@ -48,9 +49,24 @@ impl Method {
     /// (train reward, test reward, success rate, inference rate relative to bayes-rl).
     pub fn paper(self) -> Option<PaperFigures> {
         match self {
-            Method::QLearning => Some(PaperFigures { train_reward: 78.0, test_reward: -21.8, success_rate: 0.03, inference_rate: 0.0 }),
-            Method::BayesRl => Some(PaperFigures { train_reward: 72.7, test_reward: -18.2, success_rate: 0.05, inference_rate: 1.0 }),
-            Method::Scaled => Some(PaperFigures { train_reward: 78.0, test_reward: 22.9, success_rate: 1.0, inference_rate: 0.633 }),
+            Method::QLearning => Some(PaperFigures {
+                train_reward: 78.0,
+                test_reward: -21.8,
+                success_rate: 0.03,
+                inference_rate: 0.0,
+            }),
+            Method::BayesRl => Some(PaperFigures {
+                train_reward: 72.7,
+                test_reward: -18.2,
+                success_rate: 0.05,
+                inference_rate: 1.0,
+            }),
+            Method::Scaled => Some(PaperFigures {
+                train_reward: 78.0,
+                test_reward: 22.9,
+                success_rate: 1.0,
+                inference_rate: 0.633,
+            }),
             _ => None,
         }
     }
@@ -68,15 +84,29 @@ impl Method {
     /// Builds a fresh controller of this method from the trained bundle.
     pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> anyhow::Result<Box<dyn Controller>> {
         let scaled = |params: ScaledParams| -> anyhow::Result<Box<dyn Controller>> {
-            Ok(Box::new(ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params)?))
+            Ok(Box::new(ScaledAgent::new(
+                bundle.world_model.clone(),
+                &bundle.q_learning,
+                params,
+            )?))
         };
         Ok(match self {
             Method::QLearning => Box::new(bundle.q_learning.clone()),
             Method::BayesRl => Box::new(bundle.bayes_rl.clone()),
-            Method::BayesRlFactored => Box::new(BayesRl::factored_from(&bundle.bayes_rl, &bundle.world_model)?),
+            Method::BayesRlFactored => Box::new(bundle.bayes_rl_factored.clone().ok_or_else(|| {
+                crate::cli::BadInput(
+                    "this agent file has no factored Bayesian-RL model; retrain it with `unforeseen train`".into(),
+                )
+            })?),
             Method::Scaled => scaled(params.clone())?,
-            Method::ScaledAlways => scaled(ScaledParams { reasoning: ReasoningMode::Always, ..params.clone() })?,
-            Method::ScaledNoLearning => scaled(ScaledParams { learning: false, ..params.clone() })?,
+            Method::ScaledAlways => scaled(ScaledParams {
+                reasoning: ReasoningMode::Always,
+                ..params.clone()
+            })?,
+            Method::ScaledNoLearning => scaled(ScaledParams {
+                learning: false,
+                ..params.clone()
+            })?,
         })
     }
 }

@@ -44,10 +44,22 @@ impl Aggregate {
             success_rate: share(&|r| r.success),
             collision_rate: share(&|r| r.collision),
             timeout_rate: share(&|r| r.timeout),
-            inference_rate: if ticks == 0 { 0.0 } else { reasoning as f64 / ticks as f64 },
+            inference_rate: if ticks == 0 {
+                0.0
+            } else {
+                reasoning as f64 / ticks as f64
+            },
             mean_ticks: ticks as f64 / n as f64,
-            us_per_tick: if ticks == 0 { 0.0 } else { decide_ns as f64 / ticks as f64 / 1e3 },
-            us_per_reasoning_tick: if reasoning == 0 { 0.0 } else { reasoning_ns as f64 / reasoning as f64 / 1e3 },
+            us_per_tick: if ticks == 0 {
+                0.0
+            } else {
+                decide_ns as f64 / ticks as f64 / 1e3
+            },
+            us_per_reasoning_tick: if reasoning == 0 {
+                0.0
+            } else {
+                reasoning_ns as f64 / reasoning as f64 / 1e3
+            },
         }
     }
 }
@@ -58,8 +70,23 @@ mod tests {
 
     #[test]
     fn aggregates_by_hand() {
-        let a = EpisodeResult { ret: 10.0, success: true, ticks: 10, reasoning_ticks: 5, decide_ns: 10_000, reasoning_ns: 9_000, ..Default::default() };
-        let b = EpisodeResult { ret: -20.0, collision: true, ticks: 4, reasoning_ticks: 0, decide_ns: 4_000, ..Default::default() };
+        let a = EpisodeResult {
+            ret: 10.0,
+            success: true,
+            ticks: 10,
+            reasoning_ticks: 5,
+            decide_ns: 10_000,
+            reasoning_ns: 9_000,
+            ..Default::default()
+        };
+        let b = EpisodeResult {
+            ret: -20.0,
+            collision: true,
+            ticks: 4,
+            reasoning_ticks: 0,
+            decide_ns: 4_000,
+            ..Default::default()
+        };
         let agg = Aggregate::of(&[a, b]);
         assert_eq!(agg.episodes, 2);
         assert_eq!(agg.mean_reward, -5.0);

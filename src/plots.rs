@@ -56,7 +56,10 @@ pub fn grouped_bars(path: &Path, panels: &[BarPanel<'_>]) -> Result<()> {
                 .margin(12)
                 .x_label_area_size(30)
                 .y_label_area_size(45)
-                .build_cartesian_2d(-0.5f64..(n as f64 - 0.5), (lo - if lo < 0.0 { pad } else { 0.0 })..(hi + pad))
+                .build_cartesian_2d(
+                    -0.5f64..(n as f64 - 0.5),
+                    (lo - if lo < 0.0 { pad } else { 0.0 })..(hi + pad),
+                )
                 .map_err(plot_err)?;
             let labels = panel.labels.to_vec();
             chart
@@ -65,7 +68,11 @@ pub fn grouped_bars(path: &Path, panels: &[BarPanel<'_>]) -> Result<()> {
                 .x_labels(n)
                 .x_label_formatter(&move |x| {
                     let i = x.round();
-                    if (x - i).abs() < 1e-6 && i >= 0.0 { labels.get(i as usize).cloned().unwrap_or_default() } else { String::new() }
+                    if (x - i).abs() < 1e-6 && i >= 0.0 {
+                        labels.get(i as usize).cloned().unwrap_or_default()
+                    } else {
+                        String::new()
+                    }
                 })
                 .draw()
                 .map_err(plot_err)?;
@@ -73,15 +80,28 @@ pub fn grouped_bars(path: &Path, panels: &[BarPanel<'_>]) -> Result<()> {
                 let x = i as f64;
                 Rectangle::new([(x - 0.38, 0.0), (x, v)], BLUE.mix(0.75).filled())
             });
-            chart.draw_series(ours).map_err(plot_err)?.label("ours").legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLUE.mix(0.75).filled()));
+            chart
+                .draw_series(ours)
+                .map_err(plot_err)?
+                .label("ours")
+                .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLUE.mix(0.75).filled()));
             let paper = panel.paper.iter().enumerate().filter_map(|(i, v)| {
                 v.map(|v| {
                     let x = i as f64;
                     Rectangle::new([(x, 0.0), (x + 0.38, v)], BLACK.mix(0.3).filled())
                 })
             });
-            chart.draw_series(paper).map_err(plot_err)?.label("paper").legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLACK.mix(0.3).filled()));
-            chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw().map_err(plot_err)?;
+            chart
+                .draw_series(paper)
+                .map_err(plot_err)?
+                .label("paper")
+                .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLACK.mix(0.3).filled()));
+            chart
+                .configure_series_labels()
+                .border_style(BLACK)
+                .background_style(WHITE.mix(0.8))
+                .draw()
+                .map_err(plot_err)?;
         }
         Ok(())
     })
@@ -124,14 +144,21 @@ pub fn line_panels(path: &Path, x_label: &str, panels: &[(&str, Vec<Series<'_>>)
                     .label(s.label)
                     .legend(move |(x, y)| PathElement::new([(x, y), (x + 14, y)], color.stroke_width(2)));
             }
-            chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw().map_err(plot_err)?;
+            chart
+                .configure_series_labels()
+                .border_style(BLACK)
+                .background_style(WHITE.mix(0.8))
+                .draw()
+                .map_err(plot_err)?;
         }
         Ok(())
     })
 }
 
 fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (lo, hi) = values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
     if lo.is_finite() { (lo, hi) } else { (0.0, 1.0) }
 }
 
@@ -147,15 +174,28 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, f64, bool, String)],
             .y_label_area_size(45)
             .build_cartesian_2d(-0.5f64..(n - 0.5), 0.0f64..1.05)
             .map_err(plot_err)?;
-        chart.configure_mesh().x_desc("decision tick").y_desc("theta = 1 - exp(-Omega S)").draw().map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("decision tick")
+            .y_desc("theta = 1 - exp(-Omega S)")
+            .draw()
+            .map_err(plot_err)?;
         let shade = RGBColor(255, 200, 60).mix(0.35);
         chart
-            .draw_series(ticks.iter().filter(|t| t.2).map(|t| Rectangle::new([(t.0 as f64 - 0.5, 0.0), (t.0 as f64 + 0.5, 1.05)], shade.filled())))
+            .draw_series(
+                ticks
+                    .iter()
+                    .filter(|t| t.2)
+                    .map(|t| Rectangle::new([(t.0 as f64 - 0.5, 0.0), (t.0 as f64 + 0.5, 1.05)], shade.filled())),
+            )
             .map_err(plot_err)?
             .label("reasoning tick")
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], shade.filled()));
         chart
-            .draw_series(LineSeries::new([(-0.5, epsilon), (n - 0.5, epsilon)], RED.stroke_width(1)))
+            .draw_series(LineSeries::new(
+                [(-0.5, epsilon), (n - 0.5, epsilon)],
+                RED.stroke_width(1),
+            ))
             .map_err(plot_err)?
             .label(format!("epsilon = {epsilon}"))
             .legend(|(x, y)| PathElement::new([(x, y), (x + 14, y)], RED));
@@ -165,9 +205,19 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, f64, bool, String)],
             .label("theta")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 14, y)], BLUE.stroke_width(2)));
         chart
-            .draw_series(ticks.iter().map(|t| Text::new(t.3.clone(), (t.0 as f64 - 0.3, 1.0), ("sans-serif", 10))))
+            .draw_series(
+                ticks
+                    .iter()
+                    .map(|t| Text::new(t.3.clone(), (t.0 as f64 - 0.3, 1.0), ("sans-serif", 10))),
+            )
             .map_err(plot_err)?;
-        chart.configure_series_labels().position(SeriesLabelPosition::UpperRight).border_style(BLACK).background_style(WHITE.mix(0.8)).draw().map_err(plot_err)?;
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.8))
+            .draw()
+            .map_err(plot_err)?;
         Ok(())
     })
 }
@@ -191,7 +241,10 @@ pub fn filmstrip(path: &Path, map: &unforeseen_sim::Map, ticks: &[crate::runner:
                 .y_label_area_size(70)
                 .build_cartesian_2d(x0..x1, -y_span..y_span)
                 .map_err(plot_err)?;
-            let label = format!("t={} d{} v{} L{} p{}", t.step, t.state.d, t.state.v, t.state.l, t.state.p);
+            let label = format!(
+                "t={} d{} v{} L{} p{}",
+                t.step, t.state.d, t.state.v, t.state.l, t.state.p
+            );
             let grey = RGBColor(205, 205, 205);
             let walk = RGBColor(235, 235, 235);
             chart
@@ -199,10 +252,16 @@ pub fn filmstrip(path: &Path, map: &unforeseen_sim::Map, ticks: &[crate::runner:
                     Rectangle::new([(x0, -y_span), (x1, y_span)], RGBColor(190, 225, 180).filled()),
                     Rectangle::new([(x0, -road_half), (x1, road_half)], grey.filled()),
                     Rectangle::new(
-                        [(map.crosswalk.x - map.crosswalk.width / 2.0, -road_half), (map.crosswalk.x + map.crosswalk.width / 2.0, road_half)],
+                        [
+                            (map.crosswalk.x - map.crosswalk.width / 2.0, -road_half),
+                            (map.crosswalk.x + map.crosswalk.width / 2.0, road_half),
+                        ],
                         walk.filled(),
                     ),
-                    Rectangle::new([(map.road.goal_x - 0.3, -road_half), (map.road.goal_x, road_half)], BLACK.filled()),
+                    Rectangle::new(
+                        [(map.road.goal_x - 0.3, -road_half), (map.road.goal_x, road_half)],
+                        BLACK.filled(),
+                    ),
                 ])
                 .map_err(plot_err)?;
             let light = match t.snapshot.light {
@@ -212,11 +271,22 @@ pub fn filmstrip(path: &Path, map: &unforeseen_sim::Map, ticks: &[crate::runner:
             };
             let s = &t.snapshot;
             let car = Rectangle::new(
-                [(s.car_x - map.vehicle.length, car_y - map.vehicle.width / 2.0), (s.car_x, car_y + map.vehicle.width / 2.0)],
-                if t.reasoned { RGBColor(230, 140, 0).filled() } else { BLUE.filled() },
+                [
+                    (s.car_x - map.vehicle.length, car_y - map.vehicle.width / 2.0),
+                    (s.car_x, car_y + map.vehicle.width / 2.0),
+                ],
+                if t.reasoned {
+                    RGBColor(230, 140, 0).filled()
+                } else {
+                    BLUE.filled()
+                },
             );
             chart
-                .draw_series([Circle::new((map.crosswalk.x - map.crosswalk.width, -road_half - 1.0), 5, light.filled())])
+                .draw_series([Circle::new(
+                    (map.crosswalk.x - map.crosswalk.width, -road_half - 1.0),
+                    5,
+                    light.filled(),
+                )])
                 .map_err(plot_err)?;
             chart.draw_series([car]).map_err(plot_err)?;
             chart

@@ -25,6 +25,18 @@ pub fn crosswalk_bins(map: &Map, disc: &Discretizer) -> Vec<usize> {
     (lo..=hi).collect()
 }
 
+/// The states that end an episode in the agent's planning model: arrival (d = 0) and
+/// the crash-risk states (see [`state_rewards`]). They are absorbing when planning.
+pub fn terminal_states(map: &Map, disc: &Discretizer) -> Vec<usize> {
+    let risky = crosswalk_bins(map, disc);
+    (0..disc.n_states())
+        .filter(|&s| {
+            let st = disc.decode(s);
+            st.d == 0 || (st.p == 1 && st.v > 0 && risky.contains(&st.d))
+        })
+        .collect()
+}
+
 /// R(s) for every joint state: the goal reward where the car has arrived (d = 0), the
 /// crash penalty in crash-risk states (a pedestrian on the crosswalk while the car is
 /// moving in a crosswalk bin), and zero elsewhere.

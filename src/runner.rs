@@ -11,7 +11,7 @@ use unforeseen_sim::{Action, Map, Snapshot, World};
 use crate::rewards::tick_reward;
 
 /// One decision tick of an episode, as shown by `trace`.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone)]
 pub struct Tick {
     /// Decision tick index, from 0.
     pub step: u32,
@@ -32,7 +32,6 @@ pub struct Tick {
     /// Reward paid for this tick.
     pub reward: f64,
     /// The world before acting (for the filmstrip).
-    #[serde(skip)]
     pub snapshot: Snapshot,
 }
 

@@ -7,7 +7,7 @@ use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
 use unforeseen_agent::bayes_rl::BayesRl;
 use unforeseen_agent::model::WorldModel;
-use unforeseen_agent::params::{BayesRlParams, ModelPriors, QParams};
+use unforeseen_agent::params::{BayesModel, BayesRlParams, ModelPriors, QParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::q_learning::QLearning;
 use unforeseen_agent::structure::Structure;
@@ -15,7 +15,7 @@ use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::{Action, Map, World};
 
 use crate::progress;
-use crate::rewards::{state_rewards, tick_reward};
+use crate::rewards::{state_rewards, terminal_states, tick_reward};
 use crate::seeds::episode_seed;
 
 /// Everything training needs besides the map.
@@ -43,7 +43,10 @@ impl TrainConfig {
         Self {
             episodes,
             seed,
-            q: QParams { bias_action: Some(Action::SpeedUp.index()), ..QParams::default() },
+            q: QParams {
+                bias_action: Some(Action::SpeedUp.index()),
+                ..QParams::default()
+            },
             priors: ModelPriors::default(),
             bayes: BayesRlParams::default(),
             tau_c: 1.0,
@@ -65,10 +68,16 @@ pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, Train
     let disc = Discretizer::new(&map.bins)?;
     let n = disc.n_states();
     let n_actions = Action::ALL.len();
-    let mut q = QLearning::new(n, n_actions, cfg.q.clone())?;
+    let mut q = QLearning::try_new(n, n_actions, cfg.q.clone())?;
     let structure = Structure::paper_default(disc.factor_sizes())?;
+    let structure_for_bayes = structure.clone();
     let mut model = WorldModel::new(structure, n_actions, &cfg.priors)?;
     let mut bayes = BayesRl::new(n, n_actions, cfg.bayes.clone())?;
+    let factored = BayesRlParams {
+        model: BayesModel::Factored(structure_for_bayes),
+        ..cfg.bayes.clone()
+    };
+    let mut bayes_factored = BayesRl::new(n, n_actions, factored)?;
     let mut log = TrainLog::default();
     let bar = progress::bar(cfg.episodes, "training", cfg.quiet);
     let stream = format!("{}/train", map.name);
@@ -77,6 +86,7 @@ pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, Train
         let mut world = World::from_map(map, seed);
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6578_706c_6f72_6521);
         let mut s = disc.encode(disc.state(&world.snapshot()));
+        model.observe_initial(s);
         let mut ret = 0.0;
         loop {
             let a = q.act_epsilon_greedy(s, &mut rng);
@@ -87,6 +97,7 @@ pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, Train
             q.update(s, a, r, s_next, done);
             model.observe_transition(s, a, s_next);
             bayes.observe_transition(s, a, r, s_next, done);
+            bayes_factored.observe_transition(s, a, r, s_next, done);
             ret += r;
             s = s_next;
             if done {
@@ -100,12 +111,14 @@ pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, Train
     bar.finish_and_clear();
     model.materialize();
     model.set_preferences(&state_rewards(map, &disc), cfg.tau_c)?;
-    bayes.finish_training();
+    model.set_terminal_states(&terminal_states(map, &disc))?;
     let mut meta = BTreeMap::new();
     meta.insert("map".into(), map.name.clone());
     meta.insert("episodes".into(), cfg.episodes.to_string());
     meta.insert("seed".into(), cfg.seed.to_string());
     meta.insert("factor_sizes".into(), format!("{:?}", disc.factor_sizes()));
     meta.insert("unforeseen_version".into(), env!("CARGO_PKG_VERSION").into());
-    Ok((AgentBundle::new(q, model, bayes, meta), log))
+    let mut bundle = AgentBundle::new(q, model, bayes, meta);
+    bundle.bayes_rl_factored = Some(bayes_factored);
+    Ok((bundle, log))
 }

@@ -78,6 +78,8 @@ struct WorldModelRepr {
     a_counts: DMatrix<f64>,
     c: Vec<f64>,
     d_counts: Vec<f64>,
+    #[serde(default)]
+    terminal: Vec<usize>,
 }
 
 /// The agent's world model (§II-A, §V): Dirichlet-count CPTs per factor, `A` counts,
@@ -93,7 +95,11 @@ pub struct WorldModel {
     a_counts: DMatrix<f64>,
     /// Counts behind `D` (prior mass 1 spread per `ModelPriors::d`).
     d_counts: Vec<f64>,
+    /// Episode-ending states, absorbing in the planning model.
+    terminal: Vec<usize>,
     gm: GenerativeModel,
+    /// The generative model used for planning: `gm` with every terminal state absorbing.
+    gm_plan: GenerativeModel,
 }
 
 impl From<WorldModel> for WorldModelRepr {
@@ -106,6 +112,7 @@ impl From<WorldModel> for WorldModelRepr {
             a_counts: w.a_counts,
             c: w.gm.c,
             d_counts: w.d_counts,
+            terminal: w.terminal,
         }
     }
 }
@@ -134,6 +141,13 @@ impl TryFrom<WorldModelRepr> for WorldModel {
                 found: r.cpt.len(),
             });
         }
+        if r.terminal.iter().any(|&s| s >= n) {
+            return Err(AgentError::OutOfRange {
+                what: "terminal state",
+                index: n,
+                size: n,
+            });
+        }
         if r.a_counts.ncols() != n || r.c.len() != r.a_counts.nrows() || r.d_counts.len() != n {
             return Err(AgentError::SizeMismatch {
                 what: "A/C/D sizes".into(),
@@ -143,6 +157,8 @@ impl TryFrom<WorldModelRepr> for WorldModel {
         }
         let mut w = WorldModel {
             gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], r.c, vec![]),
+            gm_plan: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], vec![], vec![]),
+            terminal: r.terminal,
             d_counts: r.d_counts,
             structure: r.structure,
             n_actions: r.n_actions,
@@ -196,6 +212,8 @@ impl WorldModel {
         let c = vec![-(n as f64).ln(); n];
         let mut w = WorldModel {
             gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], c, vec![]),
+            gm_plan: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], vec![], vec![]),
+            terminal: Vec::new(),
             d_counts: d,
             structure,
             n_actions,
@@ -291,7 +309,45 @@ impl WorldModel {
         let c = std::mem::take(&mut self.gm.c);
         let mut d = self.d_counts.clone();
         crate::maths::normalize_in_place(&mut d);
+        let mut b_plan = b.clone();
+        for m in &mut b_plan {
+            for &s in &self.terminal {
+                m.column_mut(s).fill(0.0);
+                m[(s, s)] = 1.0;
+            }
+        }
+        self.gm_plan = GenerativeModel::new(a.clone(), b_plan, c.clone(), d.clone());
         self.gm = GenerativeModel::new(a, b, c, d);
+    }
+
+    /// Declares the episode-ending states (arrival, and the crash-risk states the agent
+    /// must not enter): in the model used for planning they are absorbing, so the
+    /// expected free energy of a policy that ends the episode counts that end for the
+    /// rest of the horizon instead of imagining the drive going on (§IV, EFE_0).
+    /// Perception and surprise keep the learned transitions. Re-materializes.
+    pub fn set_terminal_states(&mut self, states: &[usize]) -> Result<(), AgentError> {
+        let n = self.n_states();
+        if let Some(&s) = states.iter().find(|&&s| s >= n) {
+            return Err(AgentError::OutOfRange {
+                what: "terminal state",
+                index: s,
+                size: n,
+            });
+        }
+        self.terminal = states.to_vec();
+        self.materialize();
+        Ok(())
+    }
+
+    /// The episode-ending states (see [`WorldModel::set_terminal_states`]).
+    pub fn terminal_states(&self) -> &[usize] {
+        &self.terminal
+    }
+
+    /// The generative model used for planning: as [`WorldModel::generative`], with the
+    /// terminal states absorbing.
+    pub fn planning_generative(&self) -> &GenerativeModel {
+        &self.gm_plan
     }
 
     /// `B[u]` (n_states x n_states, column-stochastic; entry `(s', s)`).
@@ -341,6 +397,7 @@ impl WorldModel {
         }
         let scaled: Vec<f64> = rewards.iter().map(|r| r / tau_c).collect();
         self.gm.c = log_softmax(&scaled);
+        self.gm_plan.c = self.gm.c.clone();
         Ok(())
     }
 

@@ -22,6 +22,10 @@ pub struct AgentBundle {
     pub world_model: WorldModel,
     /// The trained Bayesian-RL posterior.
     pub bayes_rl: BayesRl,
+    /// Bayesian RL given the factored world model instead of the flat one (ablation,
+    /// DESIGN.md §6), trained on the same episodes; absent in older files.
+    #[serde(default)]
+    pub bayes_rl_factored: Option<BayesRl>,
     /// Free-form metadata (map name, seed, episodes...).
     pub meta: BTreeMap<String, String>,
 }
@@ -51,6 +55,7 @@ impl AgentBundle {
             q_learning,
             world_model,
             bayes_rl,
+            bayes_rl_factored: None,
             meta,
         }
     }

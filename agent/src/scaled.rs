@@ -208,7 +208,8 @@ impl ScaledAgent {
         }
         self.q_cur.copy_from_slice(&self.window_q[w - 1]);
         // Planning (§IV).
-        self.tree.evaluate(gm, &self.q_cur, self.params.gamma);
+        self.tree
+            .evaluate(self.model.planning_generative(), &self.q_cur, self.params.gamma);
         learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
         let tr = &mut self.last;
         tr.free_energy = out.free_energy;

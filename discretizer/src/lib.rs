@@ -76,7 +76,10 @@ impl Discretizer {
             if ok {
                 Ok(edges.to_vec())
             } else {
-                Err(DiscretizerError::BadEdges { field, edges: edges.to_vec() })
+                Err(DiscretizerError::BadEdges {
+                    field,
+                    edges: edges.to_vec(),
+                })
             }
         };
         let noise = bins.observation_noise;
@@ -139,7 +142,12 @@ impl Discretizer {
         let rest = index / n_p;
         let l = rest % n_l;
         let rest = rest / n_l;
-        State { d: rest / n_v, v: rest % n_v, l, p }
+        State {
+            d: rest / n_v,
+            v: rest % n_v,
+            l,
+            p,
+        }
     }
 
     /// The observation the agent receives: the true state, or with probability
@@ -157,7 +165,12 @@ impl Discretizer {
                 *value = if other >= *value { other + 1 } else { other };
             }
         }
-        State { d: values[0], v: values[1], l: values[2], p: values[3] }
+        State {
+            d: values[0],
+            v: values[1],
+            l: values[2],
+            p: values[3],
+        }
     }
 
     /// Probability that a factor of size `size` is observed as `observed` when its

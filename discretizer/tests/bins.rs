@@ -6,7 +6,11 @@ use unforeseen_discretizer::{Discretizer, State};
 use unforeseen_sim::{Bins, LightPhase, PedestrianSnapshot, Snapshot};
 
 fn paper_bins(noise: f64) -> Bins {
-    Bins { distance_edges: vec![0.0, 30.0, 60.0], speed_edges: vec![1.5, 4.5, 7.5], observation_noise: noise }
+    Bins {
+        distance_edges: vec![0.0, 30.0, 60.0],
+        speed_edges: vec![1.5, 4.5, 7.5],
+        observation_noise: noise,
+    }
 }
 
 fn snapshot(distance: f64, speed: f64, light: LightPhase, peds_on: &[bool]) -> Snapshot {
@@ -20,7 +24,13 @@ fn snapshot(distance: f64, speed: f64, light: LightPhase, peds_on: &[bool]) -> S
         light_time_left: 1.0,
         pedestrians: peds_on
             .iter()
-            .map(|&on| PedestrianSnapshot { x: 66.0, y: 0.0, vx: 0.0, vy: 1.2, on_crosswalk: on })
+            .map(|&on| PedestrianSnapshot {
+                x: 66.0,
+                y: 0.0,
+                vx: 0.0,
+                vy: 1.2,
+                on_crosswalk: on,
+            })
             .collect(),
     }
 }
@@ -31,19 +41,23 @@ fn table_of_continuous_inputs_to_states() {
     let disc = Discretizer::new(&paper_bins(0.0)).unwrap();
     // (distance to goal m, speed m/s, light, pedestrians on crosswalk) -> (d, v, L, p)
     let cases: &[(f64, f64, LightPhase, &[bool], (usize, usize, usize, usize))] = &[
-        (90.0, 3.0, Green, &[], (3, 1, 1, 0)),      // the start: far, slow, green, nobody
+        (90.0, 3.0, Green, &[], (3, 1, 1, 0)),       // the start: far, slow, green, nobody
         (60.0001, 0.0, Red, &[false], (3, 0, 0, 0)), // just beyond the 60 m edge; pedestrian on the sidewalk
         (60.0, 1.5, Red, &[true], (2, 1, 0, 1)),     // on an edge: d counts edges strictly below, v edges at or below
         (45.0, 4.4999, Amber, &[], (2, 1, 0, 0)),    // amber is red for the agent
         (30.0, 4.5, Green, &[false, true], (1, 2, 1, 1)),
-        (24.0, 7.5, Green, &[true], (1, 3, 1, 1)),   // on the crosswalk at full speed: the crash-risk state
+        (24.0, 7.5, Green, &[true], (1, 3, 1, 1)), // on the crosswalk at full speed: the crash-risk state
         (0.0001, 9.0, Red, &[], (1, 3, 0, 0)),
-        (0.0, 9.0, Green, &[], (0, 3, 1, 0)),        // arrived
-        (-3.0, 0.0, Green, &[], (0, 0, 1, 0)),       // past the destination
+        (0.0, 9.0, Green, &[], (0, 3, 1, 0)),  // arrived
+        (-3.0, 0.0, Green, &[], (0, 0, 1, 0)), // past the destination
     ];
     for &(distance, speed, light, peds, (d, v, l, p)) in cases {
         let got = disc.state(&snapshot(distance, speed, light, peds));
-        assert_eq!(got, State { d, v, l, p }, "distance {distance} speed {speed} light {light:?} peds {peds:?}");
+        assert_eq!(
+            got,
+            State { d, v, l, p },
+            "distance {distance} speed {speed} light {light:?} peds {peds:?}"
+        );
     }
 }
 
@@ -55,7 +69,10 @@ fn joint_index_matches_the_paper_layout_and_round_trips() {
     assert_eq!(disc.encode(State { d: 0, v: 0, l: 0, p: 1 }), 1);
     assert_eq!(disc.encode(State { d: 0, v: 0, l: 1, p: 0 }), 2);
     assert_eq!(disc.encode(State { d: 0, v: 1, l: 0, p: 0 }), 4);
-    assert_eq!(disc.encode(State { d: 2, v: 1, l: 1, p: 1 }), ((2 * 4 + 1) * 2 + 1) * 2 + 1);
+    assert_eq!(
+        disc.encode(State { d: 2, v: 1, l: 1, p: 1 }),
+        ((2 * 4 + 1) * 2 + 1) * 2 + 1
+    );
     assert_eq!(disc.encode(State { d: 3, v: 3, l: 1, p: 1 }), 63);
     for s in 0..64 {
         assert_eq!(disc.encode(disc.decode(s)), s);
@@ -64,7 +81,11 @@ fn joint_index_matches_the_paper_layout_and_round_trips() {
 
 #[test]
 fn finer_bins_are_a_map_change() {
-    let bins = Bins { distance_edges: (0..8).map(|i| i as f64 * 10.0).collect(), speed_edges: vec![1.0, 2.0], observation_noise: 0.0 };
+    let bins = Bins {
+        distance_edges: (0..8).map(|i| i as f64 * 10.0).collect(),
+        speed_edges: vec![1.0, 2.0],
+        observation_noise: 0.0,
+    };
     let disc = Discretizer::new(&bins).unwrap();
     assert_eq!(disc.factor_sizes(), [9, 3, 2, 2]);
     assert_eq!(disc.n_states(), 108);
@@ -79,10 +100,20 @@ fn finer_bins_are_a_map_change() {
 fn bad_edges_and_noise_are_typed_errors() {
     let mut bins = paper_bins(0.0);
     bins.speed_edges = vec![1.0, 1.0];
-    assert!(Discretizer::new(&bins).unwrap_err().to_string().contains("bins.speed_edges"));
+    assert!(
+        Discretizer::new(&bins)
+            .unwrap_err()
+            .to_string()
+            .contains("bins.speed_edges")
+    );
     let mut bins = paper_bins(0.0);
     bins.distance_edges = vec![0.0, f64::NAN];
-    assert!(Discretizer::new(&bins).unwrap_err().to_string().contains("bins.distance_edges"));
+    assert!(
+        Discretizer::new(&bins)
+            .unwrap_err()
+            .to_string()
+            .contains("bins.distance_edges")
+    );
     assert!(Discretizer::new(&paper_bins(1.0)).is_err());
     assert!(Discretizer::new(&paper_bins(-0.1)).is_err());
 }

@@ -55,7 +55,11 @@ fn default_jobs() -> usize {
 /// Runs `batch`; fails (exit 1) when any expectation fails.
 pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let scenarios = load_scenarios(&args.maps)?;
-    let methods = if args.methods.is_empty() { Method::PAPER.to_vec() } else { args.methods.clone() };
+    let methods = if args.methods.is_empty() {
+        Method::PAPER.to_vec()
+    } else {
+        args.methods.clone()
+    };
     let params = sweep(&args.sweep)?;
     for p in &params {
         let sets: Vec<String> = p.0.iter().map(|(k, v)| format!("{k}={v}")).collect();
@@ -65,7 +69,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         Some(path) => crate::agent_file::load(path)?,
         None => {
             let map = crate::maps::load("intersection")?;
-            let cfg = TrainConfig { quiet: args.quiet, ..TrainConfig::new(args.train_episodes, args.seed) };
+            let cfg = TrainConfig {
+                quiet: args.quiet,
+                ..TrainConfig::new(args.train_episodes, args.seed)
+            };
             train(&map, &cfg)?.0
         }
     };
@@ -80,7 +87,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         shard: args.shard,
     };
     let lines = run(&cfg, &args.out, args.resume, args.quiet)?;
-    println!("{:<22} {:<20} {:<24} {:>9} {:>10} {:>10} {:>10}", "scenario", "method", "parameters", "success", "collision", "reward", "inference");
+    println!(
+        "{:<22} {:<20} {:<24} {:>9} {:>10} {:>10} {:>10}",
+        "scenario", "method", "parameters", "success", "collision", "reward", "inference"
+    );
     let mut failures = Vec::new();
     for l in &lines {
         println!(
@@ -101,7 +111,13 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         }
     }
     let checked: usize = lines.iter().map(|l| l.checks.len()).sum();
-    println!("wrote {} ({} lines); {} expectation(s) checked, {} failed", args.out.display(), lines.len(), checked, failures.len());
+    println!(
+        "wrote {} ({} lines); {} expectation(s) checked, {} failed",
+        args.out.display(),
+        lines.len(),
+        checked,
+        failures.len()
+    );
     if !failures.is_empty() {
         for f in &failures {
             eprintln!("expectation failed: {f}");

@@ -56,7 +56,10 @@ impl Default for CompareArgs {
             ablations: false,
             out: None,
             quiet: false,
-            agent: AgentArgs { agent: None, set: Vec::new() },
+            agent: AgentArgs {
+                agent: None,
+                set: Vec::new(),
+            },
         }
     }
 }
@@ -94,7 +97,10 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let bundle = match &args.agent.agent {
         Some(path) => crate::agent_file::load(path)?,
         None => {
-            let cfg = crate::training::TrainConfig { quiet: args.quiet, ..crate::training::TrainConfig::new(args.train_episodes, args.seed) };
+            let cfg = crate::training::TrainConfig {
+                quiet: args.quiet,
+                ..crate::training::TrainConfig::new(args.train_episodes, args.seed)
+            };
             crate::training::train(&train_map, &cfg)?.0
         }
     };
@@ -104,7 +110,18 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     }
     let rows = methods
         .iter()
-        .map(|&m| compare_method(&bundle, &params, m, &train_map, &test_map, args.episodes, args.seed, args.quiet))
+        .map(|&m| {
+            compare_method(
+                &bundle,
+                &params,
+                m,
+                &train_map,
+                &test_map,
+                args.episodes,
+                args.seed,
+                args.quiet,
+            )
+        })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let inference = |name: &str| rows.iter().find(|r| r.method == name).map(|r| r.inference_rate);
     let relative = match (inference("scaled"), inference("bayes-rl")) {
@@ -130,7 +147,15 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     };
     let dir = out_dir(&args.out, "out/compare");
     write_json(&dir.join("compare.json"), &report)?;
-    let mut csv = Csv::new(&["method", "train_reward", "test_reward", "success_rate", "collision_rate", "inference_rate", "reasoning_us_per_tick"]);
+    let mut csv = Csv::new(&[
+        "method",
+        "train_reward",
+        "test_reward",
+        "success_rate",
+        "collision_rate",
+        "inference_rate",
+        "reasoning_us_per_tick",
+    ]);
     for r in &report.methods {
         csv.row(vec![
             r.method.clone(),
@@ -151,10 +176,30 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     grouped_bars(
         &dir.join("compare.svg"),
         &[
-            BarPanel { title: "train reward", labels: &labels, ours: col(|r| r.train_reward), paper: paper(|p| p.train_reward) },
-            BarPanel { title: "test reward (unforeseen)", labels: &labels, ours: col(|r| r.test_reward), paper: paper(|p| p.test_reward) },
-            BarPanel { title: "success rate", labels: &labels, ours: col(|r| r.success_rate), paper: paper(|p| p.success_rate) },
-            BarPanel { title: "inference rate", labels: &labels, ours: col(|r| r.inference_rate), paper: paper(|p| p.inference_rate) },
+            BarPanel {
+                title: "train reward",
+                labels: &labels,
+                ours: col(|r| r.train_reward),
+                paper: paper(|p| p.train_reward),
+            },
+            BarPanel {
+                title: "test reward (unforeseen)",
+                labels: &labels,
+                ours: col(|r| r.test_reward),
+                paper: paper(|p| p.test_reward),
+            },
+            BarPanel {
+                title: "success rate",
+                labels: &labels,
+                ours: col(|r| r.success_rate),
+                paper: paper(|p| p.success_rate),
+            },
+            BarPanel {
+                title: "inference rate",
+                labels: &labels,
+                ours: col(|r| r.inference_rate),
+                paper: paper(|p| p.inference_rate),
+            },
         ],
     )?;
     println!("wrote {}/compare.json, compare.csv, compare.svg", dir.display());
@@ -171,13 +216,20 @@ fn print_table(rows: &[MethodRow], relative: Option<f64>) {
         None => ours,
     };
     for r in rows {
-        let m = Method::PAPER.iter().chain(&Method::ABLATIONS).find(|m| m.name() == r.method).and_then(|m| m.paper());
+        let m = Method::PAPER
+            .iter()
+            .chain(&Method::ABLATIONS)
+            .find(|m| m.name() == r.method)
+            .and_then(|m| m.paper());
         println!(
             "{:<20} {:>14} {:>14} {:>14} {:>10} {:>16} {:>12}",
             r.method,
             paper_cell(num(r.train_reward, 1), m.map(|p| num(p.train_reward, 1))),
             paper_cell(num(r.test_reward, 1), m.map(|p| num(p.test_reward, 1))),
-            paper_cell(format!("{:.0}%", 100.0 * r.success_rate), m.map(|p| format!("{:.0}%", 100.0 * p.success_rate))),
+            paper_cell(
+                format!("{:.0}%", 100.0 * r.success_rate),
+                m.map(|p| format!("{:.0}%", 100.0 * p.success_rate))
+            ),
             format!("{:.0}%", 100.0 * r.collision_rate),
             format!("{:.1}%", 100.0 * r.inference_rate),
             num(r.reasoning_us_per_tick, 2),
@@ -185,6 +237,9 @@ fn print_table(rows: &[MethodRow], relative: Option<f64>) {
     }
     println!("(paper's values in parentheses, §VI)");
     if let Some(rel) = relative {
-        println!("scaled reasons on {:.1}% of the ticks Bayesian RL does (paper: 63.3%)", 100.0 * rel);
+        println!(
+            "scaled reasons on {:.1}% of the ticks Bayesian RL does (paper: 63.3%)",
+            100.0 * rel
+        );
     }
 }

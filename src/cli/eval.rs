@@ -41,9 +41,20 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bundle = args.agent.bundle(args.seed, args.quiet)?;
-    crate::agent_file::check_compatible(&bundle, &map.name, unforeseen_discretizer::Discretizer::new(&map.bins)?.n_states())?;
+    crate::agent_file::check_compatible(
+        &bundle,
+        &map.name,
+        unforeseen_discretizer::Discretizer::new(&map.bins)?.n_states(),
+    )?;
     let mut controller = args.method.controller(&bundle, &params)?;
-    let results = evaluate(&map, controller.as_mut(), args.method, args.episodes, args.seed, args.quiet)?;
+    let results = evaluate(
+        &map,
+        controller.as_mut(),
+        args.method,
+        args.episodes,
+        args.seed,
+        args.quiet,
+    )?;
     let agg = Aggregate::of(&results);
     println!(
         "{} on '{}': reward {:.2}, success {:.1}%, collisions {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
@@ -58,7 +69,10 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         agg.episodes
     );
     let dir = out_dir(&args.out, "out/eval");
-    write_json(&dir.join("eval.json"), &serde_json::json!({"method": args.method, "map": map.name, "seed": args.seed, "aggregate": agg, "episodes": results}))?;
+    write_json(
+        &dir.join("eval.json"),
+        &serde_json::json!({"method": args.method, "map": map.name, "seed": args.seed, "aggregate": agg, "episodes": results}),
+    )?;
     println!("wrote {}/eval.json", dir.display());
     Ok(())
 }

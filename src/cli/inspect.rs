@@ -16,8 +16,10 @@ pub struct InspectArgs {
 
 /// Runs `inspect`, printing the report as JSON on stdout.
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(&args.model).map_err(|e| BadInput(format!("{}: cannot read ({e})", args.model.display())))?;
-    let out = unforeseen_agent::inspect::inspect_json(&text).map_err(|e| BadInput(format!("{}: {e}", args.model.display())))?;
+    let text = std::fs::read_to_string(&args.model)
+        .map_err(|e| BadInput(format!("{}: cannot read ({e})", args.model.display())))?;
+    let out = unforeseen_agent::inspect::inspect_json(&text)
+        .map_err(|e| BadInput(format!("{}: {e}", args.model.display())))?;
     println!("{out}");
     Ok(())
 }

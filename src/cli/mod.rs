@@ -3,8 +3,8 @@
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
-use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::persist::AgentBundle;
 
 use crate::training::{TrainConfig, train};
 
@@ -59,7 +59,10 @@ pub enum Command {
 
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
-    match cli.command.unwrap_or_else(|| Command::Compare(compare::CompareArgs::default())) {
+    match cli
+        .command
+        .unwrap_or_else(|| Command::Compare(compare::CompareArgs::default()))
+    {
         Command::Compare(args) => compare::run(args),
         Command::Train(args) => train::run(args),
         Command::Eval(args) => eval::run(args),
@@ -74,9 +77,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
 
 /// Whether an error (or anything in its chain) is bad input, to pick exit code 2.
 pub fn is_bad_input(err: &anyhow::Error) -> bool {
-    err.chain().any(|e| {
-        e.is::<BadInput>() || e.is::<crate::maps::MapLookupError>() || e.is::<unforeseen_sim::MapError>()
-    })
+    err.chain()
+        .any(|e| e.is::<BadInput>() || e.is::<crate::maps::MapLookupError>() || e.is::<unforeseen_sim::MapError>())
 }
 
 /// Options shared by the commands that drive a trained agent.
@@ -99,9 +101,15 @@ impl AgentArgs {
             Some(path) => crate::agent_file::load(path),
             None => {
                 let map = crate::maps::load("intersection")?;
-                let cfg = TrainConfig { quiet, ..TrainConfig::new(compare::DEFAULT_TRAIN_EPISODES, seed) };
+                let cfg = TrainConfig {
+                    quiet,
+                    ..TrainConfig::new(compare::DEFAULT_TRAIN_EPISODES, seed)
+                };
                 if !quiet {
-                    eprintln!("no --agent given: training on the embedded 'intersection' map ({} episodes, seed {seed})", cfg.episodes);
+                    eprintln!(
+                        "no --agent given: training on the embedded 'intersection' map ({} episodes, seed {seed})",
+                        cfg.episodes
+                    );
                 }
                 Ok(train(&map, &cfg)?.0)
             }

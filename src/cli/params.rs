@@ -6,15 +6,29 @@ use super::BadInput;
 
 /// The keys `--set` accepts.
 pub const KEYS: &[&str] = &[
-    "omega", "epsilon", "gamma", "varsigma", "horizon", "kappa_pi", "vmp_window", "max_scaling_iters", "nu0", "nu_temperature", "learning_rate", "sample",
+    "omega",
+    "epsilon",
+    "gamma",
+    "varsigma",
+    "horizon",
+    "kappa_pi",
+    "vmp_window",
+    "max_scaling_iters",
+    "nu0",
+    "nu_temperature",
+    "learning_rate",
+    "sample",
 ];
 
 /// Applies `KEY=VALUE` overrides in order, then checks the result.
 pub fn apply(mut p: ScaledParams, sets: &[String]) -> anyhow::Result<ScaledParams> {
     for set in sets {
-        let (key, value) = set
-            .split_once('=')
-            .ok_or_else(|| BadInput(format!("--set {set}: expected KEY=VALUE, e.g. --set omega=0.425 (keys: {})", KEYS.join(", "))))?;
+        let (key, value) = set.split_once('=').ok_or_else(|| {
+            BadInput(format!(
+                "--set {set}: expected KEY=VALUE, e.g. --set omega=0.425 (keys: {})",
+                KEYS.join(", ")
+            ))
+        })?;
         set_one(&mut p, key.trim(), value.trim())?;
     }
     p.check().map_err(|e| BadInput(format!("--set: {e}")))?;
@@ -23,8 +37,16 @@ pub fn apply(mut p: ScaledParams, sets: &[String]) -> anyhow::Result<ScaledParam
 
 /// Sets one parameter by name.
 pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), BadInput> {
-    let float = || value.parse::<f64>().map_err(|_| BadInput(format!("--set {key}={value}: '{value}' is not a number")));
-    let int = || value.parse::<usize>().map_err(|_| BadInput(format!("--set {key}={value}: '{value}' is not a whole number")));
+    let float = || {
+        value
+            .parse::<f64>()
+            .map_err(|_| BadInput(format!("--set {key}={value}: '{value}' is not a number")))
+    };
+    let int = || {
+        value
+            .parse::<usize>()
+            .map_err(|_| BadInput(format!("--set {key}={value}: '{value}' is not a whole number")))
+    };
     match key {
         "omega" => p.omega = float()?,
         "epsilon" => p.epsilon = float()?,
@@ -44,7 +66,12 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), BadIn
                 _ => return Err(BadInput(format!("--set sample={value}: expected true or false"))),
             }
         }
-        _ => return Err(BadInput(format!("--set {key}: unknown parameter; known: {}", KEYS.join(", ")))),
+        _ => {
+            return Err(BadInput(format!(
+                "--set {key}: unknown parameter; known: {}",
+                KEYS.join(", ")
+            )));
+        }
     }
     Ok(())
 }

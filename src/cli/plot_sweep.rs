@@ -27,7 +27,12 @@ const COLORS: [RGBColor; 6] = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
 pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
     let lines = read_lines(&args.results)?;
     if lines.is_empty() {
-        return Err(BadInput(format!("{}: no result lines; run `unforeseen batch --set KEY=V1,V2 --out {}` first", args.results.display(), args.results.display())).into());
+        return Err(BadInput(format!(
+            "{}: no result lines; run `unforeseen batch --set KEY=V1,V2 --out {}` first",
+            args.results.display(),
+            args.results.display()
+        ))
+        .into());
     }
     // Swept keys: those taking more than one numeric value.
     let mut values: BTreeMap<String, Vec<f64>> = BTreeMap::new();
@@ -38,17 +43,28 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
             }
         }
     }
-    let keys: Vec<String> = values.into_iter().filter(|(_, v)| v.iter().any(|x| *x != v[0])).map(|(k, _)| k).collect();
+    let keys: Vec<String> = values
+        .into_iter()
+        .filter(|(_, v)| v.iter().any(|x| *x != v[0]))
+        .map(|(k, _)| k)
+        .collect();
     let mut x_axes: Vec<(String, Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>>)> = keys
         .iter()
         .map(|k| {
             let key = k.clone();
-            let f: Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>> =
-                Box::new(move |l| l.params.iter().find(|(kk, _)| *kk == key).and_then(|(_, v)| v.parse().ok()));
+            let f: Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>> = Box::new(move |l| {
+                l.params
+                    .iter()
+                    .find(|(kk, _)| *kk == key)
+                    .and_then(|(_, v)| v.parse().ok())
+            });
             (k.clone(), f)
         })
         .collect();
-    x_axes.push(("EFE mat-vecs per tick (reasoning compute)".into(), Box::new(|l| Some(l.efe_matvecs_per_tick))));
+    x_axes.push((
+        "EFE mat-vecs per tick (reasoning compute)".into(),
+        Box::new(|l| Some(l.efe_matvecs_per_tick)),
+    ));
 
     let mut panels = Vec::new();
     let groups: Vec<(String, String)> = {
@@ -58,7 +74,13 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         g
     };
     for (name, x_of) in &x_axes {
-        for (figure, y_of) in [("success rate", (|l: &crate::batch::ResultLine| l.success_rate) as fn(&_) -> f64), ("mean reward", |l| l.mean_reward)] {
+        for (figure, y_of) in [
+            (
+                "success rate",
+                (|l: &crate::batch::ResultLine| l.success_rate) as fn(&_) -> f64,
+            ),
+            ("mean reward", |l| l.mean_reward),
+        ] {
             let series = groups
                 .iter()
                 .enumerate()
@@ -69,7 +91,11 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
                         .filter_map(|l| x_of(l).map(|x| (x, y_of(l))))
                         .collect();
                     points.sort_by(|a, b| a.0.total_cmp(&b.0));
-                    Series { label: "", points, color: COLORS[i % COLORS.len()] }
+                    Series {
+                        label: "",
+                        points,
+                        color: COLORS[i % COLORS.len()],
+                    }
                 })
                 .collect::<Vec<_>>();
             panels.push((format!("{figure} vs {name}"), series));
@@ -81,11 +107,24 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         .map(|(title, series)| {
             (
                 title.as_str(),
-                series.iter().zip(&labels).map(|(s, label)| Series { label, points: s.points.clone(), color: s.color }).collect(),
+                series
+                    .iter()
+                    .zip(&labels)
+                    .map(|(s, label)| Series {
+                        label,
+                        points: s.points.clone(),
+                        color: s.color,
+                    })
+                    .collect(),
             )
         })
         .collect();
     line_panels(&args.out, "parameter value", &panels)?;
-    println!("wrote {} ({} panels over {} result lines)", args.out.display(), panels.len(), lines.len());
+    println!(
+        "wrote {} ({} panels over {} result lines)",
+        args.out.display(),
+        panels.len(),
+        lines.len()
+    );
     Ok(())
 }

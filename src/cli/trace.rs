@@ -45,14 +45,40 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     let (result, ticks) = trace(&bundle, &params, args.method, &map, args.seed)?;
     let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
     println!("{} on '{}', seed {}", args.method, map.name, args.seed);
-    println!("{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}", "step", "d", "v", "L", "p", "action", "mode", "S(nats)", "theta", "reward");
-    let mut csv = Csv::new(&["step", "d", "v", "L", "p", "action", "mode", "surprise_nats", "theta", "reward", "car_x", "car_speed", "light"]);
+    println!(
+        "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}",
+        "step", "d", "v", "L", "p", "action", "mode", "S(nats)", "theta", "reward"
+    );
+    let mut csv = Csv::new(&[
+        "step",
+        "d",
+        "v",
+        "L",
+        "p",
+        "action",
+        "mode",
+        "surprise_nats",
+        "theta",
+        "reward",
+        "car_x",
+        "car_speed",
+        "light",
+    ]);
     let decided = &ticks[..ticks.len().saturating_sub(1)];
     for t in decided {
         let s = t.state;
         println!(
             "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8.2}",
-            t.step, s.d, s.v, s.l, s.p, t.action.to_string(), mode(t.reasoned), opt(t.surprise, 3), opt(t.theta, 3), t.reward
+            t.step,
+            s.d,
+            s.v,
+            s.l,
+            s.p,
+            t.action.to_string(),
+            mode(t.reasoned),
+            opt(t.surprise, 3),
+            opt(t.theta, 3),
+            t.reward
         );
         csv.row(vec![
             t.step.to_string(),
@@ -70,12 +96,29 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
             format!("{:?}", t.snapshot.light),
         ]);
     }
-    let outcome = if result.success { "reached the destination" } else if result.collision { "hit a pedestrian" } else { "ran out of time" };
-    println!("{outcome} after {} ticks, return {:.2}, reasoned on {} ticks", result.ticks, result.ret, result.reasoning_ticks);
+    let outcome = if result.success {
+        "reached the destination"
+    } else if result.collision {
+        "hit a pedestrian"
+    } else {
+        "ran out of time"
+    };
+    println!(
+        "{outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
+        result.ticks, result.ret, result.reasoning_ticks
+    );
     let dir = out_dir(&args.out, "out/trace");
     csv.write(&dir.join("trace.csv"))?;
-    let points: Vec<_> = decided.iter().map(|t| (t.step, t.theta.unwrap_or(0.0), t.reasoned, t.action.to_string())).collect();
-    theta_trace(&dir.join("theta.svg"), &format!("{} on {}: normalized surprise", args.method, map.name), &points, params.epsilon)?;
+    let points: Vec<_> = decided
+        .iter()
+        .map(|t| (t.step, t.theta.unwrap_or(0.0), t.reasoned, t.action.to_string()))
+        .collect();
+    theta_trace(
+        &dir.join("theta.svg"),
+        &format!("{} on {}: normalized surprise", args.method, map.name),
+        &points,
+        params.epsilon,
+    )?;
     filmstrip(&dir.join("filmstrip.svg"), &map, &ticks)?;
     println!("wrote {}/trace.csv, theta.svg, filmstrip.svg", dir.display());
     Ok(())

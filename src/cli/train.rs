@@ -29,11 +29,18 @@ pub struct TrainArgs {
 /// Runs `train`.
 pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
-    let cfg = TrainConfig { quiet: args.quiet, ..TrainConfig::new(args.episodes, args.seed) };
+    let cfg = TrainConfig {
+        quiet: args.quiet,
+        ..TrainConfig::new(args.episodes, args.seed)
+    };
     let started = std::time::Instant::now();
     let (bundle, log) = train(&map, &cfg)?;
     let tail = &log.returns[log.returns.len().saturating_sub(100)..];
-    let mean = if tail.is_empty() { 0.0 } else { tail.iter().sum::<f64>() / tail.len() as f64 };
+    let mean = if tail.is_empty() {
+        0.0
+    } else {
+        tail.iter().sum::<f64>() / tail.len() as f64
+    };
     crate::agent_file::save(&args.out, &bundle)?;
     println!(
         "trained on '{}' for {} episodes in {:.1} s (mean return of the last {} with exploration: {mean:.2}); wrote {}",

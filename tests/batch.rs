@@ -1,0 +1,192 @@
+//! Batch runs: expectations pass and fail as declared; results do not depend on
+//! `--jobs`; `--resume` completes a truncated file without duplicates; shards
+//! concatenate into the unsharded file.
+
+mod common;
+
+use std::path::Path;
+use unforeseen::batch::{BatchConfig, ParamSet, ResultLine, Scenario, Shard, load_scenarios, read_lines, run, sweep};
+use unforeseen::methods::Method;
+
+fn scenarios() -> Vec<Scenario> {
+    let names = ["jaywalk".to_string(), "intersection".to_string()];
+    load_scenarios(&names.iter().map(Into::into).collect::<Vec<_>>()).unwrap()
+}
+
+fn config<'a>(scenarios: &'a [Scenario], params: &'a [ParamSet], jobs: usize, shard: Option<Shard>) -> BatchConfig<'a> {
+    BatchConfig {
+        bundle: common::bundle(),
+        scenarios,
+        methods: &Method::PAPER,
+        params,
+        episodes: 3,
+        seed: 9,
+        jobs,
+        shard,
+    }
+}
+
+fn without_timing(lines: &[ResultLine]) -> Vec<ResultLine> {
+    lines
+        .iter()
+        .cloned()
+        .map(|mut l| {
+            l.timing_us_per_tick = 0.0;
+            l
+        })
+        .collect()
+}
+
+fn file_without_timing(path: &Path) -> Vec<ResultLine> {
+    without_timing(&read_lines(path).unwrap())
+}
+
+#[test]
+fn jobs_do_not_change_results_and_shards_concatenate_to_the_whole() {
+    let scenarios = scenarios();
+    let params = sweep(&["horizon=1,2".to_string()]).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let one = dir.path().join("one.jsonl");
+    let two = dir.path().join("two.jsonl");
+    let a = run(&config(&scenarios, &params, 1, None), &one, false, true).unwrap();
+    let b = run(&config(&scenarios, &params, 2, None), &two, false, true).unwrap();
+    assert_eq!(a.len(), 2 * 3 * 2);
+    assert_eq!(without_timing(&a), without_timing(&b));
+    assert_eq!(file_without_timing(&one), file_without_timing(&two));
+
+    let mut concatenated = Vec::new();
+    for i in 1..=3 {
+        let part = dir.path().join(format!("shard{i}.jsonl"));
+        run(
+            &config(&scenarios, &params, 2, Some(Shard { index: i, count: 3 })),
+            &part,
+            false,
+            true,
+        )
+        .unwrap();
+        concatenated.extend(read_lines(&part).unwrap());
+    }
+    assert_eq!(without_timing(&concatenated), file_without_timing(&one));
+}
+
+#[test]
+fn resume_after_a_truncated_file_completes_the_set_without_duplicates() {
+    let scenarios = scenarios();
+    let params = vec![ParamSet(Vec::new())];
+    let dir = tempfile::tempdir().unwrap();
+    let full = dir.path().join("full.jsonl");
+    let whole = run(&config(&scenarios, &params, 2, None), &full, false, true).unwrap();
+
+    // Simulate a kill: two complete lines and half of the third.
+    let text = std::fs::read_to_string(&full).unwrap();
+    let lines: Vec<&str> = text.split_inclusive('\n').collect();
+    let cut = format!("{}{}{}", lines[0], lines[1], &lines[2][..lines[2].len() / 2]);
+    let partial = dir.path().join("partial.jsonl");
+    std::fs::write(&partial, cut).unwrap();
+    assert_eq!(read_lines(&partial).unwrap().len(), 2);
+
+    let resumed = run(&config(&scenarios, &params, 2, None), &partial, true, true).unwrap();
+    assert_eq!(resumed.len(), whole.len());
+    let mut keys: Vec<_> = resumed.iter().map(ResultLine::key).collect();
+    keys.dedup();
+    assert_eq!(keys.len(), whole.len(), "no duplicates");
+    assert_eq!(without_timing(&resumed), without_timing(&whole));
+    assert_eq!(file_without_timing(&partial), without_timing(&whole));
+}
+
+#[test]
+fn expectations_pass_and_fail_as_declared() {
+    let mut scenarios = scenarios();
+    scenarios.truncate(1); // jaywalk
+    let map = &mut scenarios[0].map;
+    use unforeseen_sim::{Expectation, MethodName};
+    let none = Expectation {
+        method: MethodName::QLearning,
+        min_success: None,
+        max_success: None,
+        min_reward: None,
+        max_reward: None,
+        max_collision: None,
+        max_inference_rate: None,
+    };
+    map.expect = vec![
+        Expectation {
+            min_success: Some(0.0),
+            max_collision: Some(1.0),
+            ..none.clone()
+        },
+        Expectation {
+            min_success: Some(1.01),
+            ..none.clone()
+        },
+        Expectation {
+            method: MethodName::BayesRl,
+            max_inference_rate: Some(1.0),
+            ..none.clone()
+        },
+    ];
+    let params = vec![ParamSet(Vec::new())];
+    let dir = tempfile::tempdir().unwrap();
+    let lines = run(
+        &config(&scenarios, &params, 2, None),
+        &dir.path().join("r.jsonl"),
+        false,
+        true,
+    )
+    .unwrap();
+    let q = lines.iter().find(|l| l.method == "q-learning").unwrap();
+    assert_eq!(q.checks.len(), 3);
+    assert!(q.checks[0].pass && q.checks[1].pass);
+    assert!(
+        !q.checks[2].pass
+            && q.checks[2].figure == "success_rate"
+            && q.checks[2].bound == "min"
+            && q.checks[2].limit == 1.01
+    );
+    let b = lines.iter().find(|l| l.method == "bayes-rl").unwrap();
+    assert_eq!(b.checks.len(), 1);
+    assert!(b.checks[0].pass);
+    assert!(lines.iter().find(|l| l.method == "scaled").unwrap().checks.is_empty());
+}
+
+#[test]
+fn the_cli_fails_when_an_expectation_fails_and_names_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let agent = dir.path().join("agent.ron");
+    unforeseen::agent_file::save(&agent, common::bundle()).unwrap();
+    let jay = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps").join("jaywalk.ron");
+    let map = dir.path().join("impossible.ron");
+    std::fs::write(
+        &map,
+        format!(
+            "(base: {:?}, name: \"impossible\", expect: [(method: QLearning, min_success: 1.01)])",
+            jay.display().to_string()
+        ),
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+        .args([
+            "batch",
+            map.to_str().unwrap(),
+            "--agent",
+            agent.to_str().unwrap(),
+            "--episodes",
+            "2",
+            "--method",
+            "q-learning",
+            "-q",
+            "--out",
+        ])
+        .arg(dir.path().join("r.jsonl"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("impossible")
+            && err.contains("q-learning")
+            && err.contains("success_rate")
+            && err.contains("1.01"),
+        "{err}"
+    );
+}

@@ -1,0 +1,119 @@
+//! The command line on bad arguments and bad files: exit code 2, a message that names
+//! the file and the fix, and never a panic.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn unforeseen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+        .args(args)
+        .output()
+        .expect("run the binary")
+}
+
+fn text(out: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+fn assert_bad_input(out: &Output, needles: &[&str]) {
+    let all = text(out);
+    assert_eq!(out.status.code(), Some(2), "exit code 2 expected:\n{all}");
+    assert!(!all.contains("panicked"), "panic:\n{all}");
+    for n in needles {
+        assert!(all.contains(n), "message should contain {n:?}:\n{all}");
+    }
+}
+
+#[test]
+fn unknown_commands_flags_and_values_exit_2() {
+    assert_bad_input(&unforeseen(&["fly"]), &["fly"]);
+    assert_bad_input(&unforeseen(&["compare", "--episodes", "many"]), &["many"]);
+    assert_bad_input(&unforeseen(&["eval", "--method", "magic"]), &["magic"]);
+    assert_bad_input(&unforeseen(&["batch", "--shard", "4/3"]), &["4/3"]);
+}
+
+#[test]
+fn bad_parameter_overrides_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let agent = dir.path().join("a.ron");
+    assert!(
+        unforeseen(&["train", "--episodes", "3", "--out", agent.to_str().unwrap(), "-q"])
+            .status
+            .success()
+    );
+    let a = agent.to_str().unwrap();
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", a, "--episodes", "1", "--set", "omega"]),
+        &["KEY=VALUE"],
+    );
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", a, "--episodes", "1", "--set", "colour=red"]),
+        &["colour", "omega"],
+    );
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", a, "--episodes", "1", "--set", "gamma=-1"]),
+        &["gamma"],
+    );
+}
+
+#[test]
+fn missing_and_bad_maps_exit_2_naming_the_file() {
+    assert_bad_input(
+        &unforeseen(&["eval", "--map", "no/such/map.ron"]),
+        &["no/such/map.ron", "embedded maps"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.ron");
+    std::fs::write(&bad, "(name: \"x\", road: (goal_x: -5.0, lane_width: 3.5)").unwrap();
+    assert_bad_input(&unforeseen(&["check-map", bad.to_str().unwrap()]), &["bad.ron"]);
+    std::fs::write(&bad, [0u8, 159, 146, 150, 0, 1]).unwrap();
+    assert_bad_input(&unforeseen(&["check-map", bad.to_str().unwrap()]), &["bad.ron"]);
+}
+
+#[test]
+fn missing_corrupt_and_foreign_agent_files_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.ron");
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", missing.to_str().unwrap()]),
+        &["missing.ron", "unforeseen train"],
+    );
+    let corrupt = dir.path().join("corrupt.ron");
+    std::fs::write(&corrupt, "(format_version: 1, q_learning: (").unwrap();
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", corrupt.to_str().unwrap()]),
+        &["corrupt.ron"],
+    );
+    let foreign = dir.path().join("foreign.ron");
+    std::fs::write(&foreign, "(format_version: 999)").unwrap();
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", foreign.to_str().unwrap()]),
+        &["foreign.ron"],
+    );
+}
+
+#[test]
+fn inspect_rejects_bad_models_and_check_map_accepts_the_shipped_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("m.json");
+    std::fs::write(&model, r#"{"A": [[0.5, 0.5], [0.4, 0.5]], "B": [[[1,0],[0,1]]], "C": [0,0], "D": [0.5,0.5], "obs": [0], "actions": [], "policy_len": 1, "gamma": 1.0}"#).unwrap();
+    assert_bad_input(
+        &unforeseen(&["inspect", "--model", model.to_str().unwrap()]),
+        &["m.json", "A"],
+    );
+    let maps: Vec<String> = std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("maps"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+        .map(|p| p.display().to_string())
+        .collect();
+    assert!(maps.len() >= 4);
+    let mut args = vec!["check-map"];
+    args.extend(maps.iter().map(String::as_str));
+    let out = unforeseen(&args);
+    assert!(out.status.success(), "{}", text(&out));
+}

@@ -1,0 +1,64 @@
+//! `compare` writes the same JSON for the same seed, bit for bit, apart from the one
+//! wall-clock figure (µs per tick).
+
+use std::process::Command;
+
+fn strip_timing(v: &mut serde_json::Value) {
+    match v {
+        serde_json::Value::Object(m) => {
+            m.retain(|k, _| !k.contains("us_per"));
+            m.values_mut().for_each(strip_timing);
+        }
+        serde_json::Value::Array(a) => a.iter_mut().for_each(strip_timing),
+        _ => {}
+    }
+}
+
+fn compare_json(dir: &std::path::Path) -> serde_json::Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+        .args([
+            "compare",
+            "--train-episodes",
+            "150",
+            "--episodes",
+            "4",
+            "--seed",
+            "3",
+            "-q",
+            "--out",
+        ])
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("compare.json")).unwrap()).unwrap();
+    assert!(dir.join("compare.csv").exists() && dir.join("compare.svg").exists());
+    strip_timing(&mut v);
+    v
+}
+
+#[test]
+fn compare_json_is_identical_across_runs_with_the_same_seed() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let (ja, jb) = (compare_json(a.path()), compare_json(b.path()));
+    assert_eq!(ja, jb);
+    let methods: Vec<_> = ja["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["method"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(methods, ["q-learning", "bayes-rl", "scaled"]);
+    for m in ja["methods"].as_array().unwrap() {
+        for k in [
+            "train_reward",
+            "test_reward",
+            "success_rate",
+            "collision_rate",
+            "inference_rate",
+        ] {
+            assert!(m[k].is_number(), "{k} missing in {m}");
+        }
+    }
+}
