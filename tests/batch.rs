@@ -116,7 +116,7 @@ fn expectations_pass_and_fail_as_declared() {
             ..none.clone()
         },
         Expectation {
-            min_success: Some(1.01),
+            min_success: Some(1.0),
             ..none.clone()
         },
         Expectation {
@@ -141,7 +141,7 @@ fn expectations_pass_and_fail_as_declared() {
         !q.checks[2].pass
             && q.checks[2].figure == "success_rate"
             && q.checks[2].bound == "min"
-            && q.checks[2].limit == 1.01
+            && q.checks[2].limit == 1.0
     );
     let b = lines.iter().find(|l| l.method == "bayes-rl").unwrap();
     assert_eq!(b.checks.len(), 1);
@@ -159,7 +159,7 @@ fn the_cli_fails_when_an_expectation_fails_and_names_it() {
     std::fs::write(
         &map,
         format!(
-            "(base: {:?}, name: \"impossible\", expect: [(method: QLearning, min_success: 1.01)])",
+            "(base: {:?}, name: \"impossible\", expect: [(method: QLearning, min_success: 1.0)])",
             jay.display().to_string()
         ),
     )
@@ -186,7 +186,7 @@ fn the_cli_fails_when_an_expectation_fails_and_names_it() {
         err.contains("impossible")
             && err.contains("q-learning")
             && err.contains("success_rate")
-            && err.contains("1.01"),
+            && err.contains("min 1"),
         "{err}"
     );
 }
