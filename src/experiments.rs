@@ -73,6 +73,7 @@ pub struct MethodRow {
 }
 
 /// Evaluates `method` on the training and the test map and fills a table row.
+#[allow(clippy::too_many_arguments)]
 pub fn compare_method(
     bundle: &AgentBundle,
     params: &ScaledParams,

@@ -21,6 +21,9 @@ pub struct PlotSweepArgs {
     pub out: PathBuf,
 }
 
+/// Reads an x value off a result line.
+type XOf = Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>>;
+
 const COLORS: [RGBColor; 6] = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
 
 /// Runs `plot-sweep`.
@@ -48,11 +51,11 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         .filter(|(_, v)| v.iter().any(|x| *x != v[0]))
         .map(|(k, _)| k)
         .collect();
-    let mut x_axes: Vec<(String, Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>>)> = keys
+    let mut x_axes: Vec<(String, XOf)> = keys
         .iter()
         .map(|k| {
             let key = k.clone();
-            let f: Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>> = Box::new(move |l| {
+            let f: XOf = Box::new(move |l| {
                 l.params
                     .iter()
                     .find(|(kk, _)| *kk == key)
