@@ -35,12 +35,15 @@ fn snapshot(distance: f64, speed: f64, light: LightPhase, peds_on: &[bool]) -> S
     }
 }
 
+/// (distance to goal m, speed m/s, light, pedestrians on the crosswalk) -> (d, v, L, p).
+type Case = (f64, f64, LightPhase, &'static [bool], (usize, usize, usize, usize));
+
 #[test]
 fn table_of_continuous_inputs_to_states() {
     use LightPhase::*;
     let disc = Discretizer::new(&paper_bins(0.0)).unwrap();
     // (distance to goal m, speed m/s, light, pedestrians on crosswalk) -> (d, v, L, p)
-    let cases: &[(f64, f64, LightPhase, &[bool], (usize, usize, usize, usize))] = &[
+    let cases: &[Case] = &[
         (90.0, 3.0, Green, &[], (3, 1, 1, 0)),       // the start: far, slow, green, nobody
         (60.0001, 0.0, Red, &[false], (3, 0, 0, 0)), // just beyond the 60 m edge; pedestrian on the sidewalk
         (60.0, 1.5, Red, &[true], (2, 1, 0, 1)),     // on an edge: d counts edges strictly below, v edges at or below
