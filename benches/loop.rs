@@ -1,0 +1,169 @@
+//! Whole-system benchmarks (issue 5): one physics decision step, one jaywalk episode,
+//! training throughput, and the closed loop (world + discretizer + scaled agent) at
+//! 10 Hz decisions / 60 Hz physics.
+//!
+//! Run with `cargo bench --bench loop`. See BENCHMARKS.md for the figures.
+
+use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+use unforeseen::experiments::eval_seeds;
+use unforeseen::methods::Method;
+use unforeseen::runner::run_episode;
+use unforeseen::training::{TrainConfig, train};
+use unforeseen_agent::controller::Controller;
+use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::persist::AgentBundle;
+use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_discretizer::Discretizer;
+use unforeseen_sim::{Action, World, embedded};
+
+/// Training episodes of the bench setup (the default run uses 6000).
+const TRAIN_EPISODES: u64 = 1500;
+
+fn train_cfg(episodes: u64) -> TrainConfig {
+    TrainConfig {
+        quiet: true,
+        ..TrainConfig::new(episodes, 7)
+    }
+}
+
+fn bundle() -> AgentBundle {
+    let map = embedded::load("intersection").expect("embedded intersection map");
+    train(&map, &train_cfg(TRAIN_EPISODES)).expect("training").0
+}
+
+/// `physics_decision_step`: one `World::step` on the intersection map (decision_dt 1 s
+/// at 60 Hz = 60 Rapier sub-steps, plus lights, spawns and events). The car speeds up
+/// on the first tick and then holds its speed; a finished world is rebuilt untimed.
+fn physics_decision_step(c: &mut Criterion) {
+    let map = embedded::load("intersection").expect("map");
+    c.bench_function("physics_decision_step", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            let mut world = World::from_map(&map, 0);
+            let mut seed = 0;
+            let mut k = 0;
+            for _ in 0..iters {
+                if world.is_done() {
+                    seed += 1;
+                    world = World::from_map(&map, seed);
+                    k = 0;
+                }
+                let action = if k == 0 { Action::SpeedUp } else { Action::Maintain };
+                let t = Instant::now();
+                black_box(world.step(black_box(action)));
+                total += t.elapsed();
+                k += 1;
+            }
+            total
+        })
+    });
+}
+
+/// `episode`: one jaywalk episode (`run_episode`, no recording) of a fresh scaled agent
+/// built from the trained bundle (construction untimed), including its end-of-episode
+/// test-time learning.
+fn episode(c: &mut Criterion, bundle: &AgentBundle) {
+    let map = embedded::load("jaywalk").expect("map");
+    let disc = Discretizer::new(&map.bins).expect("discretizer");
+    let params = ScaledParams::default();
+    let seeds = eval_seeds(7, &map, Method::Scaled, 0);
+    let mut probe = Method::Scaled.controller(bundle, &params).expect("controller");
+    let (r, _) = run_episode(&map, &disc, probe.as_mut(), seeds, false);
+    eprintln!(
+        "episode: {} ticks, {} reasoning, return {:.1}, success {}",
+        r.ticks, r.reasoning_ticks, r.ret, r.success
+    );
+    c.bench_function("episode", |b| {
+        b.iter_batched(
+            || Method::Scaled.controller(bundle, &params).expect("controller"),
+            |mut ctl| run_episode(&map, &disc, ctl.as_mut(), seeds, false),
+            BatchSize::SmallInput,
+        )
+    });
+}
+
+/// `training_throughput`: `train` for 100 episodes on the intersection map
+/// (Q-learning + world model + flat and factored Bayesian RL, as the default run does).
+fn training_throughput(c: &mut Criterion) {
+    let map = embedded::load("intersection").expect("map");
+    let cfg = train_cfg(100);
+    let mut g = c.benchmark_group("training_throughput");
+    g.throughput(Throughput::Elements(100));
+    g.bench_function("100_episodes", |b| b.iter(|| train(&map, &cfg).expect("train")));
+    g.finish();
+}
+
+/// `decision_throughput`: the closed loop on the intersection map with
+/// `decision_dt = 0.1` (10 Hz decisions, 6 Rapier sub-steps per decision at 60 Hz) and
+/// `max_steps = 400` (same 40 s horizon): `World::step` + snapshot + discretizer +
+/// `ScaledAgent::act` (surprise-triggered reasoning, default parameters). One element
+/// is one decision tick; episode restarts (world construction, `begin_episode`) are
+/// untimed and no test-time learning runs.
+fn decision_throughput(c: &mut Criterion, bundle: &AgentBundle) {
+    let mut map = embedded::load("intersection").expect("map");
+    map.episode.decision_dt = 0.1;
+    map.episode.max_steps = 400;
+    let disc = Discretizer::new(&map.bins).expect("discretizer");
+    let mut agent =
+        ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, ScaledParams::default()).expect("agent");
+    // Reasoning share of the loop (for the report).
+    {
+        let mut world = World::from_map(&map, 0);
+        agent.begin_episode(0);
+        let (mut ticks, mut reasoned) = (0, 0);
+        loop {
+            let d = agent.act(disc.encode(disc.state(&world.snapshot())));
+            ticks += 1;
+            reasoned += u32::from(d.reasoned);
+            if world.step(Action::from_index(d.action).expect("action")).done() {
+                break;
+            }
+        }
+        eprintln!("decision_throughput: episode 0 has {ticks} ticks, {reasoned} reasoning");
+    }
+    let mut g = c.benchmark_group("decision_throughput");
+    g.throughput(Throughput::Elements(1));
+    g.bench_function("10hz_decisions_60hz_physics", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            let mut seed = 0;
+            let mut world = World::from_map(&map, seed);
+            agent.begin_episode(seed);
+            let mut t = Instant::now();
+            for _ in 0..iters {
+                let obs = disc.encode(disc.state(&world.snapshot()));
+                let d = agent.act(obs);
+                let out = world.step(Action::from_index(d.action).expect("action"));
+                if out.done() {
+                    total += t.elapsed();
+                    seed += 1;
+                    world = World::from_map(&map, seed);
+                    agent.begin_episode(seed);
+                    t = Instant::now();
+                }
+            }
+            total + t.elapsed()
+        })
+    });
+    g.finish();
+}
+
+fn benches(c: &mut Criterion) {
+    let bundle = bundle();
+    physics_decision_step(c);
+    episode(c, &bundle);
+    training_throughput(c);
+    decision_throughput(c, &bundle);
+}
+
+criterion_group! {
+    name = system;
+    config = Criterion::default()
+        .measurement_time(Duration::from_secs(2))
+        .warm_up_time(Duration::from_secs(1))
+        .sample_size(20);
+    targets = benches
+}
+criterion_main!(system);
