@@ -104,8 +104,8 @@ pub fn compare_method(
     })
 }
 
-/// Runs one recorded episode of `method` (after `warmup` unrecorded episodes, which
-/// let test-time learning act) and returns its ticks.
+/// Runs one recorded episode of `method` (the first evaluation episode of `seed`) and
+/// returns its result and ticks.
 pub fn trace(
     bundle: &AgentBundle,
     params: &ScaledParams,

@@ -45,8 +45,7 @@ impl Method {
         }
     }
 
-    /// The paper's reported figures for this method (§VI, Fig. 8), where it reports them:
-    /// (train reward, test reward, success rate, inference rate relative to bayes-rl).
+    /// The paper's reported figures for this method (§VI, Fig. 8), where it reports them.
     pub fn paper(self) -> Option<PaperFigures> {
         match self {
             Method::QLearning => Some(PaperFigures {

@@ -55,7 +55,7 @@ impl TrainConfig {
     }
 }
 
-/// Mean return of the last `window` training episodes, per episode.
+/// What training recorded: the return of every episode.
 #[derive(Debug, Clone, Default)]
 pub struct TrainLog {
     /// Return of every training episode (with exploration).

@@ -94,16 +94,9 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let train_map = maps::load(&args.train_map)?;
     let test_map = maps::load(&args.test_map)?;
     let params = args.agent.params()?;
-    let bundle = match &args.agent.agent {
-        Some(path) => crate::agent_file::load(path)?,
-        None => {
-            let cfg = crate::training::TrainConfig {
-                quiet: args.quiet,
-                ..crate::training::TrainConfig::new(args.train_episodes, args.seed)
-            };
-            crate::training::train(&train_map, &cfg)?.0
-        }
-    };
+    let bundle = args
+        .agent
+        .bundle_trained_on(&args.train_map, args.train_episodes, args.seed, args.quiet)?;
     let mut methods: Vec<Method> = Method::PAPER.to_vec();
     if args.ablations {
         methods.extend(Method::ABLATIONS);

@@ -97,20 +97,19 @@ pub struct AgentArgs {
 impl AgentArgs {
     /// Loads the agent file, or trains one on the embedded training map.
     pub fn bundle(&self, seed: u64, quiet: bool) -> anyhow::Result<AgentBundle> {
+        self.bundle_trained_on("intersection", compare::DEFAULT_TRAIN_EPISODES, seed, quiet)
+    }
+
+    /// Loads the agent file, or trains one on `map` (file or embedded name).
+    pub fn bundle_trained_on(&self, map: &str, episodes: u64, seed: u64, quiet: bool) -> anyhow::Result<AgentBundle> {
         match &self.agent {
             Some(path) => crate::agent_file::load(path),
             None => {
-                let map = crate::maps::load("intersection")?;
+                let map = crate::maps::load(map)?;
                 let cfg = TrainConfig {
                     quiet,
-                    ..TrainConfig::new(compare::DEFAULT_TRAIN_EPISODES, seed)
+                    ..TrainConfig::new(episodes, seed)
                 };
-                if !quiet {
-                    eprintln!(
-                        "no --agent given: training on the embedded 'intersection' map ({} episodes, seed {seed})",
-                        cfg.episodes
-                    );
-                }
                 Ok(train(&map, &cfg)?.0)
             }
         }
