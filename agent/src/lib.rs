@@ -6,7 +6,7 @@
 //! learning, and the two baselines (tabular Q-learning, Bayesian RL). All three methods
 //! implement [`controller::Controller`].
 //!
-//! Module map (named after the paper): [`maths`], [`params`], [`structure`], [`model`],
+//! Module map (named after the paper): [`maths`], [`params`], [`structure`], [`model`], [`transition`] (factored `B`),
 //! [`surprise`] (§II), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
 //! [`scaled`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`].
@@ -40,3 +40,4 @@ pub mod scaled;
 pub mod scaling;
 pub mod structure;
 pub mod surprise;
+pub mod transition;

@@ -32,6 +32,25 @@ pub fn softmax_in_place(x: &mut [f64]) {
     }
 }
 
+/// `Σ_{i<n} f(i)` with four interleaved accumulators, so that consecutive additions do
+/// not wait on each other (a plain `sum` is one serial chain of adds). The order is
+/// fixed, so the result is deterministic; it may differ from a serial sum in the last bits.
+#[inline]
+pub fn lane_sum(n: usize, f: impl Fn(usize) -> f64) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let n4 = n - n % 4;
+    for i in (0..n4).step_by(4) {
+        acc[0] += f(i);
+        acc[1] += f(i + 1);
+        acc[2] += f(i + 2);
+        acc[3] += f(i + 3);
+    }
+    for i in n4..n {
+        acc[i - n4] += f(i);
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3])
+}
+
 /// Softmax of a slice into a new vector (see [`softmax_in_place`]).
 pub fn softmax(x: &[f64]) -> Vec<f64> {
     let mut v = x.to_vec();
@@ -112,5 +131,14 @@ mod tests {
         assert!((entropy(&[0.5, 0.5]) - 2f64.ln()).abs() < 1e-15);
         assert_eq!(argmax(&[1.0, 3.0, 3.0]), 1);
         assert!((ln(0.0) - (1e-16f64).ln()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lane_sum_adds_every_term_once() {
+        for n in 0..11 {
+            // Powers of two: every partial sum is exact, so any order gives the same value.
+            let got = lane_sum(n, |i| (1u64 << i) as f64);
+            assert_eq!(got, ((1u64 << n) - 1) as f64, "n = {n}");
+        }
     }
 }

@@ -6,6 +6,7 @@ use crate::error::{AgentError, ParamError};
 use crate::maths::{ln, log_softmax};
 use crate::params::ModelPriors;
 use crate::structure::Structure;
+use crate::transition::FactoredTransition;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -31,6 +32,9 @@ pub struct GenerativeModel {
     pub c: Vec<f64>,
     /// Initial state prior `D`.
     pub d: Vec<f64>,
+    /// The same `B[u]` as per-factor steps (§II-A), when the model came from a factored
+    /// world model whose structure allows it; planning uses it for dense beliefs.
+    pub factored: Option<FactoredTransition>,
 }
 
 impl GenerativeModel {
@@ -52,6 +56,17 @@ impl GenerativeModel {
             ln_b,
             c,
             d,
+            factored: None,
+        }
+    }
+
+    /// `out = B[u] x` (§II): the factor-by-factor product when it is cheaper than the
+    /// dense columns of `x`'s non-zero entries, else those columns. `scratch` is reused.
+    pub fn transition_into(&self, u: usize, x: &[f64], out: &mut [f64], scratch: &mut Vec<f64>) {
+        let n = self.n_states();
+        match &self.factored {
+            Some(ft) if x.iter().filter(|v| **v != 0.0).count() * n > ft.cost() => ft.apply(u, x, out, scratch),
+            _ => crate::surprise::matvec_sparse_x(self.b[u].as_slice(), n, x, out),
         }
     }
 
@@ -317,7 +332,9 @@ impl WorldModel {
             }
         }
         self.gm_plan = GenerativeModel::new(a.clone(), b_plan, c.clone(), d.clone());
+        self.gm_plan.factored = FactoredTransition::new(&self.structure, &means, self.n_actions, &self.terminal);
         self.gm = GenerativeModel::new(a, b, c, d);
+        self.gm.factored = FactoredTransition::new(&self.structure, &means, self.n_actions, &[]);
     }
 
     /// Declares the episode-ending states (arrival, and the crash-risk states the agent

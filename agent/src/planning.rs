@@ -2,12 +2,15 @@
 //! (Prop. 1, eq. "EFE_0"), `q(π) = σ(-γ G)` (Cor. 1), the first-action marginal
 //! `ψ(u) = Σ_{π: π_1 = u} q(π)`, and `Q_S(u) = -(1/γ) ln ψ(u)` (Theorem 1).
 //!
+//! Predictions `B[u] s` go through [`GenerativeModel::transition_into`] (factor by
+//! factor for dense beliefs, §II-A); the brute-force oracle uses the dense `B`.
+//!
 //! All policies start from `q_t`: `s_1 = B[π_1] q_t`, `s_k = B[π_k] s_{k-1}`, `o_k = A s_k`,
 //! `G(π) = Σ_k [ o_k·(ln o_k - C) + s_k·H_A ]` (risk + ambiguity). The tree shares
 //! prefixes: `U + U^2 + ... + U^H` mat-vecs instead of `H U^H`. Policies are ordered
 //! lexicographically (first action most significant): `[0,0], [0,1], ...`.
 
-use crate::maths::{ln, softmax_in_place};
+use crate::maths::{lane_sum, ln, softmax_in_place};
 use crate::model::GenerativeModel;
 use crate::surprise::matvec_sparse_x;
 
@@ -20,12 +23,9 @@ pub fn step_efe(gm: &GenerativeModel, s: &[f64], obuf: &mut [f64]) -> (f64, f64)
         matvec_sparse_x(gm.a.as_slice(), gm.n_obs(), s, obuf);
         obuf
     };
-    let mut risk = 0.0;
-    for (oi, ci) in o.iter().zip(&gm.c) {
-        if *oi > 0.0 {
-            risk += oi * (ln(*oi) - ci);
-        }
-    }
+    // Zero entries add exactly 0 (the floored log and C are finite): no branch needed.
+    let c = &gm.c[..o.len()];
+    let risk = lane_sum(o.len(), |i| o[i] * (ln(o[i]) - c[i]));
     let ambiguity = if gm.a_identity {
         0.0
     } else {
@@ -111,6 +111,7 @@ pub struct EfeTree {
     /// `bufs[k]` is the predicted state belief at depth k (bufs[0] = q_t).
     bufs: Vec<Vec<f64>>,
     obuf: Vec<f64>,
+    scratch: Vec<f64>,
     /// `G(π)` per policy, lexicographic.
     pub g: Vec<f64>,
     /// `q(π)`.
@@ -131,6 +132,7 @@ impl EfeTree {
             horizon,
             bufs: vec![vec![0.0; n_states]; horizon + 1],
             obuf: vec![0.0; n_obs],
+            scratch: vec![0.0; n_states],
             g: vec![0.0; np],
             q_pi: vec![0.0; np],
             psi: vec![0.0; n_actions],
@@ -153,11 +155,10 @@ impl EfeTree {
     }
 
     fn recurse(&mut self, gm: &GenerativeModel, depth: usize, g_acc: f64, idx: usize) {
-        let n = self.bufs[0].len();
         for u in 0..self.n_actions {
             {
                 let (lo, hi) = self.bufs.split_at_mut(depth + 1);
-                matvec_sparse_x(gm.b[u].as_slice(), n, &lo[depth], &mut hi[0]);
+                gm.transition_into(u, &lo[depth], &mut hi[0], &mut self.scratch);
             }
             self.matvecs += 1;
             let (r, a) = step_efe(gm, &self.bufs[depth + 1], &mut self.obuf);
