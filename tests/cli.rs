@@ -117,3 +117,33 @@ fn inspect_rejects_bad_models_and_check_map_accepts_the_shipped_maps() {
     let out = unforeseen(&args);
     assert!(out.status.success(), "{}", text(&out));
 }
+
+#[test]
+fn export_model_writes_what_inspect_reads_and_rejects_bad_observations() {
+    let dir = tempfile::tempdir().unwrap();
+    let agent = dir.path().join("a.ron");
+    let a = agent.to_str().unwrap();
+    assert!(unforeseen(&["train", "--episodes", "3", "--out", a, "-q"]).status.success());
+    let model = dir.path().join("model.json");
+    let m = model.to_str().unwrap();
+    let out = unforeseen(&["export-model", "--agent", a, "--set", "horizon=2", "--out", m]);
+    assert!(out.status.success(), "{}", text(&out));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert_eq!(json["B"].as_array().unwrap().len(), 3);
+    assert_eq!(json["policy_len"], 2);
+    let out = unforeseen(&["inspect", "--model", m]);
+    assert!(out.status.success(), "{}", text(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["G"].as_array().unwrap().len(), 9);
+    let bad = dir.path().join("bad.json");
+    let b = bad.to_str().unwrap();
+    assert_bad_input(
+        &unforeseen(&["export-model", "--agent", a, "--obs", "1,2,5,0", "--out", b]),
+        &["--obs", "L=5", "0..2"],
+    );
+    assert_bad_input(
+        &unforeseen(&["export-model", "--agent", a, "--obs", "1,2", "--out", b]),
+        &["--obs", "4 factors"],
+    );
+    assert!(!bad.exists(), "no file on bad input");
+}

@@ -12,6 +12,7 @@ pub mod batch;
 pub mod check_map;
 pub mod compare;
 pub mod eval;
+pub mod export_model;
 pub mod inspect;
 pub mod learn;
 pub mod params;
@@ -55,6 +56,8 @@ pub enum Command {
     PlotSweep(plot_sweep::PlotSweepArgs),
     /// Cross-check the agent's math on a single-factor model given as JSON (pymdp layout).
     Inspect(inspect::InspectArgs),
+    /// Write a trained agent's planning model in the `inspect` JSON layout (for pymdp).
+    ExportModel(export_model::ExportModelArgs),
 }
 
 /// Runs the parsed command line.
@@ -70,6 +73,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Learn(args) => learn::run(args),
         Command::CheckMap(args) => check_map::run(args),
         Command::Inspect(args) => inspect::run(args),
+        Command::ExportModel(args) => export_model::run(args),
         Command::Batch(args) => batch::run_cli(args),
         Command::PlotSweep(args) => plot_sweep::run(args),
     }
