@@ -9,7 +9,6 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
-use unforeseen::training::{TrainConfig, train};
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::model::WorldModel;
 use unforeseen_agent::params::{ModelPriors, QParams, ReasoningMode, ScaledParams};
@@ -20,23 +19,11 @@ use unforeseen_agent::structure::{Factor, Parent, Structure};
 use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::{Action, World, embedded};
 
-/// Training episodes of the bench setup (the default run uses 6000).
-const TRAIN_EPISODES: u64 = 1500;
+mod common;
+use common::{agent, bundle, criterion_config};
+
 /// Jaywalk-like observation: d=2, v=3, L=1 (green), p=1 (pedestrian on the crosswalk).
 const JAYWALK_OBS: usize = ((2 * 4 + 3) * 2 + 1) * 2 + 1;
-
-fn bundle() -> AgentBundle {
-    let map = embedded::load("intersection").expect("embedded intersection map");
-    let cfg = TrainConfig {
-        quiet: true,
-        ..TrainConfig::new(TRAIN_EPISODES, 7)
-    };
-    train(&map, &cfg).expect("training").0
-}
-
-fn agent(bundle: &AgentBundle, params: ScaledParams) -> ScaledAgent {
-    ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params).expect("scaled agent")
-}
 
 /// `reasoning_tick/H`: `begin_episode` (untimed) then one timed `act` on the jaywalk
 /// observation, with reasoning forced on every tick. This is the first tick of an
@@ -192,37 +179,25 @@ fn learning_update(c: &mut Criterion, bundle: &AgentBundle) {
     });
 }
 
-/// A world model with the paper's structure over `sizes` (optionally a second
-/// pedestrian factor), random transition counts, materialised, with random preferences.
-fn synthetic_model(sizes: &[usize], rng: &mut ChaCha8Rng) -> WorldModel {
-    let structure = if sizes.len() == 4 {
-        Structure::paper_default([sizes[0], sizes[1], sizes[2], sizes[3]]).expect("structure")
-    } else {
-        let f = |name: &str, size, parents, action_parent| Factor {
-            name: name.to_string(),
-            size,
-            parents,
-            action_parent,
-        };
-        Structure::new(vec![
-            f("d", sizes[0], vec![Parent::Prev(0), Parent::Next(1)], false),
-            f("v", sizes[1], vec![Parent::Prev(1)], true),
-            f("L", sizes[2], vec![Parent::Prev(2)], false),
-            f(
-                "p",
-                sizes[3],
-                vec![Parent::Prev(3), Parent::Next(2), Parent::Next(0)],
-                false,
-            ),
-            f(
-                "p2",
-                sizes[4],
-                vec![Parent::Prev(4), Parent::Next(2), Parent::Next(0)],
-                false,
-            ),
-        ])
-        .expect("structure")
-    };
+/// The paper's structure over `sizes` (`[d, v, L, p]`), with a fifth entry a second
+/// pedestrian factor `p2 <- (p2, L', d')`.
+fn paper_structure(sizes: &[usize]) -> Structure {
+    let base = Structure::paper_default([sizes[0], sizes[1], sizes[2], sizes[3]]).expect("structure");
+    if sizes.len() == 4 {
+        return base;
+    }
+    let mut factors = base.factors().to_vec();
+    factors.push(Factor {
+        name: "p2".into(),
+        size: sizes[4],
+        parents: vec![Parent::Prev(4), Parent::Next(2), Parent::Next(0)],
+        action_parent: false,
+    });
+    Structure::new(factors).expect("structure")
+}
+
+/// A world model of `structure` with random transition counts and preferences.
+fn synthetic_model(structure: Structure, rng: &mut ChaCha8Rng) -> WorldModel {
     let n = structure.joint_size();
     let mut m = WorldModel::new(structure, 3, &ModelPriors::default()).expect("model");
     for _ in 0..20 * n {
@@ -237,8 +212,10 @@ fn synthetic_model(sizes: &[usize], rng: &mut ChaCha8Rng) -> WorldModel {
     m
 }
 
-/// `reasoning_tick_states/N_shape`: one reasoning tick (H = 2, first tick of an episode)
-/// on synthetic models of growing joint size N.
+/// `reasoning_tick_states/{factored,dense}/N_shape`: one reasoning tick (H = 3, first
+/// tick of an episode) on synthetic models of growing joint size N: `factored` has the
+/// paper's structure (predictions factor by factor), `dense` is the flat joint model of
+/// the same N (one factor `s' <- (s, u)`, dense `N x N` predictions).
 fn reasoning_tick_states(c: &mut Criterion) {
     let shapes: [&[usize]; 9] = [
         &[4, 4, 2, 2],
@@ -254,30 +231,37 @@ fn reasoning_tick_states(c: &mut Criterion) {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let mut g = c.benchmark_group("reasoning_tick_states");
     for shape in shapes {
-        let m = synthetic_model(shape, &mut rng);
-        let n = m.n_states();
-        let q = QLearning::new(n, 3, QParams::default());
-        let params = ScaledParams {
-            reasoning: ReasoningMode::Always,
-            horizon: 2,
-            ..ScaledParams::default()
-        };
-        let mut a = ScaledAgent::new(m, &q, params).expect("agent");
-        let obs = n / 2 + 1;
+        let factored = paper_structure(shape);
+        let n = factored.joint_size();
         let label = shape.iter().map(|s| s.to_string()).collect::<Vec<_>>().join("x");
-        g.bench_with_input(BenchmarkId::from_parameter(format!("{n}_{label}")), &obs, |b, obs| {
-            b.iter_custom(|iters| {
-                let mut total = Duration::ZERO;
-                for i in 0..iters {
-                    a.begin_episode(i);
-                    let t = Instant::now();
-                    let d = a.act(black_box(*obs));
-                    total += t.elapsed();
-                    black_box(d);
-                }
-                total
-            })
-        });
+        let models = [
+            ("factored", factored),
+            ("dense", Structure::flat(n).expect("flat structure")),
+        ];
+        for (kind, structure) in models {
+            let m = synthetic_model(structure, &mut rng);
+            assert_eq!(m.generative().factored.is_some(), kind == "factored");
+            let q = QLearning::new(n, 3, QParams::default());
+            let params = ScaledParams {
+                reasoning: ReasoningMode::Always,
+                ..ScaledParams::default()
+            };
+            let mut a = ScaledAgent::new(m, &q, params).expect("agent");
+            let obs = n / 2 + 1;
+            g.bench_with_input(BenchmarkId::new(kind, format!("{n}_{label}")), &obs, |b, obs| {
+                b.iter_custom(|iters| {
+                    let mut total = Duration::ZERO;
+                    for i in 0..iters {
+                        a.begin_episode(i);
+                        let t = Instant::now();
+                        let d = a.act(black_box(*obs));
+                        total += t.elapsed();
+                        black_box(d);
+                    }
+                    total
+                })
+            });
+        }
     }
     g.finish();
 }
@@ -292,10 +276,7 @@ fn benches(c: &mut Criterion) {
 
 criterion_group! {
     name = agent_ticks;
-    config = Criterion::default()
-        .measurement_time(Duration::from_secs(2))
-        .warm_up_time(Duration::from_secs(1))
-        .sample_size(20);
+    config = criterion_config();
     targets = benches
 }
 criterion_main!(agent_ticks);

@@ -10,28 +10,15 @@ use std::time::{Duration, Instant};
 use unforeseen::experiments::eval_seeds;
 use unforeseen::methods::Method;
 use unforeseen::runner::run_episode;
-use unforeseen::training::{TrainConfig, train};
+use unforeseen::training::train;
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::{Action, World, embedded};
 
-/// Training episodes of the bench setup (the default run uses 6000).
-const TRAIN_EPISODES: u64 = 1500;
-
-fn train_cfg(episodes: u64) -> TrainConfig {
-    TrainConfig {
-        quiet: true,
-        ..TrainConfig::new(episodes, 7)
-    }
-}
-
-fn bundle() -> AgentBundle {
-    let map = embedded::load("intersection").expect("embedded intersection map");
-    train(&map, &train_cfg(TRAIN_EPISODES)).expect("training").0
-}
+mod common;
+use common::{agent, bundle, criterion_config, train_cfg};
 
 /// `physics_decision_step`: one `World::step` on the intersection map (decision_dt 1 s
 /// at 60 Hz = 60 Rapier sub-steps, plus lights, spawns and events). The car speeds up
@@ -106,8 +93,7 @@ fn decision_throughput(c: &mut Criterion, bundle: &AgentBundle) {
     map.episode.decision_dt = 0.1;
     map.episode.max_steps = 400;
     let disc = Discretizer::new(&map.bins).expect("discretizer");
-    let mut agent =
-        ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, ScaledParams::default()).expect("agent");
+    let mut agent = agent(bundle, ScaledParams::default());
     // Reasoning share of the loop (for the report).
     {
         let mut world = World::from_map(&map, 0);
@@ -160,10 +146,7 @@ fn benches(c: &mut Criterion) {
 
 criterion_group! {
     name = system;
-    config = Criterion::default()
-        .measurement_time(Duration::from_secs(2))
-        .warm_up_time(Duration::from_secs(1))
-        .sample_size(20);
+    config = criterion_config();
     targets = benches
 }
 criterion_main!(system);

@@ -123,7 +123,11 @@ fn export_model_writes_what_inspect_reads_and_rejects_bad_observations() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("a.ron");
     let a = agent.to_str().unwrap();
-    assert!(unforeseen(&["train", "--episodes", "3", "--out", a, "-q"]).status.success());
+    assert!(
+        unforeseen(&["train", "--episodes", "3", "--out", a, "-q"])
+            .status
+            .success()
+    );
     let model = dir.path().join("model.json");
     let m = model.to_str().unwrap();
     let out = unforeseen(&["export-model", "--agent", a, "--set", "horizon=2", "--out", m]);

@@ -281,39 +281,13 @@ impl WorldModel {
     /// Rebuild the joint `B[u][(s',s)] = Π_f p(s'_f | parents_f, u)` from CPT posterior
     /// means, and `A` from its counts (§II-A; re-run after learning, §V).
     pub fn materialize(&mut self) {
-        let n = self.n_states();
-        let nf = self.structure.factors().len();
-        // Posterior means of each CPT.
-        let means: Vec<Vec<f64>> = (0..nf)
-            .map(|f| {
-                let size = self.structure.factors()[f].size;
-                let mut m = self.cpt[f].clone();
-                for row in m.chunks_mut(size) {
-                    crate::maths::normalize_in_place(row);
-                }
-                m
-            })
-            .collect();
-        let decoded: Vec<Vec<usize>> = (0..n).map(|s| self.structure.decode(s)).collect();
-        let mut b = Vec::with_capacity(self.n_actions);
-        for u in 0..self.n_actions {
-            let mut m = DMatrix::zeros(n, n);
-            for (s, prev) in decoded.iter().enumerate() {
-                for (s2, next) in decoded.iter().enumerate() {
-                    let mut p = 1.0;
-                    for f in 0..nf {
-                        let size = self.structure.factors()[f].size;
-                        let cfg = self.structure.config_index(f, prev, next, u, self.n_actions);
-                        p *= means[f][cfg * size + next[f]];
-                        if p == 0.0 {
-                            break;
-                        }
-                    }
-                    m[(s2, s)] = p;
-                }
-            }
-            b.push(m);
-        }
+        let means = self.cpt_means();
+        let factored = FactoredTransition::new(&self.structure, &means, self.n_actions, &[]);
+        let b: Vec<DMatrix<f64>> = match &factored {
+            // Factor by factor: N columns of N · Σ size_f multiply-adds each.
+            Some(ft) => (0..self.n_actions).map(|u| ft.dense(u)).collect(),
+            None => self.dense_b(&means),
+        };
         let mut a = self.a_counts.clone();
         for mut col in a.column_iter_mut() {
             let z: f64 = col.sum();
@@ -334,7 +308,56 @@ impl WorldModel {
         self.gm_plan = GenerativeModel::new(a.clone(), b_plan, c.clone(), d.clone());
         self.gm_plan.factored = FactoredTransition::new(&self.structure, &means, self.n_actions, &self.terminal);
         self.gm = GenerativeModel::new(a, b, c, d);
-        self.gm.factored = FactoredTransition::new(&self.structure, &means, self.n_actions, &[]);
+        self.gm.factored = factored;
+    }
+
+    /// Posterior means of each CPT, laid out like the counts.
+    fn cpt_means(&self) -> Vec<Vec<f64>> {
+        (0..self.structure.factors().len())
+            .map(|f| {
+                let size = self.structure.factors()[f].size;
+                let mut m = self.cpt[f].clone();
+                for row in m.chunks_mut(size) {
+                    crate::maths::normalize_in_place(row);
+                }
+                m
+            })
+            .collect()
+    }
+
+    /// The joint `B[u][(s', s)] = Π_f p(s'_f | parents_f, u)` computed entry by entry,
+    /// straight from the definition (§II-A). [`WorldModel::materialize`] builds `B`
+    /// factor by factor when it can; this is the slow oracle the tests compare it with.
+    pub fn b_by_definition(&self) -> Vec<DMatrix<f64>> {
+        self.dense_b(&self.cpt_means())
+    }
+
+    /// `B[u][(s', s)] = Π_f means_f[...]` entry by entry (structures without an
+    /// elimination order, e.g. the flat joint model).
+    fn dense_b(&self, means: &[Vec<f64>]) -> Vec<DMatrix<f64>> {
+        let n = self.n_states();
+        let nf = self.structure.factors().len();
+        let decoded: Vec<Vec<usize>> = (0..n).map(|s| self.structure.decode(s)).collect();
+        let mut b = Vec::with_capacity(self.n_actions);
+        for u in 0..self.n_actions {
+            let mut m = DMatrix::zeros(n, n);
+            for (s, prev) in decoded.iter().enumerate() {
+                for (s2, next) in decoded.iter().enumerate() {
+                    let mut p = 1.0;
+                    for f in 0..nf {
+                        let size = self.structure.factors()[f].size;
+                        let cfg = self.structure.config_index(f, prev, next, u, self.n_actions);
+                        p *= means[f][cfg * size + next[f]];
+                        if p == 0.0 {
+                            break;
+                        }
+                    }
+                    m[(s2, s)] = p;
+                }
+            }
+            b.push(m);
+        }
+        b
     }
 
     /// Declares the episode-ending states (arrival, and the crash-risk states the agent

@@ -131,6 +131,18 @@ impl FactoredTransition {
         self.steps.iter().map(|s| self.n * s.size).sum()
     }
 
+    /// The dense `B[u]` (column `s` is `B[u] e_s`), for materialising the joint matrices.
+    pub fn dense(&self, u: usize) -> nalgebra::DMatrix<f64> {
+        let mut m = nalgebra::DMatrix::zeros(self.n, self.n);
+        let (mut e, mut scratch) = (vec![0.0; self.n], Vec::new());
+        for (s, mut col) in m.column_iter_mut().enumerate() {
+            e[s] = 1.0;
+            self.apply(u, &e, col.as_mut_slice(), &mut scratch);
+            e[s] = 0.0;
+        }
+        m
+    }
+
     /// `out = B[u] x`. `scratch` is resized to `N`.
     pub fn apply(&self, u: usize, x: &[f64], out: &mut [f64], scratch: &mut Vec<f64>) {
         scratch.resize(self.n, 0.0);
@@ -273,15 +285,24 @@ mod tests {
             let z: f64 = x.iter().sum();
             x.iter_mut().for_each(|v| *v /= z);
             let mut scratch = Vec::new();
-            for gm in [w.generative(), w.planning_generative()] {
+            // The oracle: B entry by entry from the CPT means, and its absorbing version.
+            let b = &w.b_by_definition()[u];
+            let mut b_plan = b.clone();
+            for &t in &terminal {
+                b_plan.column_mut(t).fill(0.0);
+                b_plan[(t, t)] = 1.0;
+            }
+            for (gm, oracle) in [(w.generative(), b), (w.planning_generative(), &b_plan)] {
                 let ft = gm.factored.as_ref().unwrap();
                 let mut out = vec![0.0; n];
                 ft.apply(u, &x, &mut out, &mut scratch);
-                let want = dense_apply(&gm.b[u], &x);
+                let want = dense_apply(oracle, &x);
                 for (a, b) in out.iter().zip(&want) {
                     prop_assert!((a - b).abs() < 1e-14, "{a} vs {b}");
                 }
                 prop_assert!((out.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+                // The materialised dense B is the same matrix.
+                prop_assert!((&gm.b[u] - oracle).amax() < 1e-15);
             }
         }
 
