@@ -31,56 +31,35 @@ const JAYWALK_OBS: usize = ((2 * 4 + 3) * 2 + 1) * 2 + 1;
 /// the scaling loop. `reasoning_tick_mid/H` times the 4th tick of an episode instead
 /// (full VMP window of 4) after three untimed ticks on the same observation.
 fn reasoning_tick(c: &mut Criterion, bundle: &AgentBundle) {
-    let mut g = c.benchmark_group("reasoning_tick");
-    for h in 1..=5 {
-        let params = ScaledParams {
-            reasoning: ReasoningMode::Always,
-            horizon: h,
-            ..ScaledParams::default()
-        };
-        let mut a = agent(bundle, params);
-        g.bench_with_input(BenchmarkId::from_parameter(h), &h, |b, _| {
-            b.iter_custom(|iters| {
-                let mut total = Duration::ZERO;
-                for i in 0..iters {
-                    a.begin_episode(i);
-                    let t = Instant::now();
-                    let d = a.act(black_box(JAYWALK_OBS));
-                    total += t.elapsed();
-                    assert!(d.reasoned);
-                    black_box(d);
-                }
-                total
-            })
-        });
-    }
-    g.finish();
-    let mut g = c.benchmark_group("reasoning_tick_mid");
-    for h in 1..=5 {
-        let params = ScaledParams {
-            reasoning: ReasoningMode::Always,
-            horizon: h,
-            ..ScaledParams::default()
-        };
-        let mut a = agent(bundle, params);
-        g.bench_with_input(BenchmarkId::from_parameter(h), &h, |b, _| {
-            b.iter_custom(|iters| {
-                let mut total = Duration::ZERO;
-                for i in 0..iters {
-                    a.begin_episode(i);
-                    for _ in 0..3 {
-                        black_box(a.act(JAYWALK_OBS));
+    for (group, untimed_ticks) in [("reasoning_tick", 0), ("reasoning_tick_mid", 3)] {
+        let mut g = c.benchmark_group(group);
+        for h in 1..=5 {
+            let params = ScaledParams {
+                reasoning: ReasoningMode::Always,
+                horizon: h,
+                ..ScaledParams::default()
+            };
+            let mut a = agent(bundle, params);
+            g.bench_with_input(BenchmarkId::from_parameter(h), &h, |b, _| {
+                b.iter_custom(|iters| {
+                    let mut total = Duration::ZERO;
+                    for i in 0..iters {
+                        a.begin_episode(i);
+                        for _ in 0..untimed_ticks {
+                            black_box(a.act(JAYWALK_OBS));
+                        }
+                        let t = Instant::now();
+                        let d = a.act(black_box(JAYWALK_OBS));
+                        total += t.elapsed();
+                        assert!(d.reasoned);
+                        black_box(d);
                     }
-                    let t = Instant::now();
-                    let d = a.act(black_box(JAYWALK_OBS));
-                    total += t.elapsed();
-                    black_box(d);
-                }
-                total
-            })
-        });
+                    total
+                })
+            });
+        }
+        g.finish();
     }
-    g.finish();
 }
 
 /// `feedforward_tick`: `act` on the feed-forward path (`θ <= ε`: prediction by one
