@@ -10,7 +10,7 @@
 //! 4096 for the paper's `[4, 4, 2, 2]`). This works in place whenever the factors can be
 //! ordered so that each one's next-time parents are already replaced and its other
 //! previous-time parents are not yet replaced (an *elimination order*); the paper's
-//! structure has one (`v, L, d, p`). Structures without one keep the dense `B`.
+//! structure has one (`v, d, L, p`). Structures without one keep the dense `B`.
 //!
 //! Terminal states (absorbing in the planning model, see `WorldModel::set_terminal_states`)
 //! are handled exactly: their mass bypasses the factor steps and stays where it is.
@@ -72,11 +72,12 @@ pub fn elimination_order(structure: &Structure) -> Option<Vec<usize>> {
 impl FactoredTransition {
     /// Build from the structure, the CPT means (`means[f]` laid out
     /// `[config * size + child]`, each row summing to 1), the number of actions and the
-    /// absorbing states. `None` if the structure has no elimination order, or if it is a
-    /// single factor (then the steps are the dense matrix itself).
+    /// absorbing states. `None` if the structure has no elimination order, if it is a
+    /// single factor (then the steps are the dense matrix itself), or if joint indices
+    /// do not fit in 32 bits.
     pub fn new(structure: &Structure, means: &[Vec<f64>], n_actions: usize, terminal: &[usize]) -> Option<Self> {
         let factors = structure.factors();
-        if factors.len() < 2 {
+        if factors.len() < 2 || structure.joint_size() > u32::MAX as usize {
             return None;
         }
         let order = elimination_order(structure)?;
@@ -250,6 +251,33 @@ mod tests {
         ])
         .unwrap();
         assert_eq!(elimination_order(&st), None);
+    }
+
+    /// With a fifth factor (a second pedestrian `p2 <- (p2, L', d')`) the factored
+    /// product still equals the definition.
+    #[test]
+    fn five_factor_structure_matches_the_definition() {
+        let mut factors = Structure::paper_default([3, 2, 2, 2]).unwrap().factors().to_vec();
+        factors.push(Factor {
+            name: "p2".into(),
+            size: 3,
+            parents: vec![Parent::Prev(4), Parent::Next(2), Parent::Next(0)],
+            action_parent: false,
+        });
+        let st = Structure::new(factors).unwrap();
+        assert_eq!(elimination_order(&st), Some(vec![1, 0, 2, 3, 4]));
+        let w = random_model(st, 9, &[0, 50]);
+        let x: Vec<f64> = (0..72).map(|i| (i as f64 + 1.0) / (72.0 * 73.0 / 2.0)).collect();
+        let mut out = vec![0.0; 72];
+        let mut scratch = Vec::new();
+        for u in 0..3 {
+            let gm = w.generative();
+            gm.factored.as_ref().unwrap().apply(u, &x, &mut out, &mut scratch);
+            let want = dense_apply(&w.b_by_definition()[u], &x);
+            for (a, b) in out.iter().zip(&want) {
+                assert!((a - b).abs() < 1e-14, "{a} vs {b}");
+            }
+        }
     }
 
     #[test]
