@@ -3,6 +3,7 @@
 //! top-down filmstrip of an episode.
 
 use anyhow::{Result, anyhow};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -27,6 +28,20 @@ pub fn write_svg(
 /// Turns any plotters error into an anyhow error.
 pub fn plot_err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow!("plotting failed: {e:?}")
+}
+
+/// A chart on the SVG backend with `f64` axes, as every figure here draws.
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Draws the legend of the labelled series (bordered box, translucent white) at `pos`.
+fn draw_legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, pos: SeriesLabelPosition) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(pos)
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.8))
+        .draw()
+        .map_err(plot_err)
 }
 
 /// One panel of grouped bars: for each label, our value and optionally the paper's.
@@ -96,12 +111,7 @@ pub fn grouped_bars(path: &Path, panels: &[BarPanel<'_>]) -> Result<()> {
                 .map_err(plot_err)?
                 .label("paper")
                 .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLACK.mix(0.3).filled()));
-            chart
-                .configure_series_labels()
-                .border_style(BLACK)
-                .background_style(WHITE.mix(0.8))
-                .draw()
-                .map_err(plot_err)?;
+            draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
         }
         Ok(())
     })
@@ -144,12 +154,7 @@ pub fn line_panels(path: &Path, x_label: &str, panels: &[(&str, Vec<Series<'_>>)
                     .label(s.label)
                     .legend(move |(x, y)| PathElement::new([(x, y), (x + 14, y)], color.stroke_width(2)));
             }
-            chart
-                .configure_series_labels()
-                .border_style(BLACK)
-                .background_style(WHITE.mix(0.8))
-                .draw()
-                .map_err(plot_err)?;
+            draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
         }
         Ok(())
     })
@@ -211,13 +216,7 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, f64, bool, String)],
                     .map(|t| Text::new(t.3.clone(), (t.0 as f64 - 0.3, 1.0), ("sans-serif", 10))),
             )
             .map_err(plot_err)?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.8))
-            .draw()
-            .map_err(plot_err)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         Ok(())
     })
 }

@@ -282,7 +282,7 @@ impl WorldModel {
     /// means, and `A` from its counts (§II-A; re-run after learning, §V).
     pub fn materialize(&mut self) {
         let means = self.cpt_means();
-        let factored = FactoredTransition::new(&self.structure, &means, self.n_actions, &[]);
+        let factored = FactoredTransition::new(&self.structure, &means, self.n_actions);
         let b: Vec<DMatrix<f64>> = match &factored {
             // Factor by factor: N columns of N · Σ size_f multiply-adds each.
             Some(ft) => (0..self.n_actions).map(|u| ft.dense(u)).collect(),
@@ -306,7 +306,7 @@ impl WorldModel {
             }
         }
         self.gm_plan = GenerativeModel::new(a.clone(), b_plan, c.clone(), d.clone());
-        self.gm_plan.factored = FactoredTransition::new(&self.structure, &means, self.n_actions, &self.terminal);
+        self.gm_plan.factored = factored.as_ref().map(|ft| ft.with_terminal(&self.terminal));
         self.gm = GenerativeModel::new(a, b, c, d);
         self.gm.factored = factored;
     }

@@ -71,11 +71,11 @@ pub fn elimination_order(structure: &Structure) -> Option<Vec<usize>> {
 
 impl FactoredTransition {
     /// Build from the structure, the CPT means (`means[f]` laid out
-    /// `[config * size + child]`, each row summing to 1), the number of actions and the
-    /// absorbing states. `None` if the structure has no elimination order, if it is a
+    /// `[config * size + child]`, each row summing to 1) and the number of actions, with
+    /// no absorbing states (see [`FactoredTransition::with_terminal`]). `None` if the structure has no elimination order, if it is a
     /// single factor (then the steps are the dense matrix itself), or if joint indices
     /// do not fit in 32 bits.
-    pub fn new(structure: &Structure, means: &[Vec<f64>], n_actions: usize, terminal: &[usize]) -> Option<Self> {
+    pub fn new(structure: &Structure, means: &[Vec<f64>], n_actions: usize) -> Option<Self> {
         let factors = structure.factors();
         if factors.len() < 2 || structure.joint_size() > u32::MAX as usize {
             return None;
@@ -123,8 +123,16 @@ impl FactoredTransition {
             n,
             steps,
             coef,
-            terminal: terminal.to_vec(),
+            terminal: Vec::new(),
         })
+    }
+
+    /// The same transition with `terminal` as its absorbing states (the planning model).
+    pub fn with_terminal(&self, terminal: &[usize]) -> Self {
+        FactoredTransition {
+            terminal: terminal.to_vec(),
+            ..self.clone()
+        }
     }
 
     /// Multiply-adds of one [`FactoredTransition::apply`] (`N · Σ_f size_f`).

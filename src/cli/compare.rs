@@ -28,19 +28,13 @@ pub struct CompareArgs {
     /// Evaluation episodes per method and map.
     #[arg(long, default_value_t = 100)]
     pub episodes: u64,
-    /// Run seed.
-    #[arg(long, default_value_t = 7)]
-    pub seed: u64,
     /// Also run the ablations (bayes-rl-factored, scaled-always, scaled-no-learning).
     #[arg(long)]
     pub ablations: bool,
     /// Output folder for compare.json, compare.csv and compare.svg.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// No progress bars.
-    #[arg(long, short)]
-    pub quiet: bool,
-    /// Trained agent and parameter overrides.
+    /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
 }
@@ -52,13 +46,13 @@ impl Default for CompareArgs {
             test_map: "jaywalk".into(),
             train_episodes: DEFAULT_TRAIN_EPISODES,
             episodes: 100,
-            seed: 7,
             ablations: false,
             out: None,
-            quiet: false,
             agent: AgentArgs {
                 agent: None,
                 set: Vec::new(),
+                seed: 7,
+                quiet: false,
             },
         }
     }
@@ -94,9 +88,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let train_map = maps::load(&args.train_map)?;
     let test_map = maps::load(&args.test_map)?;
     let params = args.agent.params()?;
-    let bundle = args
-        .agent
-        .bundle_trained_on(&args.train_map, args.train_episodes, args.seed, args.quiet)?;
+    let bundle = args.agent.bundle_trained_on(&args.train_map, args.train_episodes)?;
     let mut methods: Vec<Method> = Method::PAPER.to_vec();
     if args.ablations {
         methods.extend(Method::ABLATIONS);
@@ -111,8 +103,8 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
                 &train_map,
                 &test_map,
                 args.episodes,
-                args.seed,
-                args.quiet,
+                args.agent.seed,
+                args.agent.quiet,
             )
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
@@ -131,7 +123,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         scaled_inference_relative_to_bayes_rl: relative,
         train_map: train_map.name.clone(),
         test_map: test_map.name.clone(),
-        seed: args.seed,
+        seed: args.agent.seed,
         train_episodes: bundle.meta.get("episodes").cloned().unwrap_or_else(|| args.train_episodes.to_string()),
         episodes: args.episodes,
         action_selection: format!("{:?}", params.action_selection),
@@ -166,35 +158,27 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         methods.iter().map(|m| m.paper().as_ref().map(f)).collect()
     };
     let col = |f: fn(&MethodRow) -> f64| report.methods.iter().map(f).collect::<Vec<_>>();
-    grouped_bars(
-        &dir.join("compare.svg"),
-        &[
-            BarPanel {
-                title: "train reward",
-                labels: &labels,
-                ours: col(|r| r.train_reward),
-                paper: paper(|p| p.train_reward),
-            },
-            BarPanel {
-                title: "test reward (unforeseen)",
-                labels: &labels,
-                ours: col(|r| r.test_reward),
-                paper: paper(|p| p.test_reward),
-            },
-            BarPanel {
-                title: "success rate",
-                labels: &labels,
-                ours: col(|r| r.success_rate),
-                paper: paper(|p| p.success_rate),
-            },
-            BarPanel {
-                title: "inference rate",
-                labels: &labels,
-                ours: col(|r| r.inference_rate),
-                paper: paper(|p| p.inference_rate),
-            },
-        ],
-    )?;
+    type Metric = (
+        &'static str,
+        fn(&MethodRow) -> f64,
+        fn(&crate::methods::PaperFigures) -> f64,
+    );
+    let metrics: [Metric; 4] = [
+        ("train reward", |r| r.train_reward, |p| p.train_reward),
+        ("test reward (unforeseen)", |r| r.test_reward, |p| p.test_reward),
+        ("success rate", |r| r.success_rate, |p| p.success_rate),
+        ("inference rate", |r| r.inference_rate, |p| p.inference_rate),
+    ];
+    let panels: Vec<BarPanel<'_>> = metrics
+        .iter()
+        .map(|(title, ours, theirs)| BarPanel {
+            title,
+            labels: &labels,
+            ours: col(*ours),
+            paper: paper(*theirs),
+        })
+        .collect();
+    grouped_bars(&dir.join("compare.svg"), &panels)?;
     println!("wrote {}/compare.json, compare.csv, compare.svg", dir.display());
     Ok(())
 }

@@ -22,16 +22,10 @@ pub struct EvalArgs {
     /// Episodes.
     #[arg(long, default_value_t = 100)]
     pub episodes: u64,
-    /// Run seed.
-    #[arg(long, default_value_t = 7)]
-    pub seed: u64,
     /// Output folder for eval.json.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// No progress bars.
-    #[arg(long, short)]
-    pub quiet: bool,
-    /// Trained agent and parameter overrides.
+    /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
 }
@@ -40,7 +34,7 @@ pub struct EvalArgs {
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
-    let bundle = args.agent.bundle(args.seed, args.quiet)?;
+    let bundle = args.agent.bundle()?;
     crate::agent_file::check_compatible(
         &bundle,
         &map.name,
@@ -52,8 +46,8 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         controller.as_mut(),
         args.method,
         args.episodes,
-        args.seed,
-        args.quiet,
+        args.agent.seed,
+        args.agent.quiet,
     )?;
     let agg = Aggregate::of(&results);
     println!(
@@ -71,7 +65,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let dir = out_dir(&args.out, "out/eval");
     write_json(
         &dir.join("eval.json"),
-        &serde_json::json!({"method": args.method, "map": map.name, "seed": args.seed, "aggregate": agg, "episodes": results}),
+        &serde_json::json!({"method": args.method, "map": map.name, "seed": args.agent.seed, "aggregate": agg, "episodes": results}),
     )?;
     println!("wrote {}/eval.json", dir.display());
     Ok(())

@@ -16,15 +16,9 @@ pub struct ExportModelArgs {
     /// observation of `reasoning_tick/H`: d=2, v=3, green, pedestrian on the crosswalk).
     #[arg(long, default_value = "2,3,1,1", value_name = "d,v,L,p")]
     pub obs: String,
-    /// Seed of the training run when no `--agent` is given.
-    #[arg(long, default_value_t = 7)]
-    pub seed: u64,
     /// Output file.
     #[arg(long, default_value = "out/model.json", value_name = "FILE.json")]
     pub out: PathBuf,
-    /// No progress bars.
-    #[arg(long, short)]
-    pub quiet: bool,
     /// Trained agent; `--set horizon=H --set gamma=G` choose the exported policy length
     /// and precision.
     #[command(flatten)]
@@ -41,7 +35,7 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         .map(|v| v.trim().parse::<usize>())
         .collect::<Result<_, _>>()
         .map_err(|e| BadInput(format!("--obs {}: {e} (expected integers, e.g. 2,3,1,1)", args.obs)))?;
-    let bundle = args.agent.bundle(args.seed, args.quiet)?;
+    let bundle = args.agent.bundle()?;
     let model = &bundle.world_model;
     let structure = model.structure();
     let factors = structure.factors();

@@ -19,16 +19,10 @@ pub struct LearnArgs {
     /// Episodes of test-time learning.
     #[arg(long, default_value_t = 50)]
     pub episodes: u64,
-    /// Run seed.
-    #[arg(long, default_value_t = 7)]
-    pub seed: u64,
     /// Output folder for learn.csv, learn.json and learn.svg.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// No progress bars.
-    #[arg(long, short)]
-    pub quiet: bool,
-    /// Trained agent and parameter overrides.
+    /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
 }
@@ -37,8 +31,8 @@ pub struct LearnArgs {
 pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
-    let bundle = args.agent.bundle(args.seed, args.quiet)?;
-    let points = learn(&bundle, &params, &map, args.episodes, args.seed, args.quiet)?;
+    let bundle = args.agent.bundle()?;
+    let points = learn(&bundle, &params, &map, args.episodes, args.agent.seed, args.agent.quiet)?;
     let mut csv = Csv::new(&[
         "episode",
         "jaywalk_surprise_bits",

@@ -89,30 +89,36 @@ pub fn is_bad_input(err: &anyhow::Error) -> bool {
 #[derive(Debug, Clone, Args)]
 pub struct AgentArgs {
     /// Agent file from `unforeseen train`; without it, one is trained first on the
-    /// embedded training map (`intersection`) with the default episodes and this seed.
+    /// embedded training map (`intersection`) with the default episodes and `--seed`.
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
     /// Scaled-agent parameter overrides, e.g. `--set omega=0.3 --set horizon=2`
     /// (keys: omega, epsilon, gamma, varsigma, horizon, kappa_pi, vmp_window, max_scaling_iters, nu0, nu_temperature, learning_rate, sample).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Run seed: the evaluation episodes and, without `--agent`, the training run derive from it.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    /// No progress bars.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 impl AgentArgs {
     /// Loads the agent file, or trains one on the embedded training map.
-    pub fn bundle(&self, seed: u64, quiet: bool) -> anyhow::Result<AgentBundle> {
-        self.bundle_trained_on("intersection", compare::DEFAULT_TRAIN_EPISODES, seed, quiet)
+    pub fn bundle(&self) -> anyhow::Result<AgentBundle> {
+        self.bundle_trained_on("intersection", compare::DEFAULT_TRAIN_EPISODES)
     }
 
     /// Loads the agent file, or trains one on `map` (file or embedded name).
-    pub fn bundle_trained_on(&self, map: &str, episodes: u64, seed: u64, quiet: bool) -> anyhow::Result<AgentBundle> {
+    pub fn bundle_trained_on(&self, map: &str, episodes: u64) -> anyhow::Result<AgentBundle> {
         match &self.agent {
             Some(path) => crate::agent_file::load(path),
             None => {
                 let map = crate::maps::load(map)?;
                 let cfg = TrainConfig {
-                    quiet,
-                    ..TrainConfig::new(episodes, seed)
+                    quiet: self.quiet,
+                    ..TrainConfig::new(episodes, self.seed)
                 };
                 Ok(train(&map, &cfg)?.0)
             }

@@ -19,16 +19,10 @@ pub struct TraceArgs {
     /// Method to trace.
     #[arg(long, value_enum, default_value_t = Method::Scaled)]
     pub method: Method,
-    /// Run seed (the episode is the first evaluation episode of this seed).
-    #[arg(long, default_value_t = 7)]
-    pub seed: u64,
     /// Output folder for trace.csv, theta.svg and filmstrip.svg.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// No progress bars.
-    #[arg(long, short)]
-    pub quiet: bool,
-    /// Trained agent and parameter overrides.
+    /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
 }
@@ -41,10 +35,10 @@ fn mode(reasoned: bool) -> &'static str {
 pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
-    let bundle = args.agent.bundle(args.seed, args.quiet)?;
-    let (result, ticks) = trace(&bundle, &params, args.method, &map, args.seed)?;
+    let bundle = args.agent.bundle()?;
+    let (result, ticks) = trace(&bundle, &params, args.method, &map, args.agent.seed)?;
     let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
-    println!("{} on '{}', seed {}", args.method, map.name, args.seed);
+    println!("{} on '{}', seed {}", args.method, map.name, args.agent.seed);
     println!(
         "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}",
         "step", "d", "v", "L", "p", "action", "mode", "S(nats)", "theta", "reward"
