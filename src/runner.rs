@@ -29,6 +29,8 @@ pub struct Tick {
     pub theta: Option<f64>,
     /// The distribution the action was taken from.
     pub policy: Vec<f64>,
+    /// The planner's action distribution `psi` (§IV), on ticks that planned.
+    pub psi: Option<Vec<f64>>,
     /// Reward paid for this tick.
     pub reward: f64,
     /// The world before acting (for the filmstrip).
@@ -118,6 +120,7 @@ pub fn run_episode(
                 surprise: decision.surprise,
                 theta: decision.theta,
                 policy: decision.policy,
+                psi: decision.psi,
                 reward,
                 snapshot: snap,
             });
@@ -137,6 +140,7 @@ pub fn run_episode(
                     surprise: None,
                     theta: None,
                     policy: Vec::new(),
+                    psi: None,
                     reward: 0.0,
                     snapshot: next_snap,
                 });

@@ -4,8 +4,9 @@
 //!
 //! - `a[o,s] += lr Σ_τ o_τ ⊗ q_τ` (§V-A, `α'_ij = α_ij + Σ_τ 1[o_τ = i] q(s_τ = j)`)
 //! - `b_f[child | parents, u] += lr Σ_τ E_{q_{τ-1} ⊗ q_τ}[1[...]]` (§V-B, factored)
-//! - `ν[u,s] += lr Σ_τ q_τ[s] 1[a_τ = u]` (§V-C; `a_τ` is the action taken from `s_τ`,
-//!   i.e. the paper's `q(s_{τ-1} = j) 1[a_τ = i]` with its action index shifted by one).
+//! - `ν[u,s] += lr Σ_τ q_τ[s] π_τ[u]` (§V-C, the paper's "policy update through
+//!   inference": `π_τ` is what reasoning chose at `τ`, `π'`; a one-hot `π_τ` at the action
+//!   taken gives the paper's `q(s_{τ-1} = j) 1[a_τ = i]` with its action index shifted by one).
 //!
 //! The base policy is `π_o(u|s) = ν[u,s] / Σ_u ν[u,s]`, and `ν` starts as
 //! `ν0 σ(Q[s,·]/T)` (DESIGN §5).
@@ -100,12 +101,14 @@ pub fn update_cpts(model: &mut WorldModel, q_prev: &[f64], u: usize, q_next: &[f
     }
 }
 
-/// `ν[s,u] += lr q[s]` for the action `u` taken from belief `q` (§V-C). `nu` is laid out
-/// `[s * n_actions + u]`.
-pub fn update_nu(nu: &mut [f64], n_actions: usize, q: &[f64], u: usize, lr: f64) {
+/// `ν[s,u] += lr q[s] π[u]` for the policy `π` chosen from belief `q` (§V-C). `nu` is laid
+/// out `[s * n_actions + u]`; each tick adds total mass `lr` (when `q` and `π` sum to 1).
+pub fn update_nu(nu: &mut [f64], n_actions: usize, q: &[f64], pi: &[f64], lr: f64) {
     for (s, p) in q.iter().enumerate() {
         if *p != 0.0 {
-            nu[s * n_actions + u] += lr * p;
+            for (c, a) in nu[s * n_actions..(s + 1) * n_actions].iter_mut().zip(pi) {
+                *c += lr * p * a;
+            }
         }
     }
 }

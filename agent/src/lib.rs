@@ -7,7 +7,7 @@
 //! implement [`controller::Controller`].
 //!
 //! Module map (named after the paper): [`maths`], [`params`], [`structure`], [`model`], [`transition`] (factored `B`),
-//! [`surprise`] (§II), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
+//! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
 //! [`scaled`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`].
 //!
@@ -27,6 +27,7 @@
 pub mod bayes_rl;
 pub mod controller;
 pub mod error;
+pub mod gate;
 pub mod inspect;
 pub mod learning;
 pub mod maths;

@@ -124,6 +124,32 @@ pub enum ReasoningMode {
     Always,
 }
 
+/// What the reasoning trigger measures (§II, §VI; DESIGN §5 "Surprise").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum GateMode {
+    /// Surprise on the state: `-ln P(x_t | parents_t)` of the watched factor (the paper's
+    /// "surprise measured from the state space", Fig. 9a-b), see [`crate::gate`].
+    #[default]
+    State,
+    /// Ablation: the one-step surprise of the joint transition, `-ln Σ_s A[o_t,s] ŝ_t[s]`
+    /// (Lemma 1), which also fires on the car's own bin crossings.
+    OneStep,
+}
+
+/// How the gate's table learns a situation as familiar (§V applied to the gate; DESIGN §5
+/// "Hand-back"). Beyond the paper, whose rule is only `θ <= ε`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum GateLearning {
+    /// A reasoning tick counts in the gate's table with weight `π'(a_o) / max_u π'(u)`,
+    /// where `a_o` is the habit's action after this episode's update of `ν`: a situation
+    /// becomes familiar (and control returns to the habit) only as far as the planner
+    /// endorses what the habit would do there. Feed-forward ticks count fully.
+    #[default]
+    Endorsed,
+    /// Ablation: every tick counts fully (the situation becomes familiar whatever the habit does).
+    Every,
+}
+
 /// Hyperparameters of the paper's agent ([`crate::scaled::ScaledAgent`]).
 ///
 /// | field | default | range | paper |
@@ -146,6 +172,10 @@ pub enum ReasoningMode {
 /// | `learning_rate` | 1.0 | >= 0 | multiplies the expected counts added in §V |
 /// | `nu0` ν0 | 10.0 | > 0 | prior strength of ν = ν0 σ(Q/T) (DESIGN §5) |
 /// | `nu_temperature` T | 1.0 | > 0 | temperature of ν's softmax over Q |
+/// | `gate` | State | | §VI surprise on the state, or the one-step joint surprise (ablation) |
+/// | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
+/// | `gate_memory` | 20.0 | > 0 (inf allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
+/// | `gate_learning` | Endorsed | | reasoning ticks count in the gate's table as far as the planner endorses the habit |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ScaledParams {
@@ -185,6 +215,14 @@ pub struct ScaledParams {
     pub nu0: f64,
     /// T, temperature of the Q softmax that initialises ν.
     pub nu_temperature: f64,
+    /// What the reasoning trigger measures.
+    pub gate: GateMode,
+    /// Name of the factor the state gate watches (given its next-time parents).
+    pub gate_factor: String,
+    /// Data counts each row of the state gate's table keeps (bounded memory).
+    pub gate_memory: f64,
+    /// How the gate's table learns a situation as familiar.
+    pub gate_learning: GateLearning,
 }
 
 impl Default for ScaledParams {
@@ -208,6 +246,10 @@ impl Default for ScaledParams {
             learning_rate: 1.0,
             nu0: 10.0,
             nu_temperature: 1.0,
+            gate: GateMode::State,
+            gate_factor: "p".into(),
+            gate_memory: 20.0,
+            gate_learning: GateLearning::Endorsed,
         }
     }
 }
@@ -233,6 +275,13 @@ impl ScaledParams {
         non_negative("learning_rate", self.learning_rate)?;
         positive("nu0", self.nu0)?;
         positive("nu_temperature", self.nu_temperature)?;
+        if !(self.gate_memory > 0.0) {
+            return Err(ParamError::new(
+                "gate_memory",
+                self.gate_memory,
+                "> 0 (inf for unbounded)",
+            ));
+        }
         Ok(())
     }
 }

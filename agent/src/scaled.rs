@@ -5,13 +5,18 @@
 //! Feed-forward ticks (`θ_t <= ε`) are cheap: `q_t` by one exact Bayes step and the
 //! action from `π_o(·|q_t)`; no VMP and no planning (§II footnote). Reasoning ticks:
 //! VMP over the window -> `q_t`, EFE tree -> `ψ`, scaling `π_o(·|q_t)` -> `π'`, act.
+//!
+//! The trigger reads the surprise on the state ([`crate::gate`], §VI) by default, and
+//! the one-step joint surprise ([`crate::surprise`]) as an ablation. Planning always
+//! predicts with the full transition model, which keeps the pedestrian's persistence.
 
 use crate::controller::{Controller, Decision};
 use crate::error::AgentError;
+use crate::gate::StateGate;
 use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
-use crate::params::{ActionSelection, ReasoningMode, ScaledParams, ScalingMode};
+use crate::params::{ActionSelection, GateLearning, GateMode, ReasoningMode, ScaledParams, ScalingMode};
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s};
 use crate::q_learning::QLearning;
@@ -54,6 +59,8 @@ pub struct ScaledAgent {
     n_actions: usize,
     /// Policy counts `ν`, `[s * n_actions + u]`.
     nu: Vec<f64>,
+    /// The surprise gate on the state (`None` with [`GateMode::OneStep`]).
+    gate: Option<StateGate>,
     rng: ChaCha8Rng,
     tree: EfeTree,
     vmp_ws: VmpWorkspace,
@@ -66,6 +73,8 @@ pub struct ScaledAgent {
     hist_obs: Vec<usize>,
     hist_act: Vec<usize>,
     hist_q: Vec<f64>,
+    /// The policy acted upon each tick (`π'` on reasoning ticks), `[t * n_actions + u]`.
+    hist_pi: Vec<f64>,
     hist_surprise: Vec<f64>,
     hist_reasoned: Vec<bool>,
     final_obs: Option<usize>,
@@ -95,6 +104,10 @@ impl ScaledAgent {
             });
         }
         let nu = learning::nu_from_q(q.table(), na, params.nu0, params.nu_temperature);
+        let gate = match params.gate {
+            GateMode::State => Some(StateGate::from_model(&model, &params.gate_factor, params.gate_memory)?),
+            GateMode::OneStep => None,
+        };
         let n_obs = model.generative().n_obs();
         Ok(ScaledAgent {
             tree: EfeTree::new(n, n_obs, na, params.horizon),
@@ -108,6 +121,7 @@ impl ScaledAgent {
             hist_obs: Vec::with_capacity(256),
             hist_act: Vec::with_capacity(256),
             hist_q: Vec::with_capacity(256 * n),
+            hist_pi: Vec::with_capacity(256 * na),
             hist_surprise: Vec::with_capacity(256),
             hist_reasoned: Vec::with_capacity(256),
             final_obs: None,
@@ -118,6 +132,7 @@ impl ScaledAgent {
             n_states: n,
             n_actions: na,
             nu,
+            gate,
         })
     }
 
@@ -139,7 +154,11 @@ impl ScaledAgent {
         learning::pi_o_state(&self.nu, self.n_actions, s, &mut out);
         out
     }
-    /// Surprise (nats) of every tick of the current (or last) episode.
+    /// The surprise gate on the state, if the agent uses one (§VI, Fig. 9a-b).
+    pub fn gate(&self) -> Option<&StateGate> {
+        self.gate.as_ref()
+    }
+    /// Surprise (nats) of every tick of the current (or last) episode (what the trigger read).
     pub fn last_surprise_history(&self) -> &[f64] {
         &self.hist_surprise
     }
@@ -259,6 +278,7 @@ impl Controller for ScaledAgent {
         self.hist_obs.clear();
         self.hist_act.clear();
         self.hist_q.clear();
+        self.hist_pi.clear();
         self.hist_surprise.clear();
         self.hist_reasoned.clear();
         self.final_obs = None;
@@ -283,10 +303,13 @@ impl Controller for ScaledAgent {
             }
         }
         let gm = self.model.generative();
-        let s = surprise(gm, obs, &self.s_hat);
+        bayes_step(gm, obs, &self.s_hat, &mut self.q_cur);
+        let s = match &self.gate {
+            Some(gate) => gate.surprise(&self.q_cur),
+            None => surprise(gm, obs, &self.s_hat),
+        };
         let th = theta(s, self.params.omega);
         let reasoned = self.params.reasoning == ReasoningMode::Always || th > self.params.epsilon;
-        bayes_step(gm, obs, &self.s_hat, &mut self.q_cur);
         let mut scaling_iters = 0;
         if reasoned {
             scaling_iters = self.reason(obs, th);
@@ -302,6 +325,7 @@ impl Controller for ScaledAgent {
         self.hist_obs.push(obs);
         self.hist_act.push(action);
         self.hist_q.extend_from_slice(&self.q_cur);
+        self.hist_pi.extend_from_slice(&self.pi);
         self.hist_surprise.push(s);
         self.hist_reasoned.push(reasoned);
         Decision {
@@ -321,7 +345,15 @@ impl Controller for ScaledAgent {
         }
     }
 
-    /// Test-time learning (§V): A, factor CPTs and ν from the episode's posteriors.
+    /// Test-time learning (§V): A, factor CPTs, the gate's table and ν from the episode's
+    /// posteriors. `ν` consolidates the actions reasoning took (§V-C: "the policy π_o needs
+    /// to consolidate the actions sampled from its scaled version π'"), `ν[s,a_τ] += lr q_τ[s]`
+    /// on reasoning ticks only: feed-forward ticks do not reinforce the habit's own choices.
+    /// The gate's table then learns the episode's states; with [`GateLearning::Endorsed`],
+    /// each situation of the table (a cell `(x | parents)`) counts with the smallest
+    /// endorsement, over this episode's reasoning ticks in it, of the updated habit's action
+    /// by reasoning's policy: a situation becomes familiar only as far as the habit now does
+    /// what reasoning chose in every state of it the episode met.
     fn end_episode(&mut self) {
         if !self.params.learning || self.hist_obs.is_empty() {
             return;
@@ -330,13 +362,36 @@ impl Controller for ScaledAgent {
         let lr = self.params.learning_rate;
         let na = self.n_actions;
         let steps = self.hist_obs.len();
+        let mut taken = vec![0.0; na];
         for k in 0..steps {
             let q = &self.hist_q[k * n..(k + 1) * n];
             learning::update_a(self.model.a_counts_mut(), self.hist_obs[k], q, lr);
-            learning::update_nu(&mut self.nu, na, q, self.hist_act[k], lr);
+            if self.hist_reasoned[k] {
+                taken.fill(0.0);
+                taken[self.hist_act[k]] = 1.0;
+                learning::update_nu(&mut self.nu, na, q, &taken, lr);
+            }
             if k > 0 {
                 let qp = &self.hist_q[(k - 1) * n..k * n];
                 learning::update_cpts(&mut self.model, qp, self.hist_act[k - 1], q, lr);
+            }
+        }
+        if let Some(gate) = &mut self.gate {
+            // Each tick is attributed to the cell of its most likely state.
+            let mut weight = vec![1.0; gate.n_cells()];
+            if self.params.gate_learning == GateLearning::Endorsed {
+                let mut habit = vec![0.0; na];
+                for k in (0..steps).filter(|&k| self.hist_reasoned[k]) {
+                    let q = &self.hist_q[k * n..(k + 1) * n];
+                    learning::pi_o_belief(&self.nu, na, q, &mut habit);
+                    let e = endorsement(&self.hist_pi[k * na..(k + 1) * na], argmax(&habit));
+                    let cell = gate.cell_of(argmax(q));
+                    weight[cell] = f64::min(weight[cell], e);
+                }
+            }
+            for k in 0..steps {
+                let q = &self.hist_q[k * n..(k + 1) * n];
+                gate.learn(q, lr * weight[gate.cell_of(argmax(q))]);
             }
         }
         if let Some(o) = self.final_obs.filter(|o| *o < self.model.generative().n_obs()) {
@@ -349,7 +404,20 @@ impl Controller for ScaledAgent {
             bayes_step(gm, o, &pred, &mut qf);
             learning::update_a(self.model.a_counts_mut(), o, &qf, lr);
             learning::update_cpts(&mut self.model, &qp, u, &qf, lr);
+            if let Some(gate) = &mut self.gate {
+                gate.learn(&qf, lr);
+            }
+        }
+        if let Some(gate) = &mut self.gate {
+            gate.consolidate();
         }
         self.model.materialize();
     }
+}
+
+/// How far the policy reasoning chose endorses action `a`: `π'(a) / max_u π'(u)`, 1 when
+/// `a` is (one of) reasoning's most likely actions.
+fn endorsement(pi_scaled: &[f64], a: usize) -> f64 {
+    let best = pi_scaled.iter().copied().fold(0.0, f64::max);
+    if best > 0.0 { pi_scaled[a] / best } else { 0.0 }
 }

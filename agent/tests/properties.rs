@@ -193,10 +193,22 @@ proptest! {
         let mut a_counts = DMatrix::zeros(n, n);
         update_a(&mut a_counts, 2, &q_prev, lr);
         prop_assert!((a_counts.row(2).sum() - lr).abs() < 1e-12 && (a_counts.sum() - lr).abs() < 1e-12);
+        // ν from a one-hot policy (the action taken) and from a spread one (π' of reasoning).
         let mut nu = vec![1.0; n * 3];
-        update_nu(&mut nu, 3, &q_prev, u, lr);
+        let mut one_hot = [0.0; 3];
+        one_hot[u] = 1.0;
+        update_nu(&mut nu, 3, &q_prev, &one_hot, lr);
         for s in 0..n {
             prop_assert!((nu[s * 3 + u] - 1.0 - lr * q_prev[s]).abs() < 1e-12);
+        }
+        let pi = [0.2, 0.3, 0.5];
+        let mut nu = vec![1.0; n * 3];
+        update_nu(&mut nu, 3, &q_prev, &pi, lr);
+        prop_assert!((nu.iter().sum::<f64>() - 3.0 * n as f64 - lr).abs() < 1e-9);
+        for s in 0..n {
+            for (a, p) in pi.iter().enumerate() {
+                prop_assert!((nu[s * 3 + a] - 1.0 - lr * q_prev[s] * p).abs() < 1e-12);
+            }
         }
     }
 }

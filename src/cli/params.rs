@@ -1,6 +1,6 @@
 //! `--set KEY=VALUE` overrides of the scaled agent's parameters (also used by sweeps).
 
-use unforeseen_agent::params::{ActionSelection, ScaledParams};
+use unforeseen_agent::params::{ActionSelection, GateLearning, GateMode, ScaledParams};
 
 use super::BadInput;
 
@@ -18,6 +18,10 @@ pub const KEYS: &[&str] = &[
     "nu_temperature",
     "learning_rate",
     "sample",
+    "gate",
+    "gate_factor",
+    "gate_memory",
+    "gate_learning",
 ];
 
 /// Applies `KEY=VALUE` overrides in order, then checks the result.
@@ -64,6 +68,26 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), BadIn
                 "true" | "1" | "yes" => ActionSelection::Sample,
                 "false" | "0" | "no" => ActionSelection::Mode,
                 _ => return Err(BadInput(format!("--set sample={value}: expected true or false"))),
+            }
+        }
+        "gate" => {
+            p.gate = match value {
+                "state" => GateMode::State,
+                "one-step" => GateMode::OneStep,
+                _ => return Err(BadInput(format!("--set gate={value}: expected state or one-step"))),
+            }
+        }
+        "gate_factor" => p.gate_factor = value.to_string(),
+        "gate_memory" => p.gate_memory = float()?,
+        "gate_learning" => {
+            p.gate_learning = match value {
+                "endorsed" => GateLearning::Endorsed,
+                "every" => GateLearning::Every,
+                _ => {
+                    return Err(BadInput(format!(
+                        "--set gate_learning={value}: expected endorsed or every"
+                    )));
+                }
             }
         }
         _ => {

@@ -37,11 +37,13 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     let params = args.agent.params()?;
     let bundle = args.agent.bundle()?;
     let (result, ticks) = trace(&bundle, &params, args.method, &map, args.agent.seed)?;
+    let bits = |x: Option<f64>| x.map(|s| s / std::f64::consts::LN_2);
     let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
     println!("{} on '{}', seed {}", args.method, map.name, args.agent.seed);
+    let dist = |x: &[f64]| x.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join("/");
     println!(
-        "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}",
-        "step", "d", "v", "L", "p", "action", "mode", "S(nats)", "theta", "reward"
+        "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}  {:<14} {:<14}",
+        "step", "d", "v", "L", "p", "action", "mode", "S(bits)", "theta", "reward", "policy", "psi"
     );
     let mut csv = Csv::new(&[
         "step",
@@ -51,9 +53,11 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         "p",
         "action",
         "mode",
-        "surprise_nats",
+        "surprise_bits",
         "theta",
         "reward",
+        "policy",
+        "psi",
         "car_x",
         "car_speed",
         "light",
@@ -62,7 +66,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     for t in decided {
         let s = t.state;
         println!(
-            "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8.2}",
+            "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8.2}  {:<14} {:<14}",
             t.step,
             s.d,
             s.v,
@@ -70,9 +74,11 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
             s.p,
             t.action.to_string(),
             mode(t.reasoned),
-            opt(t.surprise, 3),
+            opt(bits(t.surprise), 3),
             opt(t.theta, 3),
-            t.reward
+            t.reward,
+            dist(&t.policy),
+            t.psi.as_deref().map(dist).unwrap_or_else(|| "-".into()),
         );
         csv.row(vec![
             t.step.to_string(),
@@ -82,9 +88,14 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
             s.p.to_string(),
             t.action.to_string(),
             mode(t.reasoned).into(),
-            opt(t.surprise, 6),
+            opt(bits(t.surprise), 6),
             opt(t.theta, 6),
             num(t.reward, 4),
+            t.policy.iter().map(|p| num(*p, 6)).collect::<Vec<_>>().join(" "),
+            t.psi
+                .as_deref()
+                .map(|x| x.iter().map(|p| num(*p, 6)).collect::<Vec<_>>().join(" "))
+                .unwrap_or_default(),
             num(t.snapshot.car_x, 3),
             num(t.snapshot.car_speed, 3),
             format!("{:?}", t.snapshot.light),
