@@ -291,10 +291,7 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine
     };
     let agg = Aggregate::of(&results);
     let tree: usize = (1..=params.horizon).map(|k| 3usize.pow(k as u32)).sum();
-    let plans_by_efe = matches!(
-        unit.method,
-        Method::Scaled | Method::ScaledAlways | Method::ScaledNoLearning
-    );
+    let plans_by_efe = unit.method.is_scaled();
     Ok(ResultLine {
         unit: unit.index,
         scenario: map.name.clone(),

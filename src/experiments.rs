@@ -125,20 +125,24 @@ pub fn trace(
     ))
 }
 
-/// One point of the test-time learning curves (Fig. 9).
+/// One point of the test-time learning curves (Fig. 9): what the agent brings into
+/// episode `episode` (probabilities read before it), and how the episode went.
 #[derive(Debug, Clone, Serialize)]
 pub struct LearnPoint {
     /// Episode index (0 = first encounter).
     pub episode: u64,
-    /// Surprise in bits on the first tick of the episode with a pedestrian on the
-    /// crosswalk under a green light (None if that never happened).
-    pub jaywalk_surprise_bits: Option<f64>,
-    /// P(p' = 1 | p = 0, L' = 1, d' = 2): a pedestrian appearing on green at d = 2.
-    pub p_appear_green_d2: f64,
-    /// P(p' = 1 | p = 1, L' = 1, d' = 2): a pedestrian staying on the crosswalk on green at d = 2.
+    /// The gate's surprise in bits on the first tick of the episode with a pedestrian on
+    /// the crosswalk under a green light (Fig. 9a; None if that never happened).
+    pub event_surprise_bits: Option<f64>,
+    /// The gate's `P(p=1 | L=1, d=2)`, a pedestrian on the crosswalk under green at d = 2
+    /// (Fig. 9b; None with the one-step gate).
+    pub p_pedestrian_green_d2: Option<f64>,
+    /// The planning model's persistence `P(p'=1 | p=1, L'=1, d'=2)`.
     pub p_stay_green_d2: f64,
-    /// pi_o(slow down | s_jay), the base policy in the jaywalk state first met.
+    /// `pi_o(slow down | s_event)`, the base policy in the event state first met (Fig. 9c).
     pub p_slow_down: f64,
+    /// Ticks of this episode that reasoned.
+    pub reasoning_ticks: u32,
     /// Share of this episode's ticks that reasoned.
     pub inference_rate: f64,
     /// Whether the episode succeeded.
@@ -147,8 +151,8 @@ pub struct LearnPoint {
     pub reward: f64,
 }
 
-/// Runs the scaled agent (with test-time learning) for `episodes` episodes on `map`,
-/// recording after each the quantities of Fig. 9.
+/// Runs the scaled agent (with test-time learning, the continual protocol) for `episodes`
+/// episodes on `map`, recording the quantities of Fig. 9 in the paper's units.
 pub fn learn(
     bundle: &AgentBundle,
     params: &ScaledParams,
@@ -168,18 +172,21 @@ pub fn learn(
         },
     )?;
     let bar = progress::bar(episodes, "learning", quiet);
-    let mut jay_state: Option<usize> = None;
+    let mut event_state: Option<usize> = None;
     let mut points = Vec::new();
+    let slow = Action::SlowDown.index();
     for ep in 0..episodes {
+        let p_pedestrian_green_d2 = pedestrian_on_green_d2(&agent);
+        let p_stay_green_d2 = agent.model().cpt_prob(3, 1, &[1, 1, 2], None);
+        let before = agent.nu().to_vec();
         let (result, ticks) = run_episode(map, &disc, &mut agent, eval_seeds(seed, map, Method::Scaled, ep), true);
-        if jay_state.is_none() {
-            jay_state = ticks
+        if event_state.is_none() {
+            event_state = ticks
                 .iter()
                 .find(|t| t.state.p == 1 && t.state.l == 1)
                 .map(|t| disc.encode(t.state));
         }
-        let slow = Action::SlowDown.index();
-        let js = jay_state.unwrap_or_else(|| {
+        let es = event_state.unwrap_or_else(|| {
             disc.encode(State {
                 d: 2.min(disc.factor_sizes()[0] - 1),
                 v: 0,
@@ -187,12 +194,14 @@ pub fn learn(
                 p: 1,
             })
         });
+        let row = &before[es * Action::ALL.len()..(es + 1) * Action::ALL.len()];
         points.push(LearnPoint {
             episode: ep,
-            jaywalk_surprise_bits: result.jaywalk_surprise.map(|s| s / std::f64::consts::LN_2),
-            p_appear_green_d2: pedestrian_prob(&agent, 0),
-            p_stay_green_d2: pedestrian_prob(&agent, 1),
-            p_slow_down: agent.pi_o(js)[slow],
+            event_surprise_bits: result.jaywalk_surprise.map(|s| s / std::f64::consts::LN_2),
+            p_pedestrian_green_d2,
+            p_stay_green_d2,
+            p_slow_down: row[slow] / row.iter().sum::<f64>(),
+            reasoning_ticks: result.reasoning_ticks,
             inference_rate: if result.ticks == 0 {
                 0.0
             } else {
@@ -207,8 +216,19 @@ pub fn learn(
     Ok(points)
 }
 
-/// P(p' = 1 | p = `p_prev`, L' = 1, d' = 2) from the agent's pedestrian CPT (factor 3,
-/// parents p, L', d' in the paper's default structure).
-fn pedestrian_prob(agent: &ScaledAgent, p_prev: usize) -> f64 {
-    agent.model().cpt_prob(3, 1, &[p_prev, 1, 2], None)
+/// The gate's `P(p=1 | L=1, d=2)` (Fig. 9b), if the agent gates on the state and its
+/// gate conditions on factors named `L` and `d`.
+fn pedestrian_on_green_d2(agent: &ScaledAgent) -> Option<f64> {
+    let gate = agent.gate()?;
+    let factors = agent.model().structure().factors();
+    let values = gate
+        .given()
+        .iter()
+        .map(|g| match factors[*g].name.as_str() {
+            "L" => Some(1),
+            "d" => Some(2),
+            _ => None,
+        })
+        .collect::<Option<Vec<usize>>>()?;
+    Some(gate.probability(1, &values))
 }

@@ -2,7 +2,7 @@
 //! trained [`AgentBundle`] so every method shares the same training data.
 
 use unforeseen_agent::controller::Controller;
-use unforeseen_agent::params::{ReasoningMode, ScaledParams};
+use unforeseen_agent::params::{GateLearning, GateMode, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 
@@ -25,13 +25,25 @@ pub enum Method {
     ScaledAlways,
     /// Ablation: the scaled agent without test-time learning.
     ScaledNoLearning,
+    /// Ablation: the scaled agent gated by the one-step surprise of the joint transition
+    /// instead of the surprise on the state.
+    ScaledOneStepGate,
+    /// Ablation: the scaled agent whose gate learns every tick as familiar, whether or not
+    /// reasoning endorses what the habit would do there.
+    ScaledGateLearnsAll,
 }
 
 impl Method {
     /// The three methods of the paper's table.
     pub const PAPER: [Method; 3] = [Method::QLearning, Method::BayesRl, Method::Scaled];
     /// The ablations of DESIGN.md §6.
-    pub const ABLATIONS: [Method; 3] = [Method::BayesRlFactored, Method::ScaledAlways, Method::ScaledNoLearning];
+    pub const ABLATIONS: [Method; 5] = [
+        Method::BayesRlFactored,
+        Method::ScaledAlways,
+        Method::ScaledNoLearning,
+        Method::ScaledOneStepGate,
+        Method::ScaledGateLearnsAll,
+    ];
 
     /// The name used on the command line and in result files.
     pub fn name(self) -> &'static str {
@@ -42,6 +54,8 @@ impl Method {
             Method::BayesRlFactored => "bayes-rl-factored",
             Method::ScaledAlways => "scaled-always",
             Method::ScaledNoLearning => "scaled-no-learning",
+            Method::ScaledOneStepGate => "scaled-one-step-gate",
+            Method::ScaledGateLearnsAll => "scaled-gate-learns-all",
         }
     }
 
@@ -70,11 +84,25 @@ impl Method {
         }
     }
 
+    /// Whether the method is the scaled agent or one of its ablations (plans by EFE, §IV).
+    pub fn is_scaled(self) -> bool {
+        matches!(
+            self,
+            Method::Scaled
+                | Method::ScaledAlways
+                | Method::ScaledNoLearning
+                | Method::ScaledOneStepGate
+                | Method::ScaledGateLearnsAll
+        )
+    }
+
     /// Whether the method carries state from one episode to the next (test-time
     /// learning), so its episodes must run in order.
     pub fn learns_across_episodes(self, params: &ScaledParams) -> bool {
         match self {
-            Method::Scaled | Method::ScaledAlways => params.learning,
+            Method::Scaled | Method::ScaledAlways | Method::ScaledOneStepGate | Method::ScaledGateLearnsAll => {
+                params.learning
+            }
             Method::ScaledNoLearning | Method::QLearning => false,
             Method::BayesRl | Method::BayesRlFactored => true,
         }
@@ -104,6 +132,14 @@ impl Method {
             })?,
             Method::ScaledNoLearning => scaled(ScaledParams {
                 learning: false,
+                ..params.clone()
+            })?,
+            Method::ScaledOneStepGate => scaled(ScaledParams {
+                gate: GateMode::OneStep,
+                ..params.clone()
+            })?,
+            Method::ScaledGateLearnsAll => scaled(ScaledParams {
+                gate_learning: GateLearning::Every,
                 ..params.clone()
             })?,
         })

@@ -158,7 +158,7 @@ pub enum GateLearning {
 /// | `epsilon` ε | 0.2 | [0, 1) | §II reasoning trigger θ > ε, §VI |
 /// | `gamma` γ | 0.5 | > 0 | Cor. 1 q(π) = σ(-γG), §VI |
 /// | `varsigma` ς | 0.05 | >= 0 | eq. "stopping_criterion", §VI |
-/// | `kappa_pi` | 0.5 | (0, 1] | scaling step size (1 = the paper's full step) |
+/// | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
 /// | `max_scaling_iters` | 50 | >= 1 | cap of the scaling loop |
 /// | `horizon` H | 3 | 1..=8 | policy length (3^H policies) |
 /// | `vmp_window` W | 4 | >= 1 | VMP window (ticks) |
@@ -232,7 +232,7 @@ impl Default for ScaledParams {
             epsilon: 0.2,
             gamma: 0.5,
             varsigma: 0.05,
-            kappa_pi: 0.5,
+            kappa_pi: 1.0,
             max_scaling_iters: 50,
             horizon: 3,
             vmp_window: 4,

@@ -35,54 +35,62 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     let points = learn(&bundle, &params, &map, args.episodes, args.agent.seed, args.agent.quiet)?;
     let mut csv = Csv::new(&[
         "episode",
-        "jaywalk_surprise_bits",
-        "p_appear_green_d2",
+        "event_surprise_bits",
+        "p_pedestrian_green_d2",
         "p_stay_green_d2",
         "p_slow_down",
+        "reasoning_ticks",
         "inference_rate",
         "success",
         "reward",
     ]);
+    let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_default();
     for p in &points {
         csv.row(vec![
             p.episode.to_string(),
-            p.jaywalk_surprise_bits.map(|s| num(s, 4)).unwrap_or_default(),
-            num(p.p_appear_green_d2, 5),
+            opt(p.event_surprise_bits, 4),
+            opt(p.p_pedestrian_green_d2, 5),
             num(p.p_stay_green_d2, 5),
             num(p.p_slow_down, 5),
+            p.reasoning_ticks.to_string(),
             num(p.inference_rate, 4),
             p.success.to_string(),
             num(p.reward, 3),
         ]);
     }
     if let (Some(first), Some(last)) = (points.first(), points.last()) {
-        let bits = |x: Option<f64>| x.map(|b| format!("{b:.2} bits")).unwrap_or_else(|| "n/a".into());
+        let shown = |x: Option<f64>, unit: &str| x.map(|b| format!("{b:.2}{unit}")).unwrap_or_else(|| "n/a".into());
         println!(
-            "test-time learning on '{}' over {} episodes (paper's Fig. 9 in parentheses):",
+            "test-time learning on '{}' over {} continual episodes (paper's Fig. 9 in parentheses):",
             map.name,
             points.len()
         );
         println!(
-            "  surprise at the jaywalk      {} -> {}   (1.95 -> ~0.2 bits)",
-            bits(first.jaywalk_surprise_bits),
-            bits(last.jaywalk_surprise_bits)
+            "  surprise at the event           {} -> {}   (1.95 -> ~0.2 bits)",
+            shown(first.event_surprise_bits, " bits"),
+            shown(last.event_surprise_bits, " bits")
         );
         println!(
-            "  P(p'=1 | p=1, L'=1, d'=2)    {:.3} -> {:.3}   (paper's P(pedestrian | L=1, d=2): 0.25 -> 0.9)",
-            first.p_stay_green_d2, last.p_stay_green_d2
+            "  P(p=1 | L=1, d=2)               {} -> {}   (0.25 -> 0.9)",
+            shown(first.p_pedestrian_green_d2, ""),
+            shown(last.p_pedestrian_green_d2, "")
         );
         println!(
-            "  P(p'=1 | p=0, L'=1, d'=2)    {:.3} -> {:.3}",
-            first.p_appear_green_d2, last.p_appear_green_d2
-        );
-        println!(
-            "  pi_o(slow down | jaywalk)    {:.3} -> {:.3}   (0.3 -> 0.92)",
+            "  pi_o(slow down | event state)   {:.2} -> {:.2}   (0.3 -> 0.92)",
             first.p_slow_down, last.p_slow_down
         );
         println!(
-            "  inference rate               {:.1}% -> {:.1}%",
-            100.0 * first.inference_rate,
-            100.0 * last.inference_rate
+            "  planner's P(p'=1 | p=1, L'=1, d'=2)  {:.2} -> {:.2}",
+            first.p_stay_green_d2, last.p_stay_green_d2
+        );
+        println!(
+            "  reasoning ticks per episode     {} -> {}",
+            first.reasoning_ticks, last.reasoning_ticks
+        );
+        println!(
+            "  successes                       {}/{}",
+            points.iter().filter(|p| p.success).count(),
+            points.len()
         );
     }
     let dir = out_dir(&args.out, "out/learn");
@@ -99,30 +107,30 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
         "episode of test-time learning",
         &[
             (
-                "surprise at the jaywalk (bits)",
+                "(a) surprise at the event (bits)",
                 vec![Series {
-                    label: "S at first jaywalk tick",
-                    points: x(&|p| p.jaywalk_surprise_bits),
+                    label: "gate's surprise, first tick with a pedestrian on green",
+                    points: x(&|p| p.event_surprise_bits),
                     color: RED,
                 }],
             ),
             (
-                "world model: pedestrian on green at d = 2",
+                "(b) pedestrian on green at d = 2",
                 vec![
                     Series {
-                        label: "P(p'=1 | p=1, L'=1, d'=2)",
-                        points: x(&|p| Some(p.p_stay_green_d2)),
+                        label: "gate: P(p=1 | L=1, d=2)",
+                        points: x(&|p| p.p_pedestrian_green_d2),
                         color: BLUE,
                     },
                     Series {
-                        label: "P(p'=1 | p=0, L'=1, d'=2)",
-                        points: x(&|p| Some(p.p_appear_green_d2)),
+                        label: "planner: P(p'=1 | p=1, L'=1, d'=2)",
+                        points: x(&|p| Some(p.p_stay_green_d2)),
                         color: GREEN,
                     },
                 ],
             ),
             (
-                "policy: pi_o(slow down | jaywalk state)",
+                "(c) policy: pi_o(slow down | event state)",
                 vec![Series {
                     label: "P(slow down)",
                     points: x(&|p| Some(p.p_slow_down)),
