@@ -4,7 +4,7 @@
 
 mod common;
 
-use unforeseen::experiments::{evaluate, trace};
+use unforeseen::experiments::{evaluate, learn, trace};
 use unforeseen::methods::Method;
 use unforeseen::metrics::Aggregate;
 use unforeseen_agent::params::ScaledParams;
@@ -36,7 +36,38 @@ fn scaled_avoids_the_jaywalker_that_q_learning_hits() {
         jay[0]
     );
     assert!(jay[0].theta.unwrap() > params.epsilon);
+    // The gate reads the state (§VI): before any test-time learning it stays open on every
+    // tick the pedestrian is on the crosswalk under green, and is closed before they appear.
+    assert!(
+        jay.iter().all(|t| t.reasoned),
+        "reasoning lasts while the jaywalker crosses"
+    );
+    let before: Vec<_> = s_ticks.iter().take_while(|t| t.state.p == 0).collect();
+    assert!(
+        !before.is_empty() && before.iter().all(|t| !t.reasoned),
+        "no reasoning before the event"
+    );
     assert!(s.reasoning_ticks < s.ticks, "reasoning is triggered, not constant");
+}
+
+/// Fig. 9's shape on the trained model, over continual episodes: the gate's surprise at the
+/// event falls, `P(p=1 | L=1, d=2)` and the habit's `P(slow down)` rise, reasoning fades,
+/// and learning never costs a crash.
+#[test]
+fn test_time_learning_makes_the_jaywalk_familiar_without_a_crash() {
+    let bundle = common::bundle();
+    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let points = learn(bundle, &ScaledParams::default(), &jaywalk, 30, 3, true).unwrap();
+    let (first, last) = (&points[0], points.last().unwrap());
+    assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
+    let surprise = |p: &unforeseen::experiments::LearnPoint| p.event_surprise_bits.unwrap();
+    assert!(surprise(last) < 0.5 * surprise(first), "surprise {first:?} -> {last:?}");
+    assert!(last.p_pedestrian_green_d2.unwrap() > first.p_pedestrian_green_d2.unwrap() + 0.3);
+    assert!(last.p_slow_down > first.p_slow_down, "habit {first:?} -> {last:?}");
+    assert!(
+        last.reasoning_ticks < first.reasoning_ticks,
+        "reasoning {first:?} -> {last:?}"
+    );
 }
 
 #[test]
