@@ -6,6 +6,8 @@ use unforeseen_agent::params::{ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 
+use crate::reference::{BrakeOnPedestrian, NeverBrake};
+
 /// A method (or ablation) the runner can drive.
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum, serde::Serialize, serde::Deserialize,
@@ -25,6 +27,14 @@ pub enum Method {
     ScaledAlways,
     /// Ablation: the scaled agent without test-time learning.
     ScaledNoLearning,
+    /// Scripted reference (not a method of the paper): slows down while a pedestrian is
+    /// on the crosswalk and the car has not arrived, else speeds up; never reasons,
+    /// never learns. Whether it survives a map says whether the map is survivable
+    /// ([`crate::reference::BrakeOnPedestrian`]).
+    BrakeOnPedestrian,
+    /// Scripted reference: always speeds up. Whether it is hit says whether a map is
+    /// dangerous ([`crate::reference::NeverBrake`]).
+    NeverBrake,
 }
 
 impl Method {
@@ -32,6 +42,9 @@ impl Method {
     pub const PAPER: [Method; 3] = [Method::QLearning, Method::BayesRl, Method::Scaled];
     /// The ablations of DESIGN.md §6.
     pub const ABLATIONS: [Method; 3] = [Method::BayesRlFactored, Method::ScaledAlways, Method::ScaledNoLearning];
+    /// The scripted references ([`crate::reference`]): the careful driver and the car
+    /// that never brakes. They need no trained agent.
+    pub const REFERENCE: [Method; 2] = [Method::BrakeOnPedestrian, Method::NeverBrake];
 
     /// The name used on the command line and in result files.
     pub fn name(self) -> &'static str {
@@ -42,6 +55,8 @@ impl Method {
             Method::BayesRlFactored => "bayes-rl-factored",
             Method::ScaledAlways => "scaled-always",
             Method::ScaledNoLearning => "scaled-no-learning",
+            Method::BrakeOnPedestrian => "brake-on-pedestrian",
+            Method::NeverBrake => "never-brake",
         }
     }
 
@@ -76,11 +91,31 @@ impl Method {
         match self {
             Method::Scaled | Method::ScaledAlways => params.learning,
             Method::ScaledNoLearning | Method::QLearning => false,
+            Method::BrakeOnPedestrian | Method::NeverBrake => false,
             Method::BayesRl | Method::BayesRlFactored => true,
         }
     }
 
-    /// Builds a fresh controller of this method from the trained bundle.
+    /// Whether the method is scripted ([`Method::REFERENCE`]): it needs no trained agent.
+    pub fn is_scripted(self) -> bool {
+        Method::REFERENCE.contains(&self)
+    }
+
+    /// A fresh scripted controller for observations of factor sizes `sizes`
+    /// (`[n_d, n_v, n_L, n_p]`), or `None` for a method that needs a trained agent.
+    /// [`Method::controller`] builds its scripted methods here, with the sizes of the
+    /// bundle's world model; callers without an agent (`check-map`, `eval` without
+    /// `--agent`) pass the map discretizer's sizes.
+    pub fn scripted_controller(self, sizes: &[usize]) -> anyhow::Result<Option<Box<dyn Controller>>> {
+        Ok(match self {
+            Method::BrakeOnPedestrian => Some(Box::new(BrakeOnPedestrian::new(sizes)?)),
+            Method::NeverBrake => Some(Box::new(NeverBrake)),
+            _ => None,
+        })
+    }
+
+    /// Builds a fresh controller of this method from the trained bundle (the scripted
+    /// references take only the factor sizes of its world model).
     pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> anyhow::Result<Box<dyn Controller>> {
         let scaled = |params: ScaledParams| -> anyhow::Result<Box<dyn Controller>> {
             Ok(Box::new(ScaledAgent::new(
@@ -106,6 +141,17 @@ impl Method {
                 learning: false,
                 ..params.clone()
             })?,
+            Method::BrakeOnPedestrian | Method::NeverBrake => {
+                let sizes: Vec<usize> = bundle
+                    .world_model
+                    .structure()
+                    .factors()
+                    .iter()
+                    .map(|f| f.size)
+                    .collect();
+                self.scripted_controller(&sizes)?
+                    .expect("scripted_controller builds every scripted method")
+            }
         })
     }
 }
