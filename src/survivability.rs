@@ -96,8 +96,8 @@ pub fn warnings(name: &str, brake: Option<&Witness>, never_brake: Option<&Witnes
     if let Some(w) = brake.filter(|w| w.episodes > 0 && w.success_rate < SURVIVABLE_MIN_SUCCESS) {
         out.push(format!(
             "WARNING: map '{name}' may not be survivable: {} (brakes from the first tick a pedestrian is on the \
-             crosswalk) succeeds in {}, under {:.0}%; a fair unforeseen test lets a careful driver stop \
-             (give the pedestrian a later, slower or farther entry)",
+             crosswalk) succeeds in {}, under {:.0}%; in a fair unforeseen test a car that brakes as soon as \
+             it sees the pedestrian can stop in time (let them step out when the car is farther away)",
             Method::BrakeOnPedestrian,
             w.figures(),
             100.0 * SURVIVABLE_MIN_SUCCESS
