@@ -208,6 +208,7 @@ fn method_name(m: Method) -> Option<MethodName> {
         Method::QLearning => Some(MethodName::QLearning),
         Method::BayesRl => Some(MethodName::BayesRl),
         Method::Scaled => Some(MethodName::Scaled),
+        Method::BrakeOnPedestrian => Some(MethodName::BrakeOnPedestrian),
         _ => None,
     }
 }

@@ -13,7 +13,10 @@
 //!   per-state preferences (the C vector of §IV);
 //! * [`training`] learns Q-learning, the world model and Bayesian RL on the same episodes;
 //! * [`runner`] drives one episode of any [`unforeseen_agent::controller::Controller`];
-//! * [`methods`] builds the three compared methods (§VI) and their ablations;
+//! * [`methods`] builds the three compared methods (§VI), their ablations and the
+//!   scripted references of [`reference`];
+//! * [`survivability`] checks with those references that a scenario is survivable and
+//!   dangerous;
 //! * [`metrics`] aggregates episodes into the paper's table;
 //! * [`experiments`] runs `compare`, `trace` and `learn`;
 //! * [`report`] writes JSON/CSV atomically and [`plots`] draws SVG figures;
@@ -29,8 +32,10 @@ pub mod methods;
 pub mod metrics;
 pub mod plots;
 pub mod progress;
+pub mod reference;
 pub mod report;
 pub mod rewards;
 pub mod runner;
 pub mod seeds;
+pub mod survivability;
 pub mod training;

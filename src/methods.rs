@@ -6,6 +6,8 @@ use unforeseen_agent::params::{GateLearning, GateMode, ReasoningMode, ScaledPara
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 
+use crate::reference::{BrakeOnPedestrian, NeverBrake};
+
 /// A method (or ablation) the runner can drive.
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum, serde::Serialize, serde::Deserialize,
@@ -31,6 +33,14 @@ pub enum Method {
     /// Ablation: the scaled agent whose gate learns every tick as familiar, whether or not
     /// reasoning endorses what the habit would do there.
     ScaledGateLearnsAll,
+    /// Scripted reference (not a method of the paper): slows down while a pedestrian is
+    /// on the crosswalk and the car has not arrived, else speeds up; never reasons,
+    /// never learns. Whether it survives a map says whether the map is survivable
+    /// ([`crate::reference::BrakeOnPedestrian`]).
+    BrakeOnPedestrian,
+    /// Scripted reference: always speeds up. Whether it is hit says whether a map is
+    /// dangerous ([`crate::reference::NeverBrake`]).
+    NeverBrake,
 }
 
 impl Method {
@@ -44,6 +54,9 @@ impl Method {
         Method::ScaledOneStepGate,
         Method::ScaledGateLearnsAll,
     ];
+    /// The scripted references ([`crate::reference`]): the careful driver and the car
+    /// that never brakes. They need no trained agent.
+    pub const REFERENCE: [Method; 2] = [Method::BrakeOnPedestrian, Method::NeverBrake];
 
     /// The name used on the command line and in result files.
     pub fn name(self) -> &'static str {
@@ -56,6 +69,8 @@ impl Method {
             Method::ScaledNoLearning => "scaled-no-learning",
             Method::ScaledOneStepGate => "scaled-one-step-gate",
             Method::ScaledGateLearnsAll => "scaled-gate-learns-all",
+            Method::BrakeOnPedestrian => "brake-on-pedestrian",
+            Method::NeverBrake => "never-brake",
         }
     }
 
@@ -104,11 +119,31 @@ impl Method {
                 params.learning
             }
             Method::ScaledNoLearning | Method::QLearning => false,
+            Method::BrakeOnPedestrian | Method::NeverBrake => false,
             Method::BayesRl | Method::BayesRlFactored => true,
         }
     }
 
-    /// Builds a fresh controller of this method from the trained bundle.
+    /// Whether the method is scripted ([`Method::REFERENCE`]): it needs no trained agent.
+    pub fn is_scripted(self) -> bool {
+        Method::REFERENCE.contains(&self)
+    }
+
+    /// A fresh scripted controller for observations of factor sizes `sizes`
+    /// (`[n_d, n_v, n_L, n_p]`), or `None` for a method that needs a trained agent.
+    /// [`Method::controller`] builds its scripted methods here, with the sizes of the
+    /// bundle's world model; callers without an agent (`check-map`, `eval` without
+    /// `--agent`) pass the map discretizer's sizes.
+    pub fn scripted_controller(self, sizes: &[usize]) -> anyhow::Result<Option<Box<dyn Controller>>> {
+        Ok(match self {
+            Method::BrakeOnPedestrian => Some(Box::new(BrakeOnPedestrian::new(sizes)?)),
+            Method::NeverBrake => Some(Box::new(NeverBrake)),
+            _ => None,
+        })
+    }
+
+    /// Builds a fresh controller of this method from the trained bundle (the scripted
+    /// references take only the factor sizes of its world model).
     pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> anyhow::Result<Box<dyn Controller>> {
         let scaled = |params: ScaledParams| -> anyhow::Result<Box<dyn Controller>> {
             Ok(Box::new(ScaledAgent::new(
@@ -142,6 +177,17 @@ impl Method {
                 gate_learning: GateLearning::Every,
                 ..params.clone()
             })?,
+            Method::BrakeOnPedestrian | Method::NeverBrake => {
+                let sizes: Vec<usize> = bundle
+                    .world_model
+                    .structure()
+                    .factors()
+                    .iter()
+                    .map(|f| f.size)
+                    .collect();
+                self.scripted_controller(&sizes)?
+                    .expect("scripted_controller builds every scripted method")
+            }
         })
     }
 }

@@ -16,6 +16,16 @@ pub const TWO_PEDESTRIANS: &str = include_str!("../../maps/two_pedestrians.ron")
 pub const STUCK_GREEN: &str = include_str!("../../maps/stuck_green.ron");
 /// `maps/stop_midway.ron`: a jaywalker who stops in the car's lane.
 pub const STOP_MIDWAY: &str = include_str!("../../maps/stop_midway.ron");
+/// `maps/far_appearance.ron`: a jaywalker appears while the car is still far away (d = 3).
+pub const FAR_APPEARANCE: &str = include_str!("../../maps/far_appearance.ron");
+/// `maps/slow_walker.ron`: a slow jaywalker from the near kerb.
+pub const SLOW_WALKER: &str = include_str!("../../maps/slow_walker.ron");
+/// `maps/long_pause.ron`: a jaywalker who stops in the car's lane for 10 s.
+pub const LONG_PAUSE: &str = include_str!("../../maps/long_pause.ron");
+/// `maps/near_kerb.ron`: a walker steps out from the near kerb close in front of the car.
+pub const NEAR_KERB: &str = include_str!("../../maps/near_kerb.ron");
+/// `maps/late_fast.ron`: a fast runner steps out late.
+pub const LATE_FAST: &str = include_str!("../../maps/late_fast.ron");
 
 const ALL: &[(&str, &str)] = &[
     ("intersection", INTERSECTION),
@@ -24,6 +34,11 @@ const ALL: &[(&str, &str)] = &[
     ("two_pedestrians", TWO_PEDESTRIANS),
     ("stuck_green", STUCK_GREEN),
     ("stop_midway", STOP_MIDWAY),
+    ("far_appearance", FAR_APPEARANCE),
+    ("slow_walker", SLOW_WALKER),
+    ("long_pause", LONG_PAUSE),
+    ("near_kerb", NEAR_KERB),
+    ("late_fast", LATE_FAST),
 ];
 
 const NAMES: &[&str] = &[
@@ -33,6 +48,11 @@ const NAMES: &[&str] = &[
     "two_pedestrians",
     "stuck_green",
     "stop_midway",
+    "far_appearance",
+    "slow_walker",
+    "long_pause",
+    "near_kerb",
+    "late_fast",
 ];
 
 /// Names of the embedded maps (without `.ron`).

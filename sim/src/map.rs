@@ -299,6 +299,10 @@ pub enum MethodName {
     BayesRl,
     /// The paper's method: surprise-triggered reasoning and test-time scaling.
     Scaled,
+    /// The scripted reference driver (not a method of the paper): slows down while a
+    /// pedestrian is on the crosswalk and the car has not arrived, else speeds up. A
+    /// `min_success` bound on it says the scenario is survivable.
+    BrakeOnPedestrian,
 }
 
 /// Expected outcome of a batch run of one method on this map (checked by the runner).

@@ -2,7 +2,8 @@
 //! cross only on red; in jaywalk.ron (and the other unforeseen maps) a car that
 //! never brakes hits the jaywalker for every seed, and a car that brakes as soon
 //! as a pedestrian is on the crosswalk at a decision tick stops before the
-//! crosswalk, is not hit, and then reaches the destination.
+//! crosswalk (or, for late_fast.ron's runner, slows down until they are gone),
+//! is not hit, and then reaches the destination.
 
 mod common;
 
@@ -49,6 +50,13 @@ fn never_braking_hits(name: &str, policy: fn(&unforeseen_sim::Snapshot) -> Actio
 
 /// The careful driver stops before the crosswalk and is never hit.
 fn braking_is_safe(name: &str) {
+    braking_is_safe_stopping(name, true);
+}
+
+/// The careful driver is never hit; with `must_stop` it also comes to a full stop
+/// before the crosswalk while someone is on it (a fast runner, late_fast.ron, may
+/// leave the crosswalk while the car is still slowing down: then it only slows).
+fn braking_is_safe_stopping(name: &str, must_stop: bool) {
     let map = embedded::load(name).unwrap();
     let near = map.crosswalk_near_x();
     for seed in 0..SEEDS {
@@ -56,11 +64,13 @@ fn braking_is_safe(name: &str) {
         let (snaps, out) = run(&mut world, brake_for_pedestrians);
         assert!(!out.collision, "{name} seed {seed}: hit");
         assert!(out.goal, "{name} seed {seed}: did not arrive in {} ticks", out.step);
-        // It came to a full stop before the crosswalk while someone was on it.
+        // It came to a full stop (or at least slowed down) before the crosswalk while
+        // someone was on it.
+        let limit = if must_stop { 0.0 } else { map.vehicle.max_speed - 1.0 };
         assert!(
             snaps
                 .iter()
-                .any(|s| s.car_speed == 0.0 && s.car_x < near && s.pedestrian_on_crosswalk()),
+                .any(|s| s.car_speed <= limit && s.car_x < near && s.pedestrian_on_crosswalk()),
             "{name} seed {seed}: never waited"
         );
         for s in &snaps {
@@ -116,11 +126,34 @@ fn jaywalker_appears_on_green_at_distance_bin_2() {
 }
 
 #[test]
+fn far_appearance_jaywalker_appears_on_green_at_distance_bin_3() {
+    let map = embedded::load("far_appearance").unwrap();
+    for seed in 0..SEEDS {
+        let mut world = World::from_map(&map, seed);
+        let (snaps, _) = run(&mut world, brake_for_pedestrians);
+        let first = snaps.iter().find(|s| s.pedestrian_on_crosswalk()).unwrap();
+        assert_eq!(first.light, LightPhase::Green);
+        assert!(first.distance_to_goal > 60.0, "seed {seed}: {}", first.distance_to_goal);
+    }
+}
+
+#[test]
 fn other_unforeseen_scenarios() {
-    for name in ["jaywalk_late", "two_pedestrians", "stop_midway", "stuck_green"] {
+    for name in [
+        "jaywalk_late",
+        "two_pedestrians",
+        "stop_midway",
+        "stuck_green",
+        "far_appearance",
+        "slow_walker",
+        "long_pause",
+        "near_kerb",
+    ] {
         never_braking_hits(name, speed_up);
         braking_is_safe(name);
     }
+    never_braking_hits("late_fast", speed_up);
+    braking_is_safe_stopping("late_fast", false);
     // With the light stuck on green even a slow car meets the jaywalker.
     never_braking_hits("stuck_green", keep_speed);
 }

@@ -3,8 +3,9 @@
 use clap::Args;
 use std::path::PathBuf;
 
-use crate::batch::{BatchConfig, Shard, load_scenarios, run, sweep};
+use crate::batch::{BatchConfig, ResultLine, Scenario, Shard, load_scenarios, run, sweep};
 use crate::methods::Method;
+use crate::survivability::{Witness, warnings};
 use crate::training::{TrainConfig, train};
 
 /// Arguments of `batch`.
@@ -19,7 +20,9 @@ pub struct BatchArgs {
     /// Run seed.
     #[arg(long, default_value_t = 7)]
     pub seed: u64,
-    /// Methods to run (repeatable); default: q-learning, bayes-rl, scaled.
+    /// Methods to run (repeatable); default: q-learning, bayes-rl, scaled and the
+    /// scripted references brake-on-pedestrian and never-brake (so every map reports
+    /// whether it is survivable and dangerous).
     #[arg(long = "method", value_enum)]
     pub methods: Vec<Method>,
     /// Worker threads (results do not depend on it).
@@ -56,7 +59,7 @@ fn default_jobs() -> usize {
 pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let scenarios = load_scenarios(&args.maps)?;
     let methods = if args.methods.is_empty() {
-        Method::PAPER.to_vec()
+        Method::PAPER.iter().chain(&Method::REFERENCE).copied().collect()
     } else {
         args.methods.clone()
     };
@@ -110,6 +113,9 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             ));
         }
     }
+    for warning in survivability_warnings(&scenarios, &lines) {
+        eprintln!("{warning}");
+    }
     let checked: usize = lines.iter().map(|l| l.checks.len()).sum();
     println!(
         "wrote {} ({} lines); {} expectation(s) checked, {} failed",
@@ -125,4 +131,35 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         anyhow::bail!("{} expectation(s) failed", failures.len());
     }
     Ok(())
+}
+
+/// The survivability warnings of `check-map`, from the brake-on-pedestrian and
+/// never-brake units that ran (scripted methods ignore parameter sets, so the first
+/// line of each is taken), for scenarios with pedestrian rules.
+fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<String> {
+    let witness = |scenario: &str, method: Method| {
+        lines
+            .iter()
+            .find(|l| l.scenario == scenario && l.method == method.name())
+            .map(|l| Witness {
+                episodes: l.episodes,
+                success_rate: l.success_rate,
+                collision_rate: l.collision_rate,
+                timeout_rate: l.timeout_rate,
+            })
+    };
+    scenarios
+        .iter()
+        .filter(|s| !s.map.pedestrians.is_empty())
+        .flat_map(|s| {
+            let name = &s.map.name;
+            warnings(
+                name,
+                witness(name, Method::BrakeOnPedestrian).as_ref(),
+                witness(name, Method::NeverBrake).as_ref(),
+            )
+            .into_iter()
+            .map(move |w| format!("{}: {w}", s.source))
+        })
+        .collect()
 }

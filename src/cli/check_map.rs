@@ -1,9 +1,11 @@
-//! `unforeseen check-map`: validate map files and summarize them.
+//! `unforeseen check-map`: validate map files, summarize them, and warn when a map with
+//! pedestrians is not a fair unforeseen test ([`crate::survivability`]).
 
 use clap::Args;
 use std::path::PathBuf;
 
 use super::BadInput;
+use crate::survivability;
 use unforeseen_sim::Map;
 
 /// Arguments of `check-map`.
@@ -12,14 +14,28 @@ pub struct CheckMapArgs {
     /// Map files to check.
     #[arg(required = true, value_name = "FILE")]
     pub files: Vec<PathBuf>,
+    /// Episodes of each scripted witness (brake-on-pedestrian, never-brake) on every
+    /// map with pedestrian rules; warns when the map is not survivable or not
+    /// dangerous. 0 disables the check.
+    #[arg(long, value_name = "N", default_value_t = survivability::DEFAULT_EPISODES)]
+    pub survivability_episodes: u64,
+    /// Run seed of the witnesses' episodes (the same episodes as `eval`/`batch --seed`).
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
 }
 
-/// Runs `check-map`: every file is checked; the command fails if any is bad.
+/// Runs `check-map`: every file is checked; the command fails if any is bad. The
+/// survivability warnings go to stderr and do not change the exit code.
 pub fn run(args: CheckMapArgs) -> anyhow::Result<()> {
     let mut bad = 0;
     for file in &args.files {
         match Map::load(file) {
-            Ok(map) => println!("{}: ok\n{}\n", file.display(), map.summary()),
+            Ok(map) => {
+                println!("{}: ok\n{}\n", file.display(), map.summary());
+                for warning in survivability::check(&map, args.survivability_episodes, args.seed)? {
+                    eprintln!("{}: {warning}\n", file.display());
+                }
+            }
             Err(e) => {
                 eprintln!("{e}\n");
                 bad += 1;

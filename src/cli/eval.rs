@@ -16,7 +16,8 @@ pub struct EvalArgs {
     /// Map to evaluate on (file or embedded name).
     #[arg(long, default_value = "jaywalk")]
     pub map: String,
-    /// Method to evaluate.
+    /// Method to evaluate (the scripted `brake-on-pedestrian` and `never-brake` need
+    /// no agent: `--agent` is then ignored and nothing is trained).
     #[arg(long, value_enum, default_value_t = Method::Scaled)]
     pub method: Method,
     /// Episodes.
@@ -34,13 +35,16 @@ pub struct EvalArgs {
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
-    let bundle = args.agent.bundle()?;
-    crate::agent_file::check_compatible(
-        &bundle,
-        &map.name,
-        unforeseen_discretizer::Discretizer::new(&map.bins)?.n_states(),
-    )?;
-    let mut controller = args.method.controller(&bundle, &params)?;
+    let disc = unforeseen_discretizer::Discretizer::new(&map.bins)?;
+    // The scripted references need no agent: they decode the map's own observations.
+    let mut controller = match args.method.scripted_controller(&disc.factor_sizes())? {
+        Some(scripted) => scripted,
+        None => {
+            let bundle = args.agent.bundle()?;
+            crate::agent_file::check_compatible(&bundle, &map.name, disc.n_states())?;
+            args.method.controller(&bundle, &params)?
+        }
+    };
     let results = evaluate(
         &map,
         controller.as_mut(),
