@@ -108,6 +108,19 @@ pub struct Unit {
     pub train_seed: Option<u64>,
 }
 
+impl Unit {
+    /// The unit's identity, as its result line's [`ResultLine::key`] gives it.
+    pub fn key(&self, scenarios: &[Scenario]) -> UnitKey {
+        (
+            scenarios[self.scenario].map.name.clone(),
+            self.method.name().to_string(),
+            self.params.label(),
+            self.protocol,
+            self.train_seed,
+        )
+    }
+}
+
 /// All units in canonical order: scenarios, then methods, then parameter sets, then
 /// protocols (one unit for a method that does not learn across episodes), then
 /// training seeds (innermost, so one configuration's seeds are contiguous).
@@ -449,16 +462,7 @@ pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, quiet: bool) -> anyh
     let mine = cfg.shard_units()?;
     let kept: Vec<ResultLine> = if resume { read_lines(out)? } else { Vec::new() };
     let done: BTreeSet<UnitKey> = kept.iter().map(ResultLine::key).collect();
-    let key = |u: &Unit| -> UnitKey {
-        (
-            cfg.scenarios[u.scenario].map.name.clone(),
-            u.method.name().to_string(),
-            u.params.label(),
-            u.protocol,
-            u.train_seed,
-        )
-    };
-    let todo: Vec<&Unit> = mine.iter().filter(|u| !done.contains(&key(u))).collect();
+    let todo: Vec<&Unit> = mine.iter().filter(|u| !done.contains(&u.key(cfg.scenarios))).collect();
 
     // Keep only complete lines, then stream new ones as they finish.
     crate::report::write_atomic(out, kept.iter().map(to_line).collect::<String>().as_bytes())?;

@@ -265,4 +265,15 @@ fn batch_over_training_seeds_writes_one_line_per_seed_and_checks_the_mean() {
         strip_lines(&before),
         strip_lines(&std::fs::read_to_string(&out).unwrap())
     );
+
+    // Shards (each trains or loads only its seeds) concatenate into the whole file.
+    let mut parts = String::new();
+    for (i, shard) in ["1/2", "2/2"].into_iter().enumerate() {
+        let part = dir.path().join(format!("part{i}.jsonl"));
+        let mut sharded: Vec<&str> = args[..args.len() - 1].to_vec();
+        sharded.extend([part.to_str().unwrap(), "--shard", shard]);
+        ok(&unforeseen(&sharded, "2"));
+        parts.push_str(&std::fs::read_to_string(&part).unwrap());
+    }
+    assert_eq!(strip_lines(&parts), strip_lines(&before));
 }

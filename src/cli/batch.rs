@@ -7,11 +7,15 @@ use std::path::PathBuf;
 use super::table::{cell, print_grid, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use crate::agents::Agent;
-use crate::batch::{BatchConfig, Shard, SummaryRow, load_scenarios, run, summarize, summary_path, sweep, units};
+use crate::batch::{
+    BatchConfig, ResultLine, Shard, SummaryRow, Unit, UnitKey, load_scenarios, read_lines, run, summarize,
+    summary_path, sweep, units,
+};
 use crate::methods::Method;
 use crate::protocol::ProtocolChoice;
 use crate::report::write_json;
 use crate::training::{TrainConfig, train};
+use std::collections::BTreeSet;
 
 /// Arguments of `batch`.
 #[derive(Debug, Clone, Args)]
@@ -89,14 +93,24 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         if args.seeds.train_seeds.is_none() {
             return Ok(vec![single_agent(&args)?]);
         }
-        // Only the seeds this shard's units use.
+        // Only the seeds of this shard's units that are still to run.
         let all = units(scenarios.len(), &methods, &params, &protocols, &axis)?;
         let range = args.shard.map_or(0..all.len(), |s| s.range(all.len()));
+        let kept = if args.resume {
+            read_lines(&args.out)?
+        } else {
+            Vec::new()
+        };
+        let done: BTreeSet<UnitKey> = kept.iter().map(ResultLine::key).collect();
+        let todo: Vec<&Unit> = all[range]
+            .iter()
+            .filter(|u| !done.contains(&u.key(&scenarios)))
+            .collect();
         let used: Vec<u64> = axis
             .iter()
             .flatten()
             .copied()
-            .filter(|&s| all[range.clone()].iter().any(|u| u.train_seed == Some(s)))
+            .filter(|&s| todo.iter().any(|u| u.train_seed == Some(s)))
             .collect();
         args.seeds.train(&used, "intersection", args.train_episodes, args.quiet)
     })?;

@@ -424,13 +424,18 @@ fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
         .zip(&labels)
         .map(|(t, labels)| {
             let n = t.methods.first().map_or(0, |m| m.train_seeds.len());
-            let whiskers = if n > 1 {
-                format!(", whiskers: 95% interval over {n} agents")
+            let ours = if n > 1 {
+                format!("blue: ours, mean over {n} agents with 95% interval whiskers")
             } else {
-                String::new()
+                "blue: ours".into()
+            };
+            let paper = if t.protocol == Protocol::ZeroShot {
+                "; grey: the paper's (§VI)"
+            } else {
+                ""
             };
             BarRow {
-                title: format!("{} protocol{whiskers}", t.protocol),
+                title: format!("{} protocol. {ours}{paper}", t.protocol),
                 panels: panels
                     .iter()
                     .map(|&(title, metric, paper)| BarPanel {
