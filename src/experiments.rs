@@ -1,6 +1,8 @@
 //! The experiments of §VI: evaluation of a method on a map, the comparison table
 //! (Fig. 8), one traced episode (Figs. 6-7) and test-time learning curves (Fig. 9).
 
+use indicatif::ProgressBar;
+use rayon::prelude::*;
 use serde::Serialize;
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::ScaledParams;
@@ -13,6 +15,7 @@ use crate::agent_file::check_compatible;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
 use crate::progress;
+use crate::protocol::Protocol;
 use crate::runner::{EpisodeResult, EpisodeSeeds, Tick, run_episode};
 use crate::seeds::episode_seed;
 
@@ -27,7 +30,8 @@ pub fn eval_seeds(seed: u64, map: &Map, method: Method, episode: u64) -> Episode
 }
 
 /// Runs `episodes` episodes of `controller` on `map` in order (test-time learning
-/// carries over from one episode to the next).
+/// carries over from one episode to the next: the continual protocol on a controller
+/// the caller built).
 pub fn evaluate(
     map: &Map,
     controller: &mut dyn Controller,
@@ -48,11 +52,69 @@ pub fn evaluate(
     Ok(results)
 }
 
-/// One row of the comparison table (the JSON schema of `compare.json`).
+/// Runs `episodes` evaluation episodes of `method` on `map` under `protocol`, advancing
+/// `bar` by one per episode. Zero-shot: a fresh controller per episode, episodes in
+/// parallel (rayon); continual: one controller, episodes in order. A method that does
+/// not learn across episodes always runs zero-shot (identical results, in parallel).
+/// Seeds derive from (seed, map, method, episode), so results do not depend on the
+/// number of threads.
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_under(
+    protocol: Protocol,
+    map: &Map,
+    bundle: &AgentBundle,
+    params: &ScaledParams,
+    method: Method,
+    episodes: u64,
+    seed: u64,
+    bar: &ProgressBar,
+) -> anyhow::Result<Vec<EpisodeResult>> {
+    check_compatible(bundle, &map.name, Discretizer::new(&map.bins)?.n_states())?;
+    let make = || method.controller(bundle, params);
+    evaluate_with(protocol, map, method, params, &make, episodes, seed, bar)
+}
+
+/// Makes a fresh controller of the method being evaluated.
+pub type MakeController<'a> = dyn Fn() -> anyhow::Result<Box<dyn Controller>> + Sync + 'a;
+
+/// [`evaluate_under`] with the controllers made by `make` (e.g. a scripted reference,
+/// which needs no trained agent).
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_with(
+    protocol: Protocol,
+    map: &Map,
+    method: Method,
+    params: &ScaledParams,
+    make: &MakeController<'_>,
+    episodes: u64,
+    seed: u64,
+    bar: &ProgressBar,
+) -> anyhow::Result<Vec<EpisodeResult>> {
+    let disc = Discretizer::new(&map.bins)?;
+    let run = |controller: &mut dyn Controller, ep: u64| {
+        let result = run_episode(map, &disc, controller, eval_seeds(seed, map, method, ep), false).0;
+        bar.inc(1);
+        result
+    };
+    match protocol.effective(method, params) {
+        Protocol::ZeroShot => (0..episodes)
+            .into_par_iter()
+            .map(|ep| Ok(run(make()?.as_mut(), ep)))
+            .collect(),
+        Protocol::Continual => {
+            let mut controller = make()?;
+            Ok((0..episodes).map(|ep| run(controller.as_mut(), ep)).collect())
+        }
+    }
+}
+
+/// One method's figures with one trained agent (a per-seed row of `compare.json`).
 #[derive(Debug, Clone, Serialize)]
 pub struct MethodRow {
     /// Method name.
     pub method: String,
+    /// Training seed of the agent (None for an agent file that does not record it).
+    pub train_seed: Option<u64>,
     /// Mean return on the training map after training.
     pub train_reward: f64,
     /// Mean return on the test (unforeseen) map.
@@ -72,27 +134,11 @@ pub struct MethodRow {
     pub test: Aggregate,
 }
 
-/// Evaluates `method` on the training and the test map and fills a table row.
-#[allow(clippy::too_many_arguments)]
-pub fn compare_method(
-    bundle: &AgentBundle,
-    params: &ScaledParams,
-    method: Method,
-    train_map: &Map,
-    test_map: &Map,
-    episodes: u64,
-    seed: u64,
-    quiet: bool,
-) -> anyhow::Result<MethodRow> {
-    for map in [train_map, test_map] {
-        check_compatible(bundle, &map.name, Discretizer::new(&map.bins)?.n_states())?;
-    }
-    let mut on_train = method.controller(bundle, params)?;
-    let train = Aggregate::of(&evaluate(train_map, on_train.as_mut(), method, episodes, seed, quiet)?);
-    let mut on_test = method.controller(bundle, params)?;
-    let test = Aggregate::of(&evaluate(test_map, on_test.as_mut(), method, episodes, seed, quiet)?);
-    Ok(MethodRow {
+/// Fills a row from `method`'s aggregates on the training and the test map.
+pub fn method_row(method: Method, train_seed: Option<u64>, train: Aggregate, test: Aggregate) -> MethodRow {
+    MethodRow {
         method: method.name().to_string(),
+        train_seed,
         train_reward: train.mean_reward,
         test_reward: test.mean_reward,
         success_rate: test.success_rate,
@@ -101,7 +147,7 @@ pub fn compare_method(
         reasoning_us_per_tick: test.us_per_tick,
         train,
         test,
-    })
+    }
 }
 
 /// Runs one recorded episode of `method` (the first evaluation episode of `seed`) and

@@ -18,12 +18,17 @@
 //! * [`survivability`] checks with those references that a scenario is survivable and
 //!   dangerous;
 //! * [`metrics`] aggregates episodes into the paper's table;
-//! * [`experiments`] runs `compare`, `trace` and `learn`;
+//! * [`protocol`] names the zero-shot and continual evaluation protocols;
+//! * [`experiments`] runs evaluations under a protocol, `trace` and `learn`;
+//! * [`agents`] trains one agent per training seed, in parallel, with an on-disk cache;
+//! * [`study`] runs `compare` over agents and protocols and summarizes over seeds with
+//!   [`stats`] (mean, 95% Student-t interval, range, worst seed);
 //! * [`report`] writes JSON/CSV atomically and [`plots`] draws SVG figures;
 //! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
 //! * [`cli`] is the command line.
 
 pub mod agent_file;
+pub mod agents;
 pub mod batch;
 pub mod cli;
 pub mod experiments;
@@ -32,10 +37,13 @@ pub mod methods;
 pub mod metrics;
 pub mod plots;
 pub mod progress;
+pub mod protocol;
 pub mod reference;
 pub mod report;
 pub mod rewards;
 pub mod runner;
 pub mod seeds;
+pub mod stats;
+pub mod study;
 pub mod survivability;
 pub mod training;

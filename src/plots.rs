@@ -50,71 +50,110 @@ pub struct BarPanel<'a> {
     pub title: &'a str,
     /// Group labels (methods).
     pub labels: &'a [String],
-    /// Our measured values.
+    /// Our measured values (means over agents).
     pub ours: Vec<f64>,
+    /// A 95% interval around each of our values, drawn as a whisker (None: no whisker).
+    pub interval: Vec<Option<(f64, f64)>>,
     /// The paper's values, where it reports one.
     pub paper: Vec<Option<f64>>,
 }
 
-/// Grouped bar chart, one panel per metric, ours beside the paper's (Fig. 8).
-pub fn grouped_bars(path: &Path, panels: &[BarPanel<'_>]) -> Result<()> {
-    let width = 330 * panels.len() as u32;
-    write_svg(path, (width.max(400), 380), |root| {
-        let areas = root.split_evenly((1, panels.len()));
-        for (area, panel) in areas.iter().zip(panels) {
-            let values = panel.ours.iter().copied().chain(panel.paper.iter().flatten().copied());
-            let (lo, hi) = values.fold((0.0f64, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
-            let pad = ((hi - lo) * 0.1).max(1e-3);
-            let n = panel.labels.len();
-            let mut chart = ChartBuilder::on(area)
-                .caption(panel.title, ("sans-serif", 16))
-                .margin(12)
-                .x_label_area_size(30)
-                .y_label_area_size(45)
-                .build_cartesian_2d(
-                    -0.5f64..(n as f64 - 0.5),
-                    (lo - if lo < 0.0 { pad } else { 0.0 })..(hi + pad),
-                )
-                .map_err(plot_err)?;
-            let labels = panel.labels.to_vec();
-            chart
-                .configure_mesh()
-                .disable_x_mesh()
-                .x_labels(n)
-                .x_label_formatter(&move |x| {
-                    let i = x.round();
-                    if (x - i).abs() < 1e-6 && i >= 0.0 {
-                        labels.get(i as usize).cloned().unwrap_or_default()
-                    } else {
-                        String::new()
-                    }
-                })
-                .draw()
-                .map_err(plot_err)?;
-            let ours = panel.ours.iter().enumerate().map(|(i, &v)| {
-                let x = i as f64;
-                Rectangle::new([(x - 0.38, 0.0), (x, v)], BLUE.mix(0.75).filled())
-            });
-            chart
-                .draw_series(ours)
-                .map_err(plot_err)?
-                .label("ours")
-                .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLUE.mix(0.75).filled()));
-            let paper = panel.paper.iter().enumerate().filter_map(|(i, v)| {
-                v.map(|v| {
-                    let x = i as f64;
-                    Rectangle::new([(x, 0.0), (x + 0.38, v)], BLACK.mix(0.3).filled())
-                })
-            });
-            chart
-                .draw_series(paper)
-                .map_err(plot_err)?
-                .label("paper")
-                .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], BLACK.mix(0.3).filled()));
-            draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
+/// A titled row of panels (e.g. one protocol).
+pub struct BarRow<'a> {
+    /// Row title, drawn above its panels.
+    pub title: String,
+    /// The panels, left to right.
+    pub panels: Vec<BarPanel<'a>>,
+}
+
+/// Grouped bar charts (Fig. 8): one row per entry of `rows`, one panel per metric, ours
+/// (blue, with interval whiskers) beside the paper's (grey). The key goes in the row
+/// titles, not in legends that would cover the bars.
+pub fn grouped_bars(path: &Path, rows: &[BarRow<'_>]) -> Result<()> {
+    let columns = rows.iter().map(|r| r.panels.len()).max().unwrap_or(1).max(1);
+    let width = 330 * columns as u32;
+    let height = 410 * rows.len().max(1) as u32;
+    write_svg(path, (width.max(400), height), |root| {
+        let areas = root.split_evenly((rows.len().max(1), 1));
+        for (area, row) in areas.iter().zip(rows) {
+            let titled = area.titled(&row.title, ("sans-serif", 18)).map_err(plot_err)?;
+            let cells = titled.split_evenly((1, columns));
+            for (cell, panel) in cells.iter().zip(&row.panels) {
+                bar_panel(cell, panel)?;
+            }
         }
         Ok(())
     })
+}
+
+/// Draws one panel of [`grouped_bars`].
+fn bar_panel(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panel: &BarPanel<'_>) -> Result<()> {
+    let whisker_ends = panel.interval.iter().flatten().flat_map(|&(lo, hi)| [lo, hi]);
+    let values = panel
+        .ours
+        .iter()
+        .copied()
+        .chain(panel.paper.iter().flatten().copied())
+        .chain(whisker_ends)
+        .filter(|v| v.is_finite());
+    let (lo, hi) = values.fold((0.0f64, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let pad = ((hi - lo) * 0.1).max(1e-3);
+    let n = panel.labels.len();
+    let mut chart = ChartBuilder::on(area)
+        .caption(panel.title, ("sans-serif", 16))
+        .margin(12)
+        .x_label_area_size(30)
+        .y_label_area_size(45)
+        .build_cartesian_2d(
+            -0.5f64..(n as f64 - 0.5),
+            (lo - if lo < 0.0 { pad } else { 0.0 })..(hi + pad),
+        )
+        .map_err(plot_err)?;
+    let labels = panel.labels.to_vec();
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(n)
+        .x_label_formatter(&move |x| {
+            let i = x.round();
+            if (x - i).abs() < 1e-6 && i >= 0.0 {
+                labels.get(i as usize).cloned().unwrap_or_default()
+            } else {
+                String::new()
+            }
+        })
+        .draw()
+        .map_err(plot_err)?;
+    let ours = panel.ours.iter().enumerate().map(|(i, &v)| {
+        let x = i as f64;
+        Rectangle::new([(x - 0.38, 0.0), (x, v)], BLUE.mix(0.75).filled())
+    });
+    chart.draw_series(ours).map_err(plot_err)?;
+    let whiskers = panel.interval.iter().enumerate().filter_map(|(i, w)| {
+        w.map(|(lo, hi)| {
+            let x = i as f64 - 0.19;
+            PathElement::new(
+                vec![
+                    (x - 0.08, lo),
+                    (x + 0.08, lo),
+                    (x, lo),
+                    (x, hi),
+                    (x - 0.08, hi),
+                    (x + 0.08, hi),
+                ],
+                BLACK.stroke_width(2),
+            )
+        })
+    });
+    chart.draw_series(whiskers).map_err(plot_err)?;
+    let paper = panel.paper.iter().enumerate().filter_map(|(i, v)| {
+        v.map(|v| {
+            let x = i as f64;
+            Rectangle::new([(x, 0.0), (x + 0.38, v)], BLACK.mix(0.3).filled())
+        })
+    });
+    chart.draw_series(paper).map_err(plot_err)?;
+    Ok(())
 }
 
 /// One line of a line chart.

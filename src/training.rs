@@ -2,6 +2,7 @@
 //! learn from the same episodes on the training map, driven by Q-learning's
 //! epsilon-greedy exploration.
 
+use indicatif::ProgressBar;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
@@ -65,6 +66,14 @@ pub struct TrainLog {
 /// Trains all learners on `map` and bundles them (with the preferences set from the
 /// map's rewards) for evaluation or for saving as an agent file.
 pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, TrainLog)> {
+    let bar = progress::bar(cfg.episodes, "training", cfg.quiet);
+    let trained = train_with_bar(map, cfg, &bar);
+    bar.finish_and_clear();
+    trained
+}
+
+/// [`train`], advancing `bar` by one per episode (several agents can share one bar).
+pub fn train_with_bar(map: &Map, cfg: &TrainConfig, bar: &ProgressBar) -> anyhow::Result<(AgentBundle, TrainLog)> {
     let disc = Discretizer::new(&map.bins)?;
     let n = disc.n_states();
     let n_actions = Action::ALL.len();
@@ -79,7 +88,6 @@ pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, Train
     };
     let mut bayes_factored = BayesRl::new(n, n_actions, factored)?;
     let mut log = TrainLog::default();
-    let bar = progress::bar(cfg.episodes, "training", cfg.quiet);
     let stream = format!("{}/train", map.name);
     for episode in 0..cfg.episodes {
         let seed = episode_seed(cfg.seed, &stream, episode);
@@ -108,7 +116,6 @@ pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, Train
         log.returns.push(ret);
         bar.inc(1);
     }
-    bar.finish_and_clear();
     model.materialize();
     model.set_preferences(&state_rewards(map, &disc), cfg.tau_c)?;
     model.set_terminal_states(&terminal_states(map, &disc))?;

@@ -5,20 +5,31 @@
 mod common;
 
 use std::path::Path;
+use std::sync::OnceLock;
+use unforeseen::agents::Agent;
 use unforeseen::batch::{BatchConfig, ParamSet, ResultLine, Scenario, Shard, load_scenarios, read_lines, run, sweep};
 use unforeseen::methods::Method;
+use unforeseen::protocol::Protocol;
 
 fn scenarios() -> Vec<Scenario> {
     let names = ["jaywalk".to_string(), "intersection".to_string()];
     load_scenarios(&names.iter().map(Into::into).collect::<Vec<_>>()).unwrap()
 }
 
+/// The shared test agent (training seed 7).
+fn agents() -> &'static [Agent] {
+    static AGENTS: OnceLock<Vec<Agent>> = OnceLock::new();
+    AGENTS.get_or_init(|| vec![Agent::from_bundle(common::bundle().clone())])
+}
+
 fn config<'a>(scenarios: &'a [Scenario], params: &'a [ParamSet], jobs: usize, shard: Option<Shard>) -> BatchConfig<'a> {
     BatchConfig {
-        bundle: common::bundle(),
+        agents: agents(),
+        train_seeds: &[Some(7)],
         scenarios,
         methods: &Method::PAPER,
         params,
+        protocols: &Protocol::ALL,
         episodes: 3,
         seed: 9,
         jobs,
@@ -50,7 +61,13 @@ fn jobs_do_not_change_results_and_shards_concatenate_to_the_whole() {
     let two = dir.path().join("two.jsonl");
     let a = run(&config(&scenarios, &params, 1, None), &one, false, true).unwrap();
     let b = run(&config(&scenarios, &params, 2, None), &two, false, true).unwrap();
-    assert_eq!(a.len(), 2 * 3 * 2);
+    // Per scenario and parameter set: q-learning once (covers both protocols), bayes-rl
+    // and scaled once per protocol.
+    assert_eq!(a.len(), 2 * 5 * 2);
+    assert!(
+        a.iter()
+            .all(|l| l.covers.contains(&l.protocol) && l.train_seed == Some(7))
+    );
     assert_eq!(without_timing(&a), without_timing(&b));
     assert_eq!(file_without_timing(&one), file_without_timing(&two));
 
@@ -99,7 +116,7 @@ fn expectations_pass_and_fail_as_declared() {
     let mut scenarios = scenarios();
     scenarios.truncate(1); // jaywalk
     let map = &mut scenarios[0].map;
-    use unforeseen_sim::{Expectation, MethodName};
+    use unforeseen_sim::{Expectation, MethodName, ProtocolName};
     let none = Expectation {
         method: MethodName::QLearning,
         min_success: None,
@@ -108,6 +125,7 @@ fn expectations_pass_and_fail_as_declared() {
         max_reward: None,
         max_collision: None,
         max_inference_rate: None,
+        protocol: None,
     };
     map.expect = vec![
         Expectation {
@@ -122,6 +140,12 @@ fn expectations_pass_and_fail_as_declared() {
         Expectation {
             method: MethodName::BayesRl,
             max_inference_rate: Some(1.0),
+            ..none.clone()
+        },
+        Expectation {
+            method: MethodName::BayesRl,
+            protocol: Some(ProtocolName::Continual),
+            min_success: Some(0.0),
             ..none.clone()
         },
     ];
@@ -143,9 +167,19 @@ fn expectations_pass_and_fail_as_declared() {
             && q.checks[2].bound == "min"
             && q.checks[2].limit == 1.0
     );
-    let b = lines.iter().find(|l| l.method == "bayes-rl").unwrap();
-    assert_eq!(b.checks.len(), 1);
+    assert_eq!(q.covers, Protocol::ALL, "q-learning runs once for both protocols");
+    let bayes = |p: Protocol| {
+        lines
+            .iter()
+            .find(|l| l.method == "bayes-rl" && l.protocol == p)
+            .unwrap()
+    };
+    let b = bayes(Protocol::ZeroShot);
+    assert_eq!(b.checks.len(), 1, "the continual-only expectation skips zero-shot");
     assert!(b.checks[0].pass);
+    let b = bayes(Protocol::Continual);
+    assert_eq!(b.checks.len(), 2);
+    assert!(b.checks[1].pass && b.checks[1].figure == "success_rate");
     assert!(lines.iter().find(|l| l.method == "scaled").unwrap().checks.is_empty());
 }
 

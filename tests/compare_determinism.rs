@@ -43,22 +43,30 @@ fn compare_json_is_identical_across_runs_with_the_same_seed() {
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     let (ja, jb) = (compare_json(a.path()), compare_json(b.path()));
     assert_eq!(ja, jb);
-    let methods: Vec<_> = ja["methods"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|m| m["method"].as_str().unwrap().to_string())
-        .collect();
-    assert_eq!(methods, ["q-learning", "bayes-rl", "scaled"]);
-    for m in ja["methods"].as_array().unwrap() {
-        for k in [
-            "train_reward",
-            "test_reward",
-            "success_rate",
-            "collision_rate",
-            "inference_rate",
-        ] {
-            assert!(m[k].is_number(), "{k} missing in {m}");
+    let tables = ja["tables"].as_array().unwrap();
+    let protocols: Vec<_> = tables.iter().map(|t| t["protocol"].as_str().unwrap()).collect();
+    assert_eq!(protocols, ["zero-shot", "continual"]);
+    for t in tables {
+        let methods: Vec<_> = t["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["method"].as_str().unwrap().to_string())
+            .collect();
+        assert_eq!(methods, ["q-learning", "bayes-rl", "scaled"]);
+        for m in t["methods"].as_array().unwrap() {
+            assert_eq!(m["protocol"], t["protocol"]);
+            assert_eq!(m["train_seeds"], serde_json::json!([3]));
+            for k in [
+                "train_reward",
+                "test_reward",
+                "success_rate",
+                "collision_rate",
+                "inference_rate",
+            ] {
+                assert!(m[k]["mean"].is_number(), "{k} missing in {m}");
+                assert!(m[k]["ci95_low"].is_null(), "one agent has no interval: {m}");
+            }
         }
     }
 }

@@ -329,6 +329,20 @@ pub struct Expectation {
     /// Highest acceptable share of ticks that ran planning, in [0, 1].
     #[serde(default)]
     pub max_inference_rate: Option<f64>,
+    /// The evaluation protocol the bounds apply to; absent: every protocol the batch
+    /// ran the method under.
+    #[serde(default)]
+    pub protocol: Option<ProtocolName>,
+}
+
+/// Evaluation protocols (names as written in maps): `ZeroShot`, every test episode starts
+/// from the trained state; `Continual`, learning carries over between test episodes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ProtocolName {
+    /// Every test episode starts from the trained state.
+    ZeroShot,
+    /// What a method learns carries over from one test episode to the next.
+    Continual,
 }
 
 /// A complete scenario. `Map::default()` is the training intersection without
@@ -570,7 +584,8 @@ impl Map {
                     parts.push(format!("{label} {v}"));
                 }
             }
-            let _ = writeln!(s, "expect {:?}: {}", x.method, parts.join(", "));
+            let protocol = x.protocol.map(|p| format!(" ({p:?})")).unwrap_or_default();
+            let _ = writeln!(s, "expect {:?}{protocol}: {}", x.method, parts.join(", "));
         }
         s
     }

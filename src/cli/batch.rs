@@ -1,12 +1,22 @@
-//! `unforeseen batch`: run scenario suites headless, with expectations, sweeps and shards.
+//! `unforeseen batch`: run scenario suites headless, with expectations, sweeps, shards,
+//! both protocols and training-seed studies.
 
 use clap::Args;
 use std::path::PathBuf;
 
-use crate::batch::{BatchConfig, ResultLine, Scenario, Shard, load_scenarios, run, sweep};
+use super::table::{cell, print_grid, seed_text};
+use super::train_seeds::TrainSeedArgs;
+use crate::agents::Agent;
+use crate::batch::{
+    BatchConfig, ResultLine, Scenario, Shard, SummaryRow, Unit, UnitKey, load_scenarios, read_lines, run, summarize,
+    summary_path, sweep, units,
+};
 use crate::methods::Method;
+use crate::protocol::ProtocolChoice;
+use crate::report::write_json;
 use crate::survivability::{Witness, warnings};
 use crate::training::{TrainConfig, train};
+use std::collections::BTreeSet;
 
 /// Arguments of `batch`.
 #[derive(Debug, Clone, Args)]
@@ -14,10 +24,10 @@ pub struct BatchArgs {
     /// Map files or folders of maps (every *.ron); default: the embedded maps.
     #[arg(value_name = "MAP|DIR")]
     pub maps: Vec<PathBuf>,
-    /// Episodes per (scenario, method, parameter set).
+    /// Episodes per (scenario, method, parameter set, protocol, training seed).
     #[arg(long, default_value_t = 100)]
     pub episodes: u64,
-    /// Run seed.
+    /// Evaluation seed (and, without --agent or --train-seeds, the training seed).
     #[arg(long, default_value_t = 7)]
     pub seed: u64,
     /// Methods to run (repeatable); default: q-learning, bayes-rl, scaled and the
@@ -25,10 +35,16 @@ pub struct BatchArgs {
     /// whether it is survivable and dangerous).
     #[arg(long = "method", value_enum)]
     pub methods: Vec<Method>,
+    /// Evaluation protocol: zero-shot (every episode starts from the trained agent),
+    /// continual (learning carries over between episodes, in order) or both. A method
+    /// that does not learn across episodes runs once; its line covers both.
+    #[arg(long, value_enum, default_value_t = ProtocolChoice::Both)]
+    pub protocol: ProtocolChoice,
     /// Worker threads (results do not depend on it).
     #[arg(long, default_value_t = default_jobs())]
     pub jobs: usize,
-    /// Results file (JSON Lines), one line per unit as soon as it finishes.
+    /// Results file (JSON Lines), one line per unit as soon as it finishes; the summary
+    /// over training seeds goes beside it (`results.summary.json`).
     #[arg(long, value_name = "FILE", default_value = "results.jsonl")]
     pub out: PathBuf,
     /// Keep the complete lines already in --out and run only the missing units.
@@ -46,6 +62,9 @@ pub struct BatchArgs {
     /// Agent file from `unforeseen train` (default: train on the embedded intersection map).
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
+    /// Training seeds and the agent cache.
+    #[command(flatten)]
+    pub seeds: TrainSeedArgs,
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
@@ -55,7 +74,7 @@ fn default_jobs() -> usize {
     std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
 }
 
-/// Runs `batch`; fails (exit 1) when any expectation fails.
+/// Runs `batch`; fails (exit 1) when any expectation fails on the mean over seeds.
 pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let scenarios = load_scenarios(&args.maps)?;
     let methods = if args.methods.is_empty() {
@@ -65,62 +84,81 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     };
     let params = sweep(&args.sweep)?;
     for p in &params {
-        let sets: Vec<String> = p.0.iter().map(|(k, v)| format!("{k}={v}")).collect();
-        super::params::apply(Default::default(), &sets)?;
+        p.scaled_params()?;
     }
-    let bundle = match &args.agent {
-        Some(path) => crate::agent_file::load(path)?,
-        None => {
-            let map = crate::maps::load("intersection")?;
-            let cfg = TrainConfig {
-                quiet: args.quiet,
-                ..TrainConfig::new(args.train_episodes, args.seed)
-            };
-            train(&map, &cfg)?.0
+    let protocols = args.protocol.protocols();
+    let axis: Vec<Option<u64>> = match &args.seeds.train_seeds {
+        Some(seeds) => seeds.0.iter().map(|&s| Some(s)).collect(),
+        None => Vec::new(), // the single agent's seed, known once it is loaded
+    };
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs.max(1)).build()?;
+    let agents = pool.install(|| -> anyhow::Result<Vec<Agent>> {
+        if args.seeds.train_seeds.is_none() {
+            return Ok(vec![single_agent(&args)?]);
         }
+        // Only the seeds of this shard's units that are still to run.
+        let all = units(scenarios.len(), &methods, &params, &protocols, &axis)?;
+        let range = args.shard.map_or(0..all.len(), |s| s.range(all.len()));
+        let kept = if args.resume {
+            read_lines(&args.out)?
+        } else {
+            Vec::new()
+        };
+        let done: BTreeSet<UnitKey> = kept.iter().map(ResultLine::key).collect();
+        let todo: Vec<&Unit> = all[range]
+            .iter()
+            .filter(|u| !done.contains(&u.key(&scenarios)))
+            .collect();
+        let used: Vec<u64> = axis
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&s| todo.iter().any(|u| u.train_seed == Some(s)))
+            .collect();
+        args.seeds.train(&used, "intersection", args.train_episodes, args.quiet)
+    })?;
+    let axis = if axis.is_empty() {
+        vec![agents[0].train_seed]
+    } else {
+        axis
     };
     let cfg = BatchConfig {
-        bundle: &bundle,
+        agents: &agents,
+        train_seeds: &axis,
         scenarios: &scenarios,
         methods: &methods,
         params: &params,
+        protocols: &protocols,
         episodes: args.episodes,
         seed: args.seed,
         jobs: args.jobs,
         shard: args.shard,
     };
     let lines = run(&cfg, &args.out, args.resume, args.quiet)?;
-    println!(
-        "{:<22} {:<20} {:<24} {:>9} {:>10} {:>10} {:>10}",
-        "scenario", "method", "parameters", "success", "collision", "reward", "inference"
-    );
-    let mut failures = Vec::new();
-    for l in &lines {
-        println!(
-            "{:<22} {:<20} {:<24} {:>8.1}% {:>9.1}% {:>10.2} {:>9.1}%",
-            l.scenario,
-            l.method,
-            l.param_set,
-            100.0 * l.success_rate,
-            100.0 * l.collision_rate,
-            l.mean_reward,
-            100.0 * l.inference_rate
-        );
-        for c in l.checks.iter().filter(|c| !c.pass) {
-            failures.push(format!(
-                "{} ({}): {} [{}] {} = {:.4} violates {} {}",
-                l.scenario, l.source, l.method, l.param_set, c.figure, c.value, c.bound, c.limit
-            ));
-        }
-    }
+    let rows = summarize(&lines);
+    print_summary(&rows);
     for warning in survivability_warnings(&scenarios, &lines) {
         eprintln!("{warning}");
     }
-    let checked: usize = lines.iter().map(|l| l.checks.len()).sum();
+    let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
+    let failures = failures(&rows);
+    let summary = summary_path(&args.out);
+    write_json(
+        &summary,
+        &serde_json::json!({
+            "schema": 1,
+            "results": args.out.display().to_string(),
+            "shard": args.shard.map(|s| format!("{}/{}", s.index, s.count)),
+            "checked": checked,
+            "failed": failures.len(),
+            "rows": rows,
+        }),
+    )?;
     println!(
-        "wrote {} ({} lines); {} expectation(s) checked, {} failed",
+        "wrote {} ({} lines) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
         args.out.display(),
         lines.len(),
+        summary.display(),
         checked,
         failures.len()
     );
@@ -133,9 +171,99 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The one agent of a run without --train-seeds: --agent, or trained from --seed.
+fn single_agent(args: &BatchArgs) -> anyhow::Result<Agent> {
+    let bundle = match &args.agent {
+        Some(path) => crate::agent_file::load(path)?,
+        None => {
+            let map = crate::maps::load("intersection")?;
+            let cfg = TrainConfig {
+                quiet: args.quiet,
+                ..TrainConfig::new(args.train_episodes, args.seed)
+            };
+            train(&map, &cfg)?.0
+        }
+    };
+    Ok(Agent::from_bundle(bundle))
+}
+
+/// Prints one row per (scenario, method, parameters, protocol) over its training seeds.
+fn print_summary(rows: &[SummaryRow]) {
+    let many = rows.iter().any(|r| r.train_seeds.len() > 1);
+    let mut grid = vec![
+        [
+            "scenario",
+            "method",
+            "parameters",
+            "protocol",
+            "seeds",
+            "success",
+            "collision",
+            "reward",
+            "inference",
+            "worst seed",
+        ]
+        .map(String::from)
+        .to_vec(),
+    ];
+    for r in rows {
+        let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
+        let w = &r.worst_seed;
+        grid.push(vec![
+            r.scenario.clone(),
+            r.method.clone(),
+            r.param_set.clone(),
+            protocols.join("+"),
+            r.train_seeds.len().to_string(),
+            cell(&r.success_rate, 1, true),
+            cell(&r.collision_rate, 1, true),
+            cell(&r.mean_reward, 2, false),
+            cell(&r.inference_rate, 1, true),
+            format!("{} ({:.0}%)", seed_text(w.train_seed), 100.0 * w.success_rate),
+        ]);
+    }
+    if many {
+        println!("each figure: mean ± half-width of the 95% interval over training seeds (Student t)");
+    }
+    print_grid(&grid);
+}
+
+/// One message per expectation that fails on the mean, naming the worst seed.
+fn failures(rows: &[SummaryRow]) -> Vec<String> {
+    let mut out = Vec::new();
+    for r in rows {
+        for c in r.checks.iter().filter(|c| !c.pass) {
+            let n = r.train_seeds.len();
+            let over = if n == 1 {
+                format!("training seed {}", seed_text(r.train_seeds[0]))
+            } else {
+                format!(
+                    "mean over {n} training seeds; worst seed {}: {:.4}",
+                    seed_text(c.worst_seed),
+                    c.worst_value
+                )
+            };
+            let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
+            out.push(format!(
+                "{} ({}): {} [{}] {} {} = {:.4} violates {} {} ({over})",
+                r.scenario,
+                r.source,
+                r.method,
+                r.param_set,
+                protocols.join("+"),
+                c.figure,
+                c.mean,
+                c.bound,
+                c.limit
+            ));
+        }
+    }
+    out
+}
+
 /// The survivability warnings of `check-map`, from the brake-on-pedestrian and
-/// never-brake units that ran (scripted methods ignore parameter sets, so the first
-/// line of each is taken), for scenarios with pedestrian rules.
+/// never-brake units that ran (scripted methods ignore parameter sets, protocols and
+/// training seeds, so the first line of each is taken), for scenarios with pedestrian rules.
 fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<String> {
     let witness = |scenario: &str, method: Method| {
         lines

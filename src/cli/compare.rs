@@ -1,14 +1,20 @@
-//! `unforeseen compare`: the paper's table (§VI, Fig. 8) beside the paper's values.
+//! `unforeseen compare`: the paper's table (§VI, Fig. 8) beside the paper's values, one
+//! table per protocol (zero-shot first, then continual), over one agent or over several
+//! independently trained agents (`--train-seeds`).
 
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use super::table::{cell, print_grid, range_cell, seed_text};
+use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, out_dir};
-use crate::experiments::{MethodRow, compare_method};
+use crate::agents::Agent;
 use crate::maps;
-use crate::methods::Method;
-use crate::plots::{BarPanel, grouped_bars};
+use crate::methods::{Method, PaperFigures};
+use crate::plots::{BarPanel, BarRow, grouped_bars};
+use crate::protocol::{Protocol, ProtocolChoice};
 use crate::report::{Csv, num, write_json};
+use crate::study::{METRICS, MethodSummary, ProtocolTable, StudySetup, run_study};
 
 /// Training episodes by default (the paper's 6000).
 pub const DEFAULT_TRAIN_EPISODES: u64 = 6000;
@@ -25,15 +31,23 @@ pub struct CompareArgs {
     /// Training episodes when no --agent is given.
     #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES)]
     pub train_episodes: u64,
-    /// Evaluation episodes per method and map.
+    /// Evaluation episodes per method, map and agent.
     #[arg(long, default_value_t = 100)]
     pub episodes: u64,
     /// Also run the ablations (bayes-rl-factored, scaled-always, scaled-no-learning).
     #[arg(long)]
     pub ablations: bool,
-    /// Output folder for compare.json, compare.csv and compare.svg.
+    /// Evaluation protocol: zero-shot (every test episode starts from the trained agent,
+    /// the paper's table), continual (learning carries over between test episodes, in
+    /// order) or both (zero-shot table first).
+    #[arg(long, value_enum, default_value_t = ProtocolChoice::Both)]
+    pub protocol: ProtocolChoice,
+    /// Output folder for compare.json, compare.csv, compare_seeds.csv and compare.svg.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Training seeds and the agent cache.
+    #[command(flatten)]
+    pub seeds: TrainSeedArgs,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -47,7 +61,13 @@ impl Default for CompareArgs {
             train_episodes: DEFAULT_TRAIN_EPISODES,
             episodes: 100,
             ablations: false,
+            protocol: ProtocolChoice::Both,
             out: None,
+            seeds: TrainSeedArgs {
+                train_seeds: None,
+                cache: crate::agents::DEFAULT_CACHE.into(),
+                no_cache: false,
+            },
             agent: AgentArgs {
                 agent: None,
                 set: Vec::new(),
@@ -58,24 +78,35 @@ impl Default for CompareArgs {
     }
 }
 
-/// The whole `compare.json`.
+/// The whole `compare.json` (schema 2: one table per protocol, each row summarized over
+/// training seeds with its per-seed rows kept).
 #[derive(Debug, serde::Serialize)]
 pub struct CompareReport {
-    /// One row per method (the paper's three first, then any ablations).
-    pub methods: Vec<MethodRow>,
-    /// The paper's values for the same columns (§VI).
+    /// Schema version of this file.
+    pub schema: u32,
+    /// The protocols, in table order.
+    pub protocols: Vec<Protocol>,
+    /// One table per protocol.
+    pub tables: Vec<ProtocolTable>,
+    /// The paper's values for the same columns (§VI, zero-shot).
     pub paper: Vec<serde_json::Value>,
-    /// Scaled's inference rate divided by Bayesian RL's (paper: 0.633).
-    pub scaled_inference_relative_to_bayes_rl: Option<f64>,
     /// Training map name.
     pub train_map: String,
     /// Test map name.
     pub test_map: String,
-    /// Run seed.
+    /// The reward settings of both maps (`train_map`, `test_map`).
+    pub reward: serde_json::Value,
+    /// Evaluation seed (episode seeds derive from it, the same for every agent).
     pub seed: u64,
-    /// Training episodes (from the agent file's metadata when --agent was given).
-    pub train_episodes: String,
-    /// Evaluation episodes per method and map.
+    /// Training seeds of the agents (null for an agent file that does not say).
+    pub train_seeds: Vec<Option<u64>>,
+    /// Agent file given with --agent, if any.
+    pub agent_file: Option<String>,
+    /// Agent cache folder used by --train-seeds, if any.
+    pub agent_cache: Option<String>,
+    /// Training episodes per agent (null when unknown).
+    pub train_episodes: Option<u64>,
+    /// Evaluation episodes per method, map and agent.
     pub episodes: u64,
     /// How actions are chosen from the policy in evaluation.
     pub action_selection: String,
@@ -88,135 +119,346 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let train_map = maps::load(&args.train_map)?;
     let test_map = maps::load(&args.test_map)?;
     let params = args.agent.params()?;
-    let bundle = args.agent.bundle_trained_on(&args.train_map, args.train_episodes)?;
+    let agents = match &args.seeds.train_seeds {
+        Some(seeds) => args
+            .seeds
+            .train(&seeds.0, &args.train_map, args.train_episodes, args.agent.quiet)?,
+        None => vec![Agent::from_bundle(
+            args.agent.bundle_trained_on(&args.train_map, args.train_episodes)?,
+        )],
+    };
     let mut methods: Vec<Method> = Method::PAPER.to_vec();
     if args.ablations {
         methods.extend(Method::ABLATIONS);
     }
-    let rows = methods
-        .iter()
-        .map(|&m| {
-            compare_method(
-                &bundle,
-                &params,
-                m,
-                &train_map,
-                &test_map,
-                args.episodes,
-                args.agent.seed,
-                args.agent.quiet,
-            )
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    let inference = |name: &str| rows.iter().find(|r| r.method == name).map(|r| r.inference_rate);
-    let relative = match (inference("scaled"), inference("bayes-rl")) {
-        (Some(s), Some(b)) if b > 0.0 => Some(s / b),
-        _ => None,
+    let protocols = args.protocol.protocols();
+    let setup = StudySetup {
+        train_map: &train_map,
+        test_map: &test_map,
+        params: &params,
+        methods: &methods,
+        protocols: &protocols,
+        episodes: args.episodes,
+        seed: args.agent.seed,
+        quiet: args.agent.quiet,
     };
-    print_table(&rows, relative);
+    let tables = run_study(&setup, &agents)?;
+    for table in &tables {
+        print_table(table);
+    }
 
     let report = CompareReport {
+        schema: 2,
+        protocols,
         paper: Method::PAPER
             .iter()
             .filter_map(|m| m.paper().map(|p| serde_json::json!({"method": m.name(), "train_reward": p.train_reward, "test_reward": p.test_reward, "success_rate": p.success_rate, "inference_rate_relative_to_bayes_rl": p.inference_rate})))
             .collect(),
-        scaled_inference_relative_to_bayes_rl: relative,
         train_map: train_map.name.clone(),
         test_map: test_map.name.clone(),
+        reward: serde_json::json!({"train_map": train_map.reward, "test_map": test_map.reward}),
         seed: args.agent.seed,
-        train_episodes: bundle.meta.get("episodes").cloned().unwrap_or_else(|| args.train_episodes.to_string()),
+        train_seeds: agents.iter().map(|a| a.train_seed).collect(),
+        agent_file: args.agent.agent.as_ref().map(|p| p.display().to_string()),
+        agent_cache: (args.seeds.train_seeds.is_some())
+            .then(|| args.seeds.cache_dir().map(|p| p.display().to_string()))
+            .flatten(),
+        train_episodes: agents.first().and_then(|a| a.train_episodes),
         episodes: args.episodes,
         action_selection: format!("{:?}", params.action_selection),
         scaled_params: serde_json::to_value(&params)?,
-        methods: rows,
+        tables,
     };
     let dir = out_dir(&args.out, "out/compare");
     write_json(&dir.join("compare.json"), &report)?;
-    let mut csv = Csv::new(&[
-        "method",
-        "train_reward",
-        "test_reward",
-        "success_rate",
-        "collision_rate",
-        "inference_rate",
-        "reasoning_us_per_tick",
-    ]);
-    for r in &report.methods {
-        csv.row(vec![
-            r.method.clone(),
-            num(r.train_reward, 3),
-            num(r.test_reward, 3),
-            num(r.success_rate, 4),
-            num(r.collision_rate, 4),
-            num(r.inference_rate, 4),
-            num(r.reasoning_us_per_tick, 3),
-        ]);
-    }
-    csv.write(&dir.join("compare.csv"))?;
-    let labels: Vec<String> = report.methods.iter().map(|r| r.method.clone()).collect();
-    let paper = |f: fn(&crate::methods::PaperFigures) -> f64| -> Vec<Option<f64>> {
-        methods.iter().map(|m| m.paper().as_ref().map(f)).collect()
-    };
-    let col = |f: fn(&MethodRow) -> f64| report.methods.iter().map(f).collect::<Vec<_>>();
-    type Metric = (
-        &'static str,
-        fn(&MethodRow) -> f64,
-        fn(&crate::methods::PaperFigures) -> f64,
+    summary_csv(&report.tables).write(&dir.join("compare.csv"))?;
+    seeds_csv(&report.tables).write(&dir.join("compare_seeds.csv"))?;
+    plot(&dir.join("compare.svg"), &report.tables)?;
+    println!(
+        "wrote {}/compare.json, compare.csv, compare_seeds.csv, compare.svg",
+        dir.display()
     );
-    let metrics: [Metric; 4] = [
-        ("train reward", |r| r.train_reward, |p| p.train_reward),
-        ("test reward (unforeseen)", |r| r.test_reward, |p| p.test_reward),
-        ("success rate", |r| r.success_rate, |p| p.success_rate),
-        ("inference rate", |r| r.inference_rate, |p| p.inference_rate),
-    ];
-    let panels: Vec<BarPanel<'_>> = metrics
-        .iter()
-        .map(|(title, ours, theirs)| BarPanel {
-            title,
-            labels: &labels,
-            ours: col(*ours),
-            paper: paper(*theirs),
-        })
-        .collect();
-    grouped_bars(&dir.join("compare.svg"), &panels)?;
-    println!("wrote {}/compare.json, compare.csv, compare.svg", dir.display());
     Ok(())
 }
 
-fn print_table(rows: &[MethodRow], relative: Option<f64>) {
-    println!(
-        "{:<20} {:>14} {:>14} {:>14} {:>10} {:>16} {:>12}",
-        "method", "train reward", "test reward", "success", "collisions", "inference rate", "µs/tick"
-    );
-    let paper_cell = |ours: String, paper: Option<String>| match paper {
-        Some(p) => format!("{ours} ({p})"),
-        None => ours,
+/// The paper's figures for a method, if it reports them.
+fn paper_of(method: &str) -> Option<PaperFigures> {
+    Method::PAPER
+        .iter()
+        .chain(&Method::ABLATIONS)
+        .find(|m| m.name() == method)
+        .and_then(|m| m.paper())
+}
+
+/// Who the agents are, in words.
+fn agents_line(m: &MethodSummary) -> String {
+    let n = m.train_seeds.len();
+    let episodes = m.train_episodes.map_or("?".into(), |e| e.to_string());
+    let seeds: Vec<String> = m.train_seeds.iter().map(|&s| seed_text(s)).collect();
+    let agents = if n == 1 {
+        "1 agent".into()
+    } else {
+        format!("{n} agents")
     };
-    for r in rows {
-        let m = Method::PAPER
-            .iter()
-            .chain(&Method::ABLATIONS)
-            .find(|m| m.name() == r.method)
-            .and_then(|m| m.paper());
+    format!(
+        "{agents} (training seed{} {}, {episodes} training episodes each), {} evaluation episodes per method, map and agent, evaluation seed {}",
+        if n == 1 { "" } else { "s" },
+        seeds.join(","),
+        m.episodes,
+        m.seed
+    )
+}
+
+/// Prints one protocol's table: the figures (paper's in parentheses), then, over
+/// several agents, their range and the worst seed.
+fn print_table(table: &ProtocolTable) {
+    let Some(first) = table.methods.first() else { return };
+    let n = first.train_seeds.len();
+    println!();
+    println!("== {} protocol: {}", table.protocol, table.meaning);
+    println!("{}", agents_line(first));
+    if n > 1 {
         println!(
-            "{:<20} {:>14} {:>14} {:>14} {:>10} {:>16} {:>12}",
-            r.method,
-            paper_cell(num(r.train_reward, 1), m.map(|p| num(p.train_reward, 1))),
-            paper_cell(num(r.test_reward, 1), m.map(|p| num(p.test_reward, 1))),
-            paper_cell(
-                format!("{:.0}%", 100.0 * r.success_rate),
-                m.map(|p| format!("{:.0}%", 100.0 * p.success_rate))
+            "each figure: mean ± half-width of the 95% interval over the {n} agents (Student t, {} df)",
+            n - 1
+        );
+    }
+    let mut rows = vec![
+        [
+            "method",
+            "train reward",
+            "test reward",
+            "success",
+            "collisions",
+            "inference rate",
+            "µs/tick",
+        ]
+        .map(String::from)
+        .to_vec(),
+    ];
+    let with_paper = |ours: String, paper: Option<String>| match paper {
+        Some(p) if table.protocol == Protocol::ZeroShot => format!("{ours} ({p})"),
+        _ => ours,
+    };
+    for m in &table.methods {
+        let p = paper_of(&m.method);
+        let mark = if m.computed_under != m.protocol { "*" } else { "" };
+        rows.push(vec![
+            format!("{}{mark}", m.method),
+            with_paper(cell(&m.train_reward, 1, false), p.map(|p| num(p.train_reward, 1))),
+            with_paper(cell(&m.test_reward, 1, false), p.map(|p| num(p.test_reward, 1))),
+            with_paper(
+                cell(&m.success_rate, if n > 1 { 1 } else { 0 }, true),
+                p.map(|p| format!("{:.0}%", 100.0 * p.success_rate)),
             ),
-            format!("{:.0}%", 100.0 * r.collision_rate),
-            format!("{:.1}%", 100.0 * r.inference_rate),
-            num(r.reasoning_us_per_tick, 2),
-        );
+            cell(&m.collision_rate, if n > 1 { 1 } else { 0 }, true),
+            cell(&m.inference_rate, 1, true),
+            cell(&m.reasoning_us_per_tick, 2, false),
+        ]);
     }
-    println!("(paper's values in parentheses, §VI)");
-    if let Some(rel) = relative {
+    print_grid(&rows);
+    if table.protocol == Protocol::ZeroShot {
+        println!("(paper's values in parentheses, §VI)");
+    }
+    let copied: Vec<&str> = table
+        .methods
+        .iter()
+        .filter(|m| m.computed_under != m.protocol)
+        .map(|m| m.method.as_str())
+        .collect();
+    if !copied.is_empty() {
+        let verb = if copied.len() == 1 { "does" } else { "do" };
         println!(
-            "scaled reasons on {:.1}% of the ticks Bayesian RL does (paper: 63.3%)",
-            100.0 * rel
+            "* {} {verb} not learn across episodes: identical under both protocols, run once ({}) and repeated here",
+            copied.join(", "),
+            Protocol::ZeroShot
         );
     }
+    if let Some(rel) = &table.scaled_inference_relative_to_bayes_rl {
+        println!(
+            "scaled reasons on {} of the ticks Bayesian RL does (paper: 63.3%)",
+            cell(rel, 1, true)
+        );
+    }
+    if n > 1 {
+        print_spread(table);
+    }
+}
+
+/// The range over agents of each figure and the worst seed (lowest test success).
+fn print_spread(table: &ProtocolTable) {
+    println!("over the agents: min .. max, and the worst seed (lowest test success; its success and test reward)");
+    let mut rows = vec![
+        [
+            "method",
+            "train reward",
+            "test reward",
+            "success",
+            "collisions",
+            "inference rate",
+            "worst seed",
+        ]
+        .map(String::from)
+        .to_vec(),
+    ];
+    for m in &table.methods {
+        let w = &m.worst_seed;
+        rows.push(vec![
+            m.method.clone(),
+            range_cell(&m.train_reward, 1, false),
+            range_cell(&m.test_reward, 1, false),
+            range_cell(&m.success_rate, 0, true),
+            range_cell(&m.collision_rate, 0, true),
+            range_cell(&m.inference_rate, 1, true),
+            format!(
+                "{} ({:.0}%, {})",
+                seed_text(w.train_seed),
+                100.0 * w.success_rate,
+                num(w.test_reward, 1)
+            ),
+        ]);
+    }
+    print_grid(&rows);
+}
+
+/// Formats an optional number for CSV (empty when absent).
+fn opt(x: Option<f64>, digits: usize) -> String {
+    x.map(|x| num(x, digits)).unwrap_or_default()
+}
+
+/// Training seeds as one CSV cell, space-separated.
+fn seeds_cell(seeds: &[Option<u64>]) -> String {
+    let s: Vec<String> = seeds.iter().map(|&s| seed_text(s)).collect();
+    s.join(" ")
+}
+
+/// `compare.csv`: one row per (protocol, method), every metric as mean, 95% interval,
+/// min and max over agents, and the worst seed.
+fn summary_csv(tables: &[ProtocolTable]) -> Csv {
+    let mut header: Vec<String> = [
+        "protocol",
+        "method",
+        "computed_under",
+        "agents",
+        "train_seeds",
+        "train_episodes",
+        "episodes",
+        "seed",
+    ]
+    .map(String::from)
+    .to_vec();
+    for (name, _) in METRICS {
+        for suffix in ["", "_ci95_low", "_ci95_high", "_min", "_max"] {
+            header.push(format!("{name}{suffix}"));
+        }
+    }
+    header.extend(["worst_seed", "worst_seed_success_rate", "worst_seed_test_reward"].map(String::from));
+    let mut csv = Csv::new(&header.iter().map(String::as_str).collect::<Vec<_>>());
+    for m in tables.iter().flat_map(|t| &t.methods) {
+        let mut row = vec![
+            m.protocol.to_string(),
+            m.method.clone(),
+            m.computed_under.to_string(),
+            m.train_seeds.len().to_string(),
+            seeds_cell(&m.train_seeds),
+            m.train_episodes.map(|e| e.to_string()).unwrap_or_default(),
+            m.episodes.to_string(),
+            m.seed.to_string(),
+        ];
+        for (name, _) in METRICS {
+            let s = m.stat(name);
+            row.extend([
+                num(s.mean, 4),
+                opt(s.ci95_low, 4),
+                opt(s.ci95_high, 4),
+                num(s.min, 4),
+                num(s.max, 4),
+            ]);
+        }
+        row.extend([
+            m.worst_seed.train_seed.map(|s| s.to_string()).unwrap_or_default(),
+            num(m.worst_seed.success_rate, 4),
+            num(m.worst_seed.test_reward, 4),
+        ]);
+        csv.row(row);
+    }
+    csv
+}
+
+/// `compare_seeds.csv`: one row per (protocol, method, training seed).
+fn seeds_csv(tables: &[ProtocolTable]) -> Csv {
+    let mut header = vec!["protocol", "method", "computed_under", "train_seed"];
+    header.extend(METRICS.iter().map(|(name, _)| *name));
+    let mut csv = Csv::new(&header);
+    for m in tables.iter().flat_map(|t| &t.methods) {
+        for r in &m.per_seed {
+            let mut row = vec![
+                m.protocol.to_string(),
+                m.method.clone(),
+                m.computed_under.to_string(),
+                r.train_seed.map(|s| s.to_string()).unwrap_or_default(),
+            ];
+            row.extend(METRICS.iter().map(|(_, f)| num(f(r), 4)));
+            csv.row(row);
+        }
+    }
+    csv
+}
+
+/// `compare.svg`: one row of bar panels per protocol (train reward, test reward, success,
+/// inference rate), ours with 95% interval whiskers over agents beside the paper's.
+fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
+    type PaperOf = fn(&PaperFigures) -> f64;
+    let panels: [(&str, &str, PaperOf); 4] = [
+        ("train reward", "train_reward", |p| p.train_reward),
+        ("test reward (unforeseen)", "test_reward", |p| p.test_reward),
+        ("success rate", "success_rate", |p| p.success_rate),
+        ("inference rate", "inference_rate", |p| p.inference_rate),
+    ];
+    let labels: Vec<Vec<String>> = tables
+        .iter()
+        .map(|t| t.methods.iter().map(|m| m.method.clone()).collect())
+        .collect();
+    let rows: Vec<BarRow<'_>> = tables
+        .iter()
+        .zip(&labels)
+        .map(|(t, labels)| {
+            let n = t.methods.first().map_or(0, |m| m.train_seeds.len());
+            let ours = if n > 1 {
+                format!("blue: ours, mean over {n} agents with 95% interval whiskers")
+            } else {
+                "blue: ours".into()
+            };
+            let paper = if t.protocol == Protocol::ZeroShot {
+                "; grey: the paper's (§VI)"
+            } else {
+                ""
+            };
+            BarRow {
+                title: format!("{} protocol. {ours}{paper}", t.protocol),
+                panels: panels
+                    .iter()
+                    .map(|&(title, metric, paper)| BarPanel {
+                        title,
+                        labels,
+                        ours: t.methods.iter().map(|m| m.stat(metric).mean).collect(),
+                        interval: t
+                            .methods
+                            .iter()
+                            .map(|m| m.stat(metric).ci95_low.zip(m.stat(metric).ci95_high))
+                            .collect(),
+                        paper: t
+                            .methods
+                            .iter()
+                            .map(|m| {
+                                let p = paper_of(&m.method).filter(|_| t.protocol == Protocol::ZeroShot);
+                                p.as_ref().map(paper)
+                            })
+                            .collect(),
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    grouped_bars(path, &rows)
 }

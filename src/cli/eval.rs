@@ -4,10 +4,12 @@ use clap::Args;
 use std::path::PathBuf;
 
 use super::{AgentArgs, out_dir};
-use crate::experiments::evaluate;
+use crate::experiments::{evaluate_under, evaluate_with};
 use crate::maps;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
+use crate::progress;
+use crate::protocol::Protocol;
 use crate::report::write_json;
 
 /// Arguments of `eval`.
@@ -23,6 +25,11 @@ pub struct EvalArgs {
     /// Episodes.
     #[arg(long, default_value_t = 100)]
     pub episodes: u64,
+    /// Evaluation protocol: zero-shot (default; every episode starts from the trained
+    /// agent, as in the paper's table) or continual (learning carries over between
+    /// episodes, in order).
+    #[arg(long, value_enum, default_value_t = Protocol::ZeroShot)]
+    pub protocol: Protocol,
     /// Output folder for eval.json.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -35,29 +42,48 @@ pub struct EvalArgs {
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
+    let bar = progress::bar(
+        args.episodes,
+        &format!("{} {}", args.method, map.name),
+        args.agent.quiet,
+    );
     let disc = unforeseen_discretizer::Discretizer::new(&map.bins)?;
     // The scripted references need no agent: they decode the map's own observations.
-    let mut controller = match args.method.scripted_controller(&disc.factor_sizes())? {
-        Some(scripted) => scripted,
-        None => {
-            let bundle = args.agent.bundle()?;
-            crate::agent_file::check_compatible(&bundle, &map.name, disc.n_states())?;
-            args.method.controller(&bundle, &params)?
-        }
+    let (results, train_seed) = if args.method.is_scripted() {
+        let sizes = disc.factor_sizes();
+        let make = || Ok(args.method.scripted_controller(&sizes)?.expect("a scripted method"));
+        let results = evaluate_with(
+            args.protocol,
+            &map,
+            args.method,
+            &params,
+            &make,
+            args.episodes,
+            args.agent.seed,
+            &bar,
+        )?;
+        (results, None)
+    } else {
+        let bundle = args.agent.bundle()?;
+        let results = evaluate_under(
+            args.protocol,
+            &map,
+            &bundle,
+            &params,
+            args.method,
+            args.episodes,
+            args.agent.seed,
+            &bar,
+        )?;
+        (results, bundle.meta.get("seed").cloned())
     };
-    let results = evaluate(
-        &map,
-        controller.as_mut(),
-        args.method,
-        args.episodes,
-        args.agent.seed,
-        args.agent.quiet,
-    )?;
+    bar.finish_and_clear();
     let agg = Aggregate::of(&results);
     println!(
-        "{} on '{}': reward {:.2}, success {:.1}%, collisions {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
+        "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
         args.method,
         map.name,
+        protocol_note(args.method, args.protocol, &params),
         agg.mean_reward,
         100.0 * agg.success_rate,
         100.0 * agg.collision_rate,
@@ -69,8 +95,27 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let dir = out_dir(&args.out, "out/eval");
     write_json(
         &dir.join("eval.json"),
-        &serde_json::json!({"method": args.method, "map": map.name, "seed": args.agent.seed, "aggregate": agg, "episodes": results}),
+        &serde_json::json!({
+            "method": args.method,
+            "map": map.name,
+            "protocol": args.protocol,
+            "computed_under": args.protocol.effective(args.method, &params),
+            "seed": args.agent.seed,
+            "train_seed": train_seed,
+            "reward": map.reward,
+            "aggregate": agg,
+            "episodes": results,
+        }),
     )?;
     println!("wrote {}/eval.json", dir.display());
     Ok(())
+}
+
+/// The protocol in words, noting when the method does not learn across episodes.
+fn protocol_note(method: Method, protocol: Protocol, params: &unforeseen_agent::params::ScaledParams) -> String {
+    if method.learns_across_episodes(params) {
+        protocol.to_string()
+    } else {
+        format!("{protocol}; {method} does not learn across episodes, so both protocols give these results")
+    }
 }

@@ -61,7 +61,7 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     if let (Some(first), Some(last)) = (points.first(), points.last()) {
         let shown = |x: Option<f64>, unit: &str| x.map(|b| format!("{b:.2}{unit}")).unwrap_or_else(|| "n/a".into());
         println!(
-            "test-time learning on '{}' over {} continual episodes (paper's Fig. 9 in parentheses):",
+            "test-time learning on '{}' over {} episodes, continual protocol (paper's Fig. 9 in parentheses):",
             map.name,
             points.len()
         );

@@ -17,8 +17,10 @@ pub mod inspect;
 pub mod learn;
 pub mod params;
 pub mod plot_sweep;
+pub mod table;
 pub mod trace;
 pub mod train;
+pub mod train_seeds;
 
 /// Bad input from the user (a map, an agent file, an argument): exit code 2.
 #[derive(Debug, thiserror::Error)]

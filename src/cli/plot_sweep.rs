@@ -70,8 +70,12 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
     ));
 
     let mut panels = Vec::new();
-    let groups: Vec<(String, String)> = {
-        let mut g: Vec<(String, String)> = lines.iter().map(|l| (l.scenario.clone(), l.method.clone())).collect();
+    // One series per (scenario, method, protocol); several training seeds at one x are averaged.
+    let groups: Vec<(String, String, String)> = {
+        let mut g: Vec<_> = lines
+            .iter()
+            .map(|l| (l.scenario.clone(), l.method.clone(), l.protocol.to_string()))
+            .collect();
         g.sort();
         g.dedup();
         g
@@ -87,13 +91,13 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
             let series = groups
                 .iter()
                 .enumerate()
-                .map(|(i, (scenario, method))| {
-                    let mut points: Vec<(f64, f64)> = lines
+                .map(|(i, (scenario, method, protocol))| {
+                    let points: Vec<(f64, f64)> = lines
                         .iter()
-                        .filter(|l| &l.scenario == scenario && &l.method == method)
+                        .filter(|l| &l.scenario == scenario && &l.method == method && l.protocol.name() == protocol)
                         .filter_map(|l| x_of(l).map(|x| (x, y_of(l))))
                         .collect();
-                    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                    let points = mean_by_x(points);
                     Series {
                         label: "",
                         points,
@@ -104,7 +108,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
             panels.push((format!("{figure} vs {name}"), series));
         }
     }
-    let labels: Vec<String> = groups.iter().map(|(s, m)| format!("{s} / {m}")).collect();
+    let labels: Vec<String> = groups.iter().map(|(s, m, p)| format!("{s} / {m} / {p}")).collect();
     let panels: Vec<(&str, Vec<Series<'_>>)> = panels
         .iter()
         .map(|(title, series)| {
@@ -130,4 +134,20 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         lines.len()
     );
     Ok(())
+}
+
+/// Sorts points by x and averages the y values that share an x (training seeds).
+fn mean_by_x(mut points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out: Vec<(f64, f64, usize)> = Vec::new();
+    for (x, y) in points {
+        match out.last_mut() {
+            Some(last) if last.0 == x => {
+                last.1 += y;
+                last.2 += 1;
+            }
+            _ => out.push((x, y, 1)),
+        }
+    }
+    out.into_iter().map(|(x, y, n)| (x, y / n as f64)).collect()
 }

@@ -1,0 +1,130 @@
+//! The two evaluation protocols (DESIGN.md §6). Every output names the one it ran under.
+//!
+//! * **zero-shot** (the paper's Fig. 8 table, the default of `compare`): every method
+//!   starts every test episode from its trained state; nothing carries over between
+//!   test episodes, so the episodes are independent and run in parallel.
+//! * **continual** (the paper's Fig. 9 setting): what a method learns carries over from
+//!   one test episode to the next; episodes run in order on one controller.
+//!
+//! A method that does not learn across episodes ([`Method::learns_across_episodes`]) gives
+//! identical results under both; it is run once and reported as covering both.
+
+use serde::{Deserialize, Serialize};
+use unforeseen_agent::params::ScaledParams;
+use unforeseen_sim::ProtocolName;
+
+use crate::methods::Method;
+
+/// How test episodes relate to each other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Protocol {
+    /// Every test episode starts from the trained state (fresh controller per episode).
+    ZeroShot,
+    /// Learning carries over from one test episode to the next, in order.
+    Continual,
+}
+
+impl Protocol {
+    /// Both protocols, in the order tables print them.
+    pub const ALL: [Protocol; 2] = [Protocol::ZeroShot, Protocol::Continual];
+
+    /// The name used on the command line and in result files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Protocol::ZeroShot => "zero-shot",
+            Protocol::Continual => "continual",
+        }
+    }
+
+    /// One line saying what the protocol means, for printed tables.
+    pub fn meaning(self) -> &'static str {
+        match self {
+            Protocol::ZeroShot => "every method starts every test episode from its trained state (paper Fig. 8)",
+            Protocol::Continual => {
+                "what a method learns carries over from one test episode to the next, in order (paper Fig. 9)"
+            }
+        }
+    }
+
+    /// The protocol as map files name it (`ZeroShot`, `Continual`).
+    pub fn from_map(p: ProtocolName) -> Self {
+        match p {
+            ProtocolName::ZeroShot => Protocol::ZeroShot,
+            ProtocolName::Continual => Protocol::Continual,
+        }
+    }
+
+    /// The protocol `method` really needs: a method that does not learn across episodes
+    /// runs zero-shot (fresh controllers, in parallel) whatever was asked, since both
+    /// protocols give it identical results.
+    pub fn effective(self, method: Method, params: &ScaledParams) -> Self {
+        if method.learns_across_episodes(params) {
+            self
+        } else {
+            Protocol::ZeroShot
+        }
+    }
+}
+
+impl std::fmt::Display for Protocol {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The `--protocol` option: one protocol or both.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum ProtocolChoice {
+    /// Only zero-shot.
+    ZeroShot,
+    /// Only continual.
+    Continual,
+    /// Zero-shot, then continual.
+    #[default]
+    Both,
+}
+
+impl ProtocolChoice {
+    /// The chosen protocols, zero-shot first.
+    pub fn protocols(self) -> Vec<Protocol> {
+        match self {
+            ProtocolChoice::ZeroShot => vec![Protocol::ZeroShot],
+            ProtocolChoice::Continual => vec![Protocol::Continual],
+            ProtocolChoice::Both => Protocol::ALL.to_vec(),
+        }
+    }
+}
+
+/// The protocols among `asked` under which one run of `method` is reported: all of them
+/// when the method does not learn across episodes (its results are identical under
+/// each), otherwise just `protocol`.
+pub fn covered(method: Method, params: &ScaledParams, protocol: Protocol, asked: &[Protocol]) -> Vec<Protocol> {
+    if method.learns_across_episodes(params) {
+        vec![protocol]
+    } else {
+        asked.to_vec()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn non_learners_run_zero_shot_and_cover_every_protocol_asked() {
+        let p = ScaledParams::default();
+        assert_eq!(Protocol::Continual.effective(Method::QLearning, &p), Protocol::ZeroShot);
+        assert_eq!(Protocol::Continual.effective(Method::BayesRl, &p), Protocol::Continual);
+        assert_eq!(
+            covered(Method::ScaledNoLearning, &p, Protocol::ZeroShot, &Protocol::ALL),
+            Protocol::ALL
+        );
+        assert_eq!(
+            covered(Method::Scaled, &p, Protocol::Continual, &Protocol::ALL),
+            [Protocol::Continual]
+        );
+        assert_eq!(ProtocolChoice::default().protocols(), Protocol::ALL);
+        assert_eq!(serde_json::to_string(&Protocol::ZeroShot).unwrap(), "\"zero-shot\"");
+    }
+}
