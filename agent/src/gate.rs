@@ -51,7 +51,7 @@ impl StateGate {
     /// The gate on factor `name` of `model`, conditioned on that factor's next-time parents,
     /// with counts taken from its CPT and a row memory of `memory` ticks (`inf` = unbounded).
     pub fn from_model(model: &WorldModel, name: &str, memory: f64) -> Result<StateGate, AgentError> {
-        if !(memory > 0.0) {
+        if memory.is_nan() || memory <= 0.0 {
             return Err(ParamError::new("gate_memory", memory, "> 0 (inf for unbounded)").into());
         }
         let st = model.structure();

@@ -275,7 +275,7 @@ impl ScaledParams {
         non_negative("learning_rate", self.learning_rate)?;
         positive("nu0", self.nu0)?;
         positive("nu_temperature", self.nu_temperature)?;
-        if !(self.gate_memory > 0.0) {
+        if self.gate_memory.is_nan() || self.gate_memory <= 0.0 {
             return Err(ParamError::new(
                 "gate_memory",
                 self.gate_memory,
