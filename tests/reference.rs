@@ -163,7 +163,10 @@ fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
     assert!(warnings[0].contains("harmless") && warnings[0].contains("not be dangerous"));
     // jaywalk.ron's BrakeOnPedestrian bound was checked and held.
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("1 expectation(s) checked") && stdout.contains(", 0 failed"), "{stdout}");
+    assert!(
+        stdout.contains("1 expectation(s) checked") && stdout.contains(", 0 failed"),
+        "{stdout}"
+    );
 
     // eval of a reference without --agent trains nothing and meets the jaywalker.
     let out = unforeseen(&[

@@ -87,6 +87,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
                 (|l: &crate::batch::ResultLine| l.success_rate) as fn(&_) -> f64,
             ),
             ("mean reward", |l| l.mean_reward),
+            ("inference rate", |l| l.inference_rate),
         ] {
             let series = groups
                 .iter()
