@@ -216,7 +216,7 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, f64, bool, String)],
             .margin(12)
             .x_label_area_size(35)
             .y_label_area_size(45)
-            .build_cartesian_2d(-0.5f64..(n - 0.5), 0.0f64..1.05)
+            .build_cartesian_2d(-0.5f64..(n + 0.3), 0.0f64..1.25)
             .map_err(plot_err)?;
         chart
             .configure_mesh()
@@ -252,10 +252,14 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, f64, bool, String)],
             .draw_series(
                 ticks
                     .iter()
-                    .map(|t| Text::new(t.3.clone(), (t.0 as f64 - 0.3, 1.0), ("sans-serif", 10))),
+                    // Actions above the plot, on two alternating rows so neighbours never touch.
+                    .map(|t| {
+                        let y = if t.0 % 2 == 0 { 1.21 } else { 1.13 };
+                        Text::new(t.3.clone(), (t.0 as f64 - 0.35, y), ("sans-serif", 10))
+                    }),
             )
             .map_err(plot_err)?;
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
         Ok(())
     })
 }
