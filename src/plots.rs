@@ -175,6 +175,8 @@ pub fn line_panels(path: &Path, x_label: &str, panels: &[(&str, Vec<Series<'_>>)
             let xs = series.iter().flat_map(|s| s.points.iter().map(|p| p.0));
             let ys = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
             let (x0, x1) = min_max(xs);
+            // Fitted to the data; a single x value gets a unit-wide axis.
+            let x1 = if x1 > x0 { x1 } else { x0 + 1.0 };
             let (y0, y1) = min_max(ys);
             let ypad = ((y1 - y0) * 0.08).max(1e-3);
             let mut chart = ChartBuilder::on(area)
@@ -182,7 +184,7 @@ pub fn line_panels(path: &Path, x_label: &str, panels: &[(&str, Vec<Series<'_>>)
                 .margin(10)
                 .x_label_area_size(30)
                 .y_label_area_size(55)
-                .build_cartesian_2d(x0..x1.max(x0 + 1.0), (y0 - ypad)..(y1 + ypad))
+                .build_cartesian_2d(x0..x1, (y0 - ypad)..(y1 + ypad))
                 .map_err(plot_err)?;
             chart.configure_mesh().x_desc(x_label).draw().map_err(plot_err)?;
             for s in series {

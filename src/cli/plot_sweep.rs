@@ -70,7 +70,8 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
     ));
 
     let mut panels = Vec::new();
-    // One series per (scenario, method, protocol); several training seeds at one x are averaged.
+    // One series per (scenario, method, protocol); one point per parameter set, averaged
+    // over its training seeds.
     let groups: Vec<(String, String, String)> = {
         let mut g: Vec<_> = lines
             .iter()
@@ -93,12 +94,12 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
                 .iter()
                 .enumerate()
                 .map(|(i, (scenario, method, protocol))| {
-                    let points: Vec<(f64, f64)> = lines
+                    let points: Vec<(String, f64, f64)> = lines
                         .iter()
                         .filter(|l| &l.scenario == scenario && &l.method == method && l.protocol.name() == protocol)
-                        .filter_map(|l| x_of(l).map(|x| (x, y_of(l))))
+                        .filter_map(|l| x_of(l).map(|x| (l.param_set.clone(), x, y_of(l))))
                         .collect();
-                    let points = mean_by_x(points);
+                    let points = mean_by_param_set(points);
                     Series {
                         label: "",
                         points,
@@ -127,7 +128,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
             )
         })
         .collect();
-    line_panels(&args.out, "parameter value", &panels)?;
+    line_panels(&args.out, "x as named in the panel title (each point: mean over training seeds)", &panels)?;
     println!(
         "wrote {} ({} panels over {} result lines)",
         args.out.display(),
@@ -137,18 +138,21 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Sorts points by x and averages the y values that share an x (training seeds).
-fn mean_by_x(mut points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
-    points.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut out: Vec<(f64, f64, usize)> = Vec::new();
-    for (x, y) in points {
+/// One point per parameter set: x and y averaged over its lines (the training seeds), sorted by x.
+fn mean_by_param_set(mut points: Vec<(String, f64, f64)>) -> Vec<(f64, f64)> {
+    points.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut out: Vec<(String, f64, f64, usize)> = Vec::new();
+    for (set, x, y) in points {
         match out.last_mut() {
-            Some(last) if last.0 == x => {
-                last.1 += y;
-                last.2 += 1;
+            Some(last) if last.0 == set => {
+                last.1 += x;
+                last.2 += y;
+                last.3 += 1;
             }
-            _ => out.push((x, y, 1)),
+            _ => out.push((set, x, y, 1)),
         }
     }
-    out.into_iter().map(|(x, y, n)| (x, y / n as f64)).collect()
+    let mut out: Vec<(f64, f64)> = out.into_iter().map(|(_, x, y, n)| (x / n as f64, y / n as f64)).collect();
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    out
 }
