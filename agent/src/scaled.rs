@@ -421,3 +421,17 @@ fn endorsement(pi_scaled: &[f64], a: usize) -> f64 {
     let best = pi_scaled.iter().copied().fold(0.0, f64::max);
     if best > 0.0 { pi_scaled[a] / best } else { 0.0 }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn endorsement_by_hand() {
+        // The planner's favourite (or a tie with it) is fully endorsed; others in proportion.
+        assert_eq!(endorsement(&[0.25, 0.25, 0.5], 2), 1.0);
+        assert_eq!(endorsement(&[0.47, 0.06, 0.47], 0), 1.0);
+        assert_eq!(endorsement(&[0.25, 0.25, 0.5], 1), 0.5);
+        assert_eq!(endorsement(&[0.0, 0.0, 0.0], 1), 0.0);
+    }
+}

@@ -128,7 +128,11 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
             )
         })
         .collect();
-    line_panels(&args.out, "x as named in the panel title (each point: mean over training seeds)", &panels)?;
+    line_panels(
+        &args.out,
+        "x as named in the panel title (each point: mean over training seeds)",
+        &panels,
+    )?;
     println!(
         "wrote {} ({} panels over {} result lines)",
         args.out.display(),
@@ -152,7 +156,10 @@ fn mean_by_param_set(mut points: Vec<(String, f64, f64)>) -> Vec<(f64, f64)> {
             _ => out.push((set, x, y, 1)),
         }
     }
-    let mut out: Vec<(f64, f64)> = out.into_iter().map(|(_, x, y, n)| (x / n as f64, y / n as f64)).collect();
+    let mut out: Vec<(f64, f64)> = out
+        .into_iter()
+        .map(|(_, x, y, n)| (x / n as f64, y / n as f64))
+        .collect();
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
     out
 }
