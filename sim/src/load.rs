@@ -5,7 +5,7 @@
 
 use std::cell::Cell;
 use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::Deserialize;
 use serde::de::{self, Deserializer, Visitor};
@@ -103,6 +103,9 @@ impl fmt::Display for MapError {
 
 impl std::error::Error for MapError {}
 
+/// How the origin of an embedded base map starts in diagnostics (`embedded:jaywalk`).
+const EMBEDDED_PREFIX: &str = "embedded:";
+
 /// A base map found by a resolver.
 pub(crate) struct Resolved {
     /// Name used in diagnostics.
@@ -117,22 +120,34 @@ pub(crate) struct Resolved {
 pub(crate) type Resolver<'a> = dyn Fn(&str, &str) -> Option<Resolved> + 'a;
 
 impl Map {
-    /// Load a map file; a `base` is resolved relative to the file's folder.
+    /// Load a map file. A `base` is resolved against the including map's folder (as
+    /// written, then with `.ron` added), then among the embedded maps by name (`"jaywalk"`
+    /// or `"jaywalk.ron"`); an embedded map's own bases are embedded maps.
     pub fn load(path: &Path) -> Result<Map, MapError> {
         let origin = path.display().to_string();
         let text = read_text(path, &origin).map_err(MapError::one)?;
         let key = canonical_key(path);
         let resolve = |including: &str, base: &str| -> Option<Resolved> {
-            let dir = Path::new(including).parent().map(Path::to_path_buf).unwrap_or_default();
-            let p: PathBuf = dir.join(base);
-            if !p.is_file() {
-                return None;
+            if !including.starts_with(EMBEDDED_PREFIX) {
+                let dir = Path::new(including).parent().map(Path::to_path_buf).unwrap_or_default();
+                let candidates = [dir.join(base), dir.join(format!("{base}.ron"))];
+                if let Some(p) = candidates.iter().find(|p| p.is_file()) {
+                    let origin = p.display().to_string();
+                    return Some(Resolved {
+                        text: read_text(p, &origin),
+                        origin,
+                        key: canonical_key(p),
+                    });
+                }
             }
-            let origin = p.display().to_string();
-            Some(Resolved {
-                text: read_text(&p, &origin),
-                origin,
-                key: canonical_key(&p),
+            let name = base.strip_suffix(".ron").unwrap_or(base);
+            crate::embedded::source(name).map(|text| {
+                let origin = format!("{EMBEDDED_PREFIX}{name}");
+                Resolved {
+                    text: check_text(&origin, text).map(|()| text.to_string()),
+                    key: origin.clone(),
+                    origin,
+                }
             })
         };
         load_top(&origin, &key, &text, &resolve)
@@ -374,7 +389,10 @@ fn build(origin: &str, src: &str, resolve: &Resolver, chain: &mut Vec<String>) -
                     origin,
                     "base",
                     format!("base map {base_name:?} not found"),
-                    Some("a base is a file name relative to this map's folder, e.g. \"intersection.ron\"".into()),
+                    Some(format!(
+                        "a base is a file name relative to this map's folder, e.g. \"intersection.ron\", or an embedded map ({})",
+                        crate::embedded::names().join(", ")
+                    )),
                 )));
             };
             if found.key == including {

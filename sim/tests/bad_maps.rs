@@ -120,6 +120,46 @@ fn missing_base_is_rejected() {
 }
 
 #[test]
+fn missing_base_hint_names_the_embedded_maps() {
+    let (_, lines) = reject("Map(base: \"nowhere\")");
+    assert!(has(&lines, &["not found", "embedded map", "jaywalk"]), "{lines:?}");
+}
+
+#[test]
+fn a_base_not_beside_the_map_is_an_embedded_map() {
+    for base in ["jaywalk", "jaywalk.ron"] {
+        let text = format!("Map(name: \"mine\", base: \"{base}\")");
+        let (_dir, _path, result) = load_files(&[("mine.ron", text.as_bytes())]);
+        let map = result.unwrap_or_else(|e| panic!("base {base}: {e}"));
+        assert_eq!(map.name, "mine");
+        assert_eq!(
+            map.pedestrians.len(),
+            1,
+            "jaywalk's rule, inherited through base {base}"
+        );
+        assert_eq!(
+            map.expect.len(),
+            3,
+            "jaywalk's expectations, inherited through base {base}"
+        );
+    }
+}
+
+#[test]
+fn a_base_beside_the_map_wins_over_the_embedded_one() {
+    let (_dir, _path, result) = load_files(&[
+        ("mine.ron", b"Map(name: \"mine\", base: \"jaywalk\")"),
+        ("jaywalk.ron", b"Map(base: \"intersection\", road: (goal_x: 100.0))"),
+    ]);
+    let map = result.unwrap();
+    assert_eq!(map.road.goal_x, 100.0, "the copy beside the map");
+    // The copy's own base, not found beside it, is the embedded training map: its rule
+    // (pedestrians on red), not the embedded jaywalk's.
+    assert_eq!(map.pedestrians.len(), 1);
+    assert!(map.expect.is_empty());
+}
+
+#[test]
 fn base_including_itself_is_rejected() {
     let (_, lines) = reject("Map(base: \"bad.ron\")");
     assert!(has(&lines, &["base", "names itself"]), "{lines:?}");
