@@ -17,8 +17,8 @@ pub enum MapLookupError {
         /// The embedded names, comma separated.
         names: String,
     },
-    /// The file or embedded map did not validate.
-    #[error("{0}")]
+    /// The file or embedded map did not validate (its diagnostics, printed once).
+    #[error(transparent)]
     Invalid(#[from] MapError),
 }
 

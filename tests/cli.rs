@@ -72,6 +72,11 @@ fn missing_and_bad_maps_exit_2_naming_the_file() {
     assert_bad_input(&unforeseen(&["check-map", bad.to_str().unwrap()]), &["bad.ron"]);
     std::fs::write(&bad, [0u8, 159, 146, 150, 0, 1]).unwrap();
     assert_bad_input(&unforeseen(&["check-map", bad.to_str().unwrap()]), &["bad.ron"]);
+    // A map error reaching a command through the map lookup is printed once, not twice.
+    std::fs::write(&bad, "Map(base: \"nowhere\")").unwrap();
+    let out = unforeseen(&["eval", "--map", bad.to_str().unwrap(), "--method", "never-brake"]);
+    assert_bad_input(&out, &["bad.ron", "\"nowhere\" not found"]);
+    assert_eq!(text(&out).matches("not found").count(), 1, "{}", text(&out));
 }
 
 #[test]
