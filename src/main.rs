@@ -4,6 +4,15 @@ use clap::Parser;
 use unforeseen::cli::{Cli, is_bad_input, run};
 
 fn main() {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`unforeseen check-map maps/ | head`)
+    // fails and `println!` panics; end quietly instead, as command-line tools do.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if info.payload_as_str().is_some_and(|m| m.contains("Broken pipe")) {
+            std::process::exit(0);
+        }
+        default_hook(info);
+    }));
     let cli = Cli::parse();
     if let Err(err) = run(cli) {
         eprintln!("error: {err:#}");

@@ -158,3 +158,23 @@ fn export_model_writes_what_inspect_reads_and_rejects_bad_observations() {
     );
     assert!(!bad.exists(), "no file on bad input");
 }
+
+#[test]
+fn a_closed_output_pipe_ends_the_program_quietly() {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+        .args(["check-map", "maps/jaywalk.ron", "--survivability-episodes", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run the binary");
+    // Close the reading end before the program prints (it first reads and checks the map).
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success() && !err.contains("panicked"),
+        "{:?}: {err}",
+        out.status
+    );
+}
