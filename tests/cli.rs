@@ -34,6 +34,18 @@ fn unknown_commands_flags_and_values_exit_2() {
     assert_bad_input(&unforeseen(&["compare", "--episodes", "many"]), &["many"]);
     assert_bad_input(&unforeseen(&["eval", "--method", "magic"]), &["magic"]);
     assert_bad_input(&unforeseen(&["batch", "--shard", "4/3"]), &["4/3"]);
+    // Episode counts: at least one, and bounded (a huge count used to abort on allocation).
+    for cmd in ["eval", "batch", "compare", "learn", "train"] {
+        assert_bad_input(&unforeseen(&[cmd, "--episodes", "0"]), &["--episodes", "at least 1"]);
+        assert_bad_input(
+            &unforeseen(&[cmd, "--episodes", "4294967296"]),
+            &["--episodes", "at most"],
+        );
+    }
+    assert_bad_input(
+        &unforeseen(&["compare", "--train-episodes", "0"]),
+        &["--train-episodes"],
+    );
 }
 
 #[test]

@@ -25,7 +25,7 @@ pub struct BatchArgs {
     #[arg(value_name = "MAP|DIR")]
     pub maps: Vec<PathBuf>,
     /// Episodes per (scenario, method, parameter set, protocol, training seed).
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = super::episodes)]
     pub episodes: u64,
     /// Evaluation seed (and, without --agent or --train-seeds, the training seed).
     #[arg(long, default_value_t = 7)]
@@ -57,7 +57,7 @@ pub struct BatchArgs {
     #[arg(long = "set", value_name = "KEY=V1,V2")]
     pub sweep: Vec<String>,
     /// Training episodes when no --agent is given.
-    #[arg(long, default_value_t = super::compare::DEFAULT_TRAIN_EPISODES)]
+    #[arg(long, default_value_t = super::compare::DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
     pub train_episodes: u64,
     /// Agent file from `unforeseen train` (default: train on the embedded intersection map).
     #[arg(long, value_name = "FILE")]

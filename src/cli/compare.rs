@@ -29,10 +29,10 @@ pub struct CompareArgs {
     #[arg(long, default_value = "jaywalk")]
     pub test_map: String,
     /// Training episodes when no --agent is given.
-    #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES)]
+    #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
     pub train_episodes: u64,
     /// Evaluation episodes per method, map and agent.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = super::episodes)]
     pub episodes: u64,
     /// Also run the ablations (bayes-rl-factored, scaled-always, scaled-no-learning).
     #[arg(long)]

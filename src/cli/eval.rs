@@ -23,7 +23,7 @@ pub struct EvalArgs {
     #[arg(long, value_enum, default_value_t = Method::Scaled)]
     pub method: Method,
     /// Episodes.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = super::episodes)]
     pub episodes: u64,
     /// Evaluation protocol: zero-shot (default; every episode starts from the trained
     /// agent, as in the paper's table) or continual (learning carries over between

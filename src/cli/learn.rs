@@ -17,7 +17,7 @@ pub struct LearnArgs {
     #[arg(long, default_value = "jaywalk")]
     pub map: String,
     /// Episodes of test-time learning.
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 50, value_parser = super::episodes)]
     pub episodes: u64,
     /// Output folder for learn.csv, learn.json and learn.svg.
     #[arg(long, value_name = "DIR")]

@@ -133,6 +133,22 @@ impl AgentArgs {
     }
 }
 
+/// Most episodes one flag may ask for: a million takes about an hour per method and map
+/// here, and each episode keeps a result in memory; run more as shards or seeds.
+pub const MAX_EPISODES: u64 = 1_000_000;
+
+/// Parses an episode count (`--episodes`, `--train-episodes`): a whole number in 1..=MAX_EPISODES.
+pub fn episodes(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(n) if (1..=MAX_EPISODES).contains(&n) => Ok(n),
+        Ok(0) => Err("must be at least 1 (0 episodes would measure nothing)".into()),
+        Ok(_) => Err(format!(
+            "at most {MAX_EPISODES} per run (split larger runs with --shard or several --seed values)"
+        )),
+        Err(_) => Err(format!("'{s}' is not a whole number of episodes")),
+    }
+}
+
 /// `--out` folder handling shared by the commands.
 pub fn out_dir(out: &Option<PathBuf>, default: &str) -> PathBuf {
     out.clone().unwrap_or_else(|| PathBuf::from(default))

@@ -13,7 +13,7 @@ pub struct TrainArgs {
     #[arg(long, default_value = "intersection")]
     pub map: String,
     /// Training episodes.
-    #[arg(long, default_value_t = super::compare::DEFAULT_TRAIN_EPISODES)]
+    #[arg(long, default_value_t = super::compare::DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
     pub episodes: u64,
     /// Run seed.
     #[arg(long, default_value_t = 7)]
