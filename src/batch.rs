@@ -58,20 +58,37 @@ impl ParamSet {
 /// order the options were given (the last varies fastest).
 pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, BadInput> {
     let mut out = vec![ParamSet(Vec::new())];
+    let mut keys: Vec<&str> = Vec::new();
     for set in sets {
         let (key, values) = set
             .split_once('=')
             .ok_or_else(|| BadInput(format!("--set {set}: expected KEY=V1,V2,..., e.g. --set horizon=1,2,3")))?;
-        let values: Vec<&str> = values.split(',').map(str::trim).filter(|v| !v.is_empty()).collect();
-        if values.is_empty() {
-            return Err(BadInput(format!("--set {set}: no values after '='")));
+        let key = key.trim();
+        if keys.contains(&key) {
+            return Err(BadInput(format!(
+                "--set {set}: `{key}` is set twice; give all its values in one --set, e.g. --set {key}=1,2"
+            )));
+        }
+        keys.push(key);
+        let values: Vec<&str> = values.split(',').map(str::trim).collect();
+        if values.iter().any(|v| v.is_empty()) {
+            return Err(BadInput(format!(
+                "--set {set}: an empty value; separate values by single commas, e.g. --set {key}=1,2"
+            )));
+        }
+        if let Some(v) = values
+            .iter()
+            .enumerate()
+            .find_map(|(i, v)| values[..i].contains(v).then_some(v))
+        {
+            return Err(BadInput(format!("--set {set}: the value {v} is listed twice")));
         }
         out = out
             .into_iter()
             .flat_map(|base| {
                 values.iter().map(move |v| {
                     let mut next = base.clone();
-                    next.0.push((key.trim().to_string(), v.to_string()));
+                    next.0.push((key.to_string(), v.to_string()));
                     next
                 })
             })

@@ -49,6 +49,34 @@ fn unknown_commands_flags_and_values_exit_2() {
 }
 
 #[test]
+fn bad_sweeps_and_job_counts_exit_2() {
+    let batch = |extra: &[&str]| {
+        let mut args = vec![
+            "batch",
+            "maps/jaywalk.ron",
+            "--method",
+            "never-brake",
+            "--episodes",
+            "1",
+        ];
+        args.extend_from_slice(extra);
+        unforeseen(&args)
+    };
+    assert_bad_input(&batch(&["--jobs", "0"]), &["--jobs", "1 to 256"]);
+    assert_bad_input(&batch(&["--jobs", "100000"]), &["--jobs", "1 to 256"]);
+    assert_bad_input(&batch(&["--set", "horizon=1,,2"]), &["horizon=1,,2", "empty value"]);
+    assert_bad_input(&batch(&["--set", "horizon=1,1"]), &["horizon=1,1", "listed twice"]);
+    assert_bad_input(
+        &batch(&["--set", "horizon=1", "--set", "horizon=2"]),
+        &["horizon", "set twice"],
+    );
+    assert_bad_input(
+        &batch(&["--set", "max_scaling_iters=4294967297"]),
+        &["max_scaling_iters", "at most"],
+    );
+}
+
+#[test]
 fn bad_parameter_overrides_exit_2() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("a.ron");

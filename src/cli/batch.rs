@@ -41,7 +41,7 @@ pub struct BatchArgs {
     #[arg(long, value_enum, default_value_t = ProtocolChoice::Both)]
     pub protocol: ProtocolChoice,
     /// Worker threads (results do not depend on it).
-    #[arg(long, default_value_t = default_jobs())]
+    #[arg(long, default_value_t = default_jobs(), value_parser = jobs)]
     pub jobs: usize,
     /// Results file (JSON Lines), one line per unit as soon as it finishes; the summary
     /// over training seeds goes beside it (`results.summary.json`).
@@ -68,6 +68,14 @@ pub struct BatchArgs {
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// Parses `--jobs`: 1 to 256 worker threads.
+fn jobs(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=256).contains(&n) => Ok(n),
+        _ => Err(format!("'{s}': expected a number of worker threads from 1 to 256")),
+    }
 }
 
 fn default_jobs() -> usize {

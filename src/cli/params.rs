@@ -59,7 +59,10 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), BadIn
         "horizon" => p.horizon = int()?,
         "kappa_pi" => p.kappa_pi = float()?,
         "vmp_window" => p.vmp_window = int()?,
-        "max_scaling_iters" => p.max_scaling_iters = int()? as u32,
+        "max_scaling_iters" => {
+            p.max_scaling_iters =
+                u32::try_from(int()?).map_err(|_| BadInput(format!("--set {key}={value}: at most {}", u32::MAX)))?
+        }
         "nu0" => p.nu0 = float()?,
         "nu_temperature" => p.nu_temperature = float()?,
         "learning_rate" => p.learning_rate = float()?,
