@@ -15,6 +15,13 @@ pub fn save(path: &Path, bundle: &AgentBundle) -> anyhow::Result<()> {
 
 /// Loads an agent file; every failure is a [`BadInput`] naming the file.
 pub fn load(path: &Path) -> anyhow::Result<AgentBundle> {
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+        return Err(BadInput(format!(
+            "{}: not a regular file; an agent file is written by `unforeseen train --out FILE`",
+            path.display()
+        ))
+        .into());
+    }
     let text = std::fs::read(path).map_err(|e| {
         BadInput(format!(
             "{}: cannot read the agent file ({e}); create one with `unforeseen train --out {}`",

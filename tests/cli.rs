@@ -218,3 +218,26 @@ fn a_closed_output_pipe_ends_the_program_quietly() {
         out.status
     );
 }
+
+#[test]
+fn only_regular_files_are_read_or_replaced() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.ron");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let f = fifo.to_str().unwrap();
+    // A named pipe would block forever: refused at once.
+    assert_bad_input(&unforeseen(&["check-map", f]), &["pipe.ron", "not a regular file"]);
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", f, "--map", "jaywalk", "--episodes", "1"]),
+        &["pipe.ron", "not a regular file"],
+    );
+    // An output path that is not a regular file (here a folder) is refused, not replaced.
+    let out = dir.path().join("taken");
+    std::fs::create_dir(&out).unwrap();
+    let o = out.to_str().unwrap();
+    assert_bad_input(
+        &unforeseen(&["train", "--episodes", "1", "-q", "--out", o]),
+        &["taken", "not a regular file"],
+    );
+    assert!(out.is_dir());
+}

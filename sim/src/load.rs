@@ -182,6 +182,15 @@ fn canonical_key(p: &Path) -> String {
 /// Read a file as text, refusing huge and binary files without reading them whole.
 fn read_text(path: &Path, origin: &str) -> Result<String, Diagnostic> {
     use std::io::Read;
+    // A named pipe or a device would block or never end: only regular files are maps.
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+        return Err(Diagnostic::new(
+            origin,
+            "",
+            "not a regular file".to_string(),
+            Some("a map is a RON text file".into()),
+        ));
+    }
     let file = std::fs::File::open(path)
         .map_err(|e| Diagnostic::new(origin, "", format!("cannot read the file: {e}"), None))?;
     let mut bytes = Vec::new();
