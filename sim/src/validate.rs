@@ -126,6 +126,15 @@ impl Check {
 /// All rule violations of `map` (empty when it is valid).
 pub(crate) fn validate(map: &Map) -> Vec<Problem> {
     let mut c = Check { out: Vec::new() };
+    for (path, text) in [("name", &map.name), ("description", &map.description)] {
+        if text.chars().any(char::is_control) {
+            c.fail(
+                path,
+                format!("contains a control character ({text:?})"),
+                "names and descriptions are printed in tables and logs: use plain text",
+            );
+        }
+    }
     let r = &map.road;
     c.positive("road.lane_width", r.lane_width);
     if r.lanes == 0 || r.lanes > 16 {

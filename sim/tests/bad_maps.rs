@@ -120,6 +120,12 @@ fn missing_base_is_rejected() {
 }
 
 #[test]
+fn control_characters_in_a_name_are_rejected() {
+    let (_, lines) = reject("Map(name: \"evil\\u{1b}[2J\", description: \"ok\")");
+    assert!(has(&lines, &["name", "control character"]), "{lines:?}");
+}
+
+#[test]
 fn missing_base_hint_names_the_embedded_maps() {
     let (_, lines) = reject("Map(base: \"nowhere\")");
     assert!(has(&lines, &["not found", "embedded map", "jaywalk"]), "{lines:?}");
