@@ -61,9 +61,11 @@ fn jobs_do_not_change_results_and_shards_concatenate_to_the_whole() {
     let two = dir.path().join("two.jsonl");
     let a = run(&config(&scenarios, &params, 1, None), &one, false, true).unwrap();
     let b = run(&config(&scenarios, &params, 2, None), &two, false, true).unwrap();
-    // Per scenario and parameter set: q-learning once (covers both protocols), bayes-rl
-    // and scaled once per protocol.
-    assert_eq!(a.len(), 2 * 5 * 2);
+    // Per scenario: q-learning once (covers both protocols) and bayes-rl once per protocol,
+    // both with the defaults only (the sweep does not affect them); scaled once per
+    // protocol and parameter set.
+    assert_eq!(a.len(), 2 * (1 + 2 + 2 * 2));
+    assert!(a.iter().all(|l| l.method == "scaled" || l.param_set == "default"));
     assert!(
         a.iter()
             .all(|l| l.covers.contains(&l.protocol) && l.train_seed == Some(7))
@@ -181,6 +183,37 @@ fn expectations_pass_and_fail_as_declared() {
     assert_eq!(b.checks.len(), 2);
     assert!(b.checks[1].pass && b.checks[1].figure == "success_rate");
     assert!(lines.iter().find(|l| l.method == "scaled").unwrap().checks.is_empty());
+
+    // In a sweep, expectations gate the default parameters only: a scaled expectation no
+    // point of `horizon=1,2` could meet is reported on neither, and q-learning (not swept)
+    // is still checked once.
+    scenarios[0].map.expect = vec![
+        Expectation {
+            method: MethodName::Scaled,
+            min_success: Some(1.1),
+            ..none.clone()
+        },
+        Expectation {
+            max_collision: Some(1.0),
+            ..none
+        },
+    ];
+    let sweep = sweep(&["horizon=1,2".to_string()]).unwrap();
+    let lines = run(
+        &config(&scenarios, &sweep, 2, None),
+        &dir.path().join("s.jsonl"),
+        false,
+        true,
+    )
+    .unwrap();
+    assert!(
+        lines
+            .iter()
+            .filter(|l| l.method == "scaled")
+            .all(|l| l.checks.is_empty())
+    );
+    let q: Vec<_> = lines.iter().filter(|l| l.method == "q-learning").collect();
+    assert_eq!((q.len(), q[0].param_set.as_str(), q[0].checks.len()), (1, "default", 1));
 }
 
 #[test]

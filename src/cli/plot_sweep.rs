@@ -119,6 +119,8 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
                 series
                     .iter()
                     .zip(&labels)
+                    // A method the swept parameter does not affect ran once, unswept: no series.
+                    .filter(|(s, _)| !s.points.is_empty())
                     .map(|(s, label)| Series {
                         label,
                         points: s.points.clone(),
