@@ -108,6 +108,33 @@ pub fn evaluate_with(
     }
 }
 
+/// Runs `episodes` episodes of a scripted reference `method` ([`Method::REFERENCE`]) on
+/// `map`; it needs no trained agent and does not learn, so every protocol is zero-shot.
+pub fn evaluate_scripted(
+    map: &Map,
+    method: Method,
+    episodes: u64,
+    seed: u64,
+    bar: &ProgressBar,
+) -> anyhow::Result<Vec<EpisodeResult>> {
+    let sizes = Discretizer::new(&map.bins)?.factor_sizes();
+    let make = || {
+        method
+            .scripted_controller(&sizes)?
+            .ok_or_else(|| anyhow::anyhow!("{method} is not a scripted method"))
+    };
+    evaluate_with(
+        Protocol::ZeroShot,
+        map,
+        method,
+        &ScaledParams::default(),
+        &make,
+        episodes,
+        seed,
+        bar,
+    )
+}
+
 /// One method's figures with one trained agent (a per-seed row of `compare.json`).
 #[derive(Debug, Clone, Serialize)]
 pub struct MethodRow {

@@ -11,17 +11,15 @@
 //!
 //! `check-map` measures both on every map with pedestrian rules; `batch` checks its
 //! brake-on-pedestrian and never-brake units. Both print the same warnings to stderr
-//! and neither changes the exit code. Episodes use [`eval_seeds`], so `check-map
+//! and neither changes the exit code. Episodes use [`crate::experiments::eval_seeds`], so `check-map
 //! --seed S` and `batch --seed S` meet the same pedestrians and report the same figures.
 
-use rayon::prelude::*;
-use unforeseen_discretizer::Discretizer;
+use indicatif::ProgressBar;
 use unforeseen_sim::Map;
 
-use crate::experiments::eval_seeds;
+use crate::experiments::evaluate_scripted;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
-use crate::runner::run_episode;
 
 /// Lowest success rate of brake-on-pedestrian for a map to count as survivable.
 pub const SURVIVABLE_MIN_SUCCESS: f64 = 0.99;
@@ -68,25 +66,9 @@ impl Witness {
 }
 
 /// Runs `episodes` episodes of a scripted `method` on `map` (in parallel; seeded by
-/// [`eval_seeds`], so the result does not depend on the number of threads).
+/// [`crate::experiments::eval_seeds`], so the result does not depend on the number of threads).
 pub fn witness(map: &Map, method: Method, episodes: u64, seed: u64) -> anyhow::Result<Witness> {
-    let disc = Discretizer::new(&map.bins)?;
-    let results = (0..episodes)
-        .into_par_iter()
-        .map(|ep| {
-            let mut controller = method
-                .scripted_controller(&disc.factor_sizes())?
-                .ok_or_else(|| anyhow::anyhow!("{method} is not a scripted method"))?;
-            Ok(run_episode(
-                map,
-                &disc,
-                controller.as_mut(),
-                eval_seeds(seed, map, method, ep),
-                false,
-            )
-            .0)
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
+    let results = evaluate_scripted(map, method, episodes, seed, &ProgressBar::hidden())?;
     Ok(Witness::of(&Aggregate::of(&results)))
 }
 

@@ -26,9 +26,7 @@ use crate::structure::Parent;
 /// `P(x | parents)` of one watched factor, with Dirichlet counts of bounded memory.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StateGate {
-    /// Watched factor.
-    factor: usize,
-    /// Its conditioning factors (its next-time parents in the world model), in parent order.
+    /// The watched factor's conditioning factors (its next-time parents in the world model), in parent order.
     given: Vec<usize>,
     /// Their sizes.
     given_sizes: Vec<usize>,
@@ -115,7 +113,6 @@ impl StateGate {
             value_of.push(vals[factor]);
         }
         let mut gate = StateGate {
-            factor,
             given_sizes: given.iter().map(|g| factors[*g].size).collect(),
             given,
             size,
@@ -128,11 +125,6 @@ impl StateGate {
         };
         gate.consolidate();
         Ok(gate)
-    }
-
-    /// The watched factor's index.
-    pub fn factor(&self) -> usize {
-        self.factor
     }
 
     /// The conditioning factors' indices.

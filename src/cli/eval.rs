@@ -4,7 +4,7 @@ use clap::Args;
 use std::path::PathBuf;
 
 use super::{AgentArgs, out_dir};
-use crate::experiments::{evaluate_under, evaluate_with};
+use crate::experiments::{evaluate_scripted, evaluate_under};
 use crate::maps;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
@@ -47,21 +47,9 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         &format!("{} {}", args.method, map.name),
         args.agent.quiet,
     );
-    let disc = unforeseen_discretizer::Discretizer::new(&map.bins)?;
     // The scripted references need no agent: they decode the map's own observations.
     let (results, train_seed) = if args.method.is_scripted() {
-        let sizes = disc.factor_sizes();
-        let make = || Ok(args.method.scripted_controller(&sizes)?.expect("a scripted method"));
-        let results = evaluate_with(
-            args.protocol,
-            &map,
-            args.method,
-            &params,
-            &make,
-            args.episodes,
-            args.agent.seed,
-            &bar,
-        )?;
+        let results = evaluate_scripted(&map, args.method, args.episodes, args.agent.seed, &bar)?;
         (results, None)
     } else {
         let bundle = args.agent.bundle()?;
