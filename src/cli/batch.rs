@@ -15,7 +15,6 @@ use crate::methods::Method;
 use crate::protocol::ProtocolChoice;
 use crate::report::write_json;
 use crate::survivability::{Witness, warnings};
-use crate::training::{TrainConfig, train};
 use std::collections::BTreeSet;
 
 /// Arguments of `batch`.
@@ -181,17 +180,13 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
 
 /// The one agent of a run without --train-seeds: --agent, or trained from --seed.
 fn single_agent(args: &BatchArgs) -> anyhow::Result<Agent> {
-    let bundle = match &args.agent {
-        Some(path) => crate::agent_file::load(path)?,
-        None => {
-            let map = crate::maps::load("intersection")?;
-            let cfg = TrainConfig {
-                quiet: args.quiet,
-                ..TrainConfig::new(args.train_episodes, args.seed)
-            };
-            train(&map, &cfg)?.0
-        }
-    };
+    let bundle = super::load_or_train(
+        args.agent.as_deref(),
+        "intersection",
+        args.train_episodes,
+        args.seed,
+        args.quiet,
+    )?;
     Ok(Agent::from_bundle(bundle))
 }
 

@@ -114,17 +114,7 @@ impl AgentArgs {
 
     /// Loads the agent file, or trains one on `map` (file or embedded name).
     pub fn bundle_trained_on(&self, map: &str, episodes: u64) -> anyhow::Result<AgentBundle> {
-        match &self.agent {
-            Some(path) => crate::agent_file::load(path),
-            None => {
-                let map = crate::maps::load(map)?;
-                let cfg = TrainConfig {
-                    quiet: self.quiet,
-                    ..TrainConfig::new(episodes, self.seed)
-                };
-                Ok(train(&map, &cfg)?.0)
-            }
-        }
+        load_or_train(self.agent.as_deref(), map, episodes, self.seed, self.quiet)
     }
 
     /// The scaled agent's parameters with the `--set` overrides applied.
@@ -146,6 +136,28 @@ pub fn episodes(s: &str) -> Result<u64, String> {
             "at most {MAX_EPISODES} per run (split larger runs with --shard or several --seed values)"
         )),
         Err(_) => Err(format!("'{s}' is not a whole number of episodes")),
+    }
+}
+
+/// Loads the agent file `agent`, or trains one for `episodes` episodes with `seed` on `map`
+/// (a file or embedded name).
+pub fn load_or_train(
+    agent: Option<&std::path::Path>,
+    map: &str,
+    episodes: u64,
+    seed: u64,
+    quiet: bool,
+) -> anyhow::Result<AgentBundle> {
+    match agent {
+        Some(path) => crate::agent_file::load(path),
+        None => {
+            let map = crate::maps::load(map)?;
+            let cfg = TrainConfig {
+                quiet,
+                ..TrainConfig::new(episodes, seed)
+            };
+            Ok(train(&map, &cfg)?.0)
+        }
     }
 }
 
