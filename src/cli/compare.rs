@@ -223,19 +223,7 @@ fn print_table(table: &ProtocolTable) {
             n - 1
         );
     }
-    let mut rows = vec![
-        [
-            "method",
-            "train reward",
-            "test reward",
-            "success",
-            "collisions",
-            "inference rate",
-            "µs/tick",
-        ]
-        .map(String::from)
-        .to_vec(),
-    ];
+    let mut rows = vec![header("µs/tick")];
     let with_paper = |ours: String, paper: Option<String>| match paper {
         Some(p) if table.protocol == Protocol::ZeroShot => format!("{ours} ({p})"),
         _ => ours,
@@ -285,22 +273,20 @@ fn print_table(table: &ProtocolTable) {
     }
 }
 
+/// The header of compare's printed tables: the method, the table's figures, then `last`.
+fn header(last: &str) -> Vec<String> {
+    let figures = ["train reward", "test reward", "success", "collisions", "inference rate"];
+    std::iter::once("method")
+        .chain(figures)
+        .chain([last])
+        .map(String::from)
+        .collect()
+}
+
 /// The range over agents of each figure and the worst seed (lowest test success).
 fn print_spread(table: &ProtocolTable) {
     println!("over the agents: min .. max, and the worst seed (lowest test success; its success and test reward)");
-    let mut rows = vec![
-        [
-            "method",
-            "train reward",
-            "test reward",
-            "success",
-            "collisions",
-            "inference rate",
-            "worst seed",
-        ]
-        .map(String::from)
-        .to_vec(),
-    ];
+    let mut rows = vec![header("worst seed")];
     for m in &table.methods {
         let w = &m.worst_seed;
         rows.push(vec![
