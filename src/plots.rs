@@ -210,11 +210,18 @@ fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// Normalized surprise theta against the threshold epsilon over an episode, with the
 /// reasoning ticks shaded (paper Figs. 6-7). `ticks` are (step, theta, reasoned, action label).
-pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, f64, bool, String)], epsilon: f64) -> Result<()> {
+pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, Option<f64>, bool, String)], epsilon: f64) -> Result<()> {
+    // A method that measures no surprise (q-learning) gets no theta curve, not a curve at 0.
+    let measured = ticks.iter().any(|t| t.1.is_some());
+    let title = if measured {
+        title.to_string()
+    } else {
+        format!("{title} (this method measures no surprise)")
+    };
     write_svg(path, (900, 380), |root| {
         let n = ticks.iter().map(|t| t.0).max().unwrap_or(0) as f64 + 1.0;
         let mut chart = ChartBuilder::on(root)
-            .caption(title, ("sans-serif", 18))
+            .caption(&title, ("sans-serif", 18))
             .margin(12)
             .x_label_area_size(35)
             .y_label_area_size(45)
@@ -245,11 +252,14 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, f64, bool, String)],
             .map_err(plot_err)?
             .label(format!("epsilon = {epsilon}"))
             .legend(|(x, y)| PathElement::new([(x, y), (x + 14, y)], RED));
-        chart
-            .draw_series(LineSeries::new(ticks.iter().map(|t| (t.0 as f64, t.1)), BLUE.stroke_width(2)).point_size(3))
-            .map_err(plot_err)?
-            .label("theta")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 14, y)], BLUE.stroke_width(2)));
+        if measured {
+            let points = ticks.iter().filter_map(|t| t.1.map(|th| (t.0 as f64, th)));
+            chart
+                .draw_series(LineSeries::new(points, BLUE.stroke_width(2)).point_size(3))
+                .map_err(plot_err)?
+                .label("theta")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 14, y)], BLUE.stroke_width(2)));
+        }
         chart
             .draw_series(
                 ticks

@@ -116,7 +116,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     csv.write(&dir.join("trace.csv"))?;
     let points: Vec<_> = decided
         .iter()
-        .map(|t| (t.step, t.theta.unwrap_or(0.0), t.reasoned, t.action.to_string()))
+        .map(|t| (t.step, t.theta, t.reasoned, t.action.to_string()))
         .collect();
     theta_trace(
         &dir.join("theta.svg"),
