@@ -177,23 +177,32 @@ pub fn method_row(method: Method, train_seed: Option<u64>, train: Aggregate, tes
     }
 }
 
-/// Runs one recorded episode of `method` (the first evaluation episode of `seed`) and
-/// returns its result and ticks.
+/// Runs evaluation episode `episode` of `method` (seeded as in [`evaluate_under`]) with
+/// its ticks recorded, and returns its result and ticks. Under the continual protocol the
+/// controller first runs evaluation episodes `0..episode` in order and learns from them,
+/// so the traced episode is exactly the one a continual evaluation meets at that index.
 pub fn trace(
     bundle: &AgentBundle,
     params: &ScaledParams,
     method: Method,
     map: &Map,
     seed: u64,
+    protocol: Protocol,
+    episode: u64,
 ) -> anyhow::Result<(EpisodeResult, Vec<Tick>)> {
     let disc = Discretizer::new(&map.bins)?;
     check_compatible(bundle, &map.name, disc.n_states())?;
     let mut controller = method.controller(bundle, params)?;
+    if protocol.effective(method, params) == Protocol::Continual {
+        for ep in 0..episode {
+            run_episode(map, &disc, controller.as_mut(), eval_seeds(seed, map, method, ep), false);
+        }
+    }
     Ok(run_episode(
         map,
         &disc,
         controller.as_mut(),
-        eval_seeds(seed, map, method, 0),
+        eval_seeds(seed, map, method, episode),
         true,
     ))
 }

@@ -5,7 +5,7 @@
 use crate::error::{AgentError, ParamError};
 use crate::maths::{ln, log_softmax};
 use crate::params::ModelPriors;
-use crate::structure::Structure;
+use crate::structure::{Parent, Structure};
 use crate::transition::FactoredTransition;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -112,6 +112,8 @@ pub struct WorldModel {
     d_counts: Vec<f64>,
     /// Episode-ending states, absorbing in the planning model.
     terminal: Vec<usize>,
+    /// Persistence pooling of one factor (not serialised; set by the agent that uses it).
+    pooling: Option<Pooling>,
     gm: GenerativeModel,
     /// The generative model used for planning: `gm` with every terminal state absorbing.
     gm_plan: GenerativeModel,
@@ -174,6 +176,7 @@ impl TryFrom<WorldModelRepr> for WorldModel {
             gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], r.c, vec![]),
             gm_plan: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], vec![], vec![]),
             terminal: r.terminal,
+            pooling: None,
             d_counts: r.d_counts,
             structure: r.structure,
             n_actions: r.n_actions,
@@ -183,6 +186,63 @@ impl TryFrom<WorldModelRepr> for WorldModel {
         };
         w.materialize();
         Ok(w)
+    }
+}
+
+/// Which CPT rows of one factor share their counts ([`WorldModel::set_persistence_pooling`]).
+#[derive(Debug, Clone, PartialEq)]
+struct Pooling {
+    factor: usize,
+    /// Position of the factor's own previous value among its parents.
+    own: usize,
+    /// Position of the pooled parent.
+    over: usize,
+    /// Per parent position: its size and its stride in the configuration index.
+    sizes: Vec<usize>,
+    strides: Vec<usize>,
+}
+
+impl Pooling {
+    fn new(structure: &Structure, n_actions: usize, factor: &str, over: &str) -> Result<Pooling, AgentError> {
+        let factors = structure.factors();
+        let index = |name: &str| {
+            factors.iter().position(|f| f.name == name).ok_or_else(|| {
+                let names: Vec<&str> = factors.iter().map(|f| f.name.as_str()).collect();
+                AgentError::Structure(format!("persistence pooling names factor `{name}`, not one of {names:?}"))
+            })
+        };
+        let (f, g) = (index(factor)?, index(over)?);
+        let parents = &factors[f].parents;
+        let own = parents.iter().position(|p| *p == Parent::Prev(f)).ok_or_else(|| {
+            AgentError::Structure(format!(
+                "persistence pooling: factor `{factor}` does not depend on its own previous value"
+            ))
+        })?;
+        let over = parents.iter().position(|p| *p == Parent::Next(g)).ok_or_else(|| {
+            AgentError::Structure(format!(
+                "persistence pooling: `{over}` is not a next-time parent of factor `{factor}`"
+            ))
+        })?;
+        let sizes: Vec<usize> = parents
+            .iter()
+            .map(|p| match p {
+                Parent::Prev(j) | Parent::Next(j) => factors[*j].size,
+            })
+            .collect();
+        // Mixed radix in parent order; an action parent, if any, is the least significant digit.
+        let mut strides = vec![0; sizes.len()];
+        let mut stride = if factors[f].action_parent { n_actions } else { 1 };
+        for k in (0..sizes.len()).rev() {
+            strides[k] = stride;
+            stride *= sizes[k];
+        }
+        Ok(Pooling {
+            factor: f,
+            own,
+            over,
+            sizes,
+            strides,
+        })
     }
 }
 
@@ -229,6 +289,7 @@ impl WorldModel {
             gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], c, vec![]),
             gm_plan: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], vec![], vec![]),
             terminal: Vec::new(),
+            pooling: None,
             d_counts: d,
             structure,
             n_actions,
@@ -311,18 +372,69 @@ impl WorldModel {
         self.gm.factored = factored;
     }
 
-    /// Posterior means of each CPT, laid out like the counts.
+    /// Posterior means of each CPT, laid out like the counts (rows pooled where
+    /// [`WorldModel::set_persistence_pooling`] says so).
     fn cpt_means(&self) -> Vec<Vec<f64>> {
         (0..self.structure.factors().len())
             .map(|f| {
                 let size = self.structure.factors()[f].size;
-                let mut m = self.cpt[f].clone();
+                let mut m = match &self.pooling {
+                    Some(pool) if pool.factor == f => self.pooled_counts(pool),
+                    _ => self.cpt[f].clone(),
+                };
                 for row in m.chunks_mut(size) {
                     crate::maths::normalize_in_place(row);
                 }
                 m
             })
             .collect()
+    }
+
+    /// Pool the persistence of factor `factor` over its next-time parent `over` (both by
+    /// name): in every CPT row where the factor's own previous value is not 0 (it was
+    /// present), the data counts of the rows that differ only in `over` are summed and
+    /// shared, so that those rows predict alike; rows with previous value 0 (appearance)
+    /// keep their own counts. The counts themselves are unchanged (the state gate and
+    /// agent files read them as learned); only the probabilities `B` is built from are.
+    ///
+    /// This is a context-specific independence the paper's CPT `p' | p, L', d'` does not
+    /// have: a pedestrian who is on the crosswalk stays or leaves whatever the car's
+    /// distance. Without it, one episode in which a pedestrian left just as the car
+    /// reached the crosswalk teaches the planner that driving on makes pedestrians leave
+    /// (measured on `late_fast`, EXPERIMENTS.md). `None` restores the paper's CPT.
+    pub fn set_persistence_pooling(&mut self, pooling: Option<(&str, &str)>) -> Result<(), AgentError> {
+        self.pooling = match pooling {
+            None => None,
+            Some((factor, over)) => Some(Pooling::new(&self.structure, self.n_actions, factor, over)?),
+        };
+        self.materialize();
+        Ok(())
+    }
+
+    /// The CPT counts of `pool.factor` with the persistence rows pooled (see
+    /// [`WorldModel::set_persistence_pooling`]); the prior is counted once per row.
+    fn pooled_counts(&self, pool: &Pooling) -> Vec<f64> {
+        let f = pool.factor;
+        let size = self.structure.factors()[f].size;
+        let counts = &self.cpt[f];
+        let b0 = self.priors.transition_concentration;
+        let n_cfg = counts.len() / size;
+        // Key of a row: its configuration with the pooled parent's value set to 0.
+        let value = |cfg: usize, k: usize| (cfg / pool.strides[k]) % pool.sizes[k];
+        let key = |cfg: usize| cfg - value(cfg, pool.over) * pool.strides[pool.over];
+        let mut sums = vec![0.0; counts.len()];
+        for cfg in (0..n_cfg).filter(|&c| value(c, pool.own) != 0) {
+            for x in 0..size {
+                sums[key(cfg) * size + x] += (counts[cfg * size + x] - b0).max(0.0);
+            }
+        }
+        let mut out = counts.clone();
+        for cfg in (0..n_cfg).filter(|&c| value(c, pool.own) != 0) {
+            for x in 0..size {
+                out[cfg * size + x] = b0 + sums[key(cfg) * size + x];
+            }
+        }
+        out
     }
 
     /// The joint `B[u][(s', s)] = Π_f p(s'_f | parents_f, u)` computed entry by entry,
@@ -468,7 +580,8 @@ impl WorldModel {
         }
     }
 
-    /// Posterior-mean probability `p(child' = child_value | parents = parent_values, u)`
+    /// Posterior-mean probability `p(child' = child_value | parents = parent_values, u)`, the
+    /// one `B` is built from (pooled rows included)
     /// of factor `factor` (parent values in the factor's parent order; `action` is used
     /// only if the action is a parent). E.g. `P(p'=1 | p, L'=1, d'=2)` (§VI Fig. 9).
     /// Returns NaN for out-of-range arguments.
@@ -485,7 +598,12 @@ impl WorldModel {
         let cfg = self
             .structure
             .config_from_parent_values(factor, parent_values, action, self.n_actions);
-        let row = &self.cpt[factor][cfg * fac.size..(cfg + 1) * fac.size];
+        let pooled = match &self.pooling {
+            Some(pool) if pool.factor == factor => Some(self.pooled_counts(pool)),
+            _ => None,
+        };
+        let counts = pooled.as_deref().unwrap_or(&self.cpt[factor]);
+        let row = &counts[cfg * fac.size..(cfg + 1) * fac.size];
         let z: f64 = row.iter().sum();
         if z > 0.0 {
             row[child_value] / z
@@ -520,5 +638,54 @@ mod tests {
         assert!((w.cpt_prob(3, 0, &[0, 1, 1], None) - 101.0 / 102.0).abs() < 1e-12);
         assert_eq!(w.a(), &DMatrix::identity(64, 64));
         assert!(w.generative().a_identity);
+    }
+
+    #[test]
+    fn persistence_pooling_by_hand() {
+        let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
+        let mut w = WorldModel::new(st.clone(), 3, &ModelPriors::default()).unwrap();
+        // A pedestrian on green stays twice at d' = 2 and leaves once at d' = 1.
+        let at = |d, p| st.encode(&[d, 1, 1, p]);
+        w.observe_transition(at(2, 1), 0, at(2, 1));
+        w.observe_transition(at(2, 1), 0, at(2, 1));
+        w.observe_transition(at(2, 1), 0, at(1, 0));
+        w.materialize();
+        let stay = |w: &WorldModel, l, d| w.cpt_prob(3, 1, &[1, l, d], None);
+        // The paper's CPT: each distance learns alone (prior 1 per cell).
+        assert!((stay(&w, 1, 2) - 3.0 / 4.0).abs() < 1e-12);
+        assert!((stay(&w, 1, 1) - 1.0 / 3.0).abs() < 1e-12);
+        assert!((stay(&w, 1, 3) - 0.5).abs() < 1e-12);
+        let counts = w.cpt_counts(3).to_vec();
+        w.set_persistence_pooling(Some(("p", "d"))).unwrap();
+        // Pooled over d': 2 stays and 1 leave, prior once: 3/5 at every distance under green.
+        for d in 0..4 {
+            assert!((stay(&w, 1, d) - 0.6).abs() < 1e-12, "d = {d}: {}", stay(&w, 1, d));
+            // Red and appearance rows keep their own (prior-only) counts.
+            assert!((stay(&w, 0, d) - 0.5).abs() < 1e-12);
+            assert!((w.cpt_prob(3, 1, &[0, 1, d], None) - 0.5).abs() < 1e-12);
+        }
+        // B predicts with the pooled probabilities and stays column-stochastic; the
+        // counts (what the gate and agent files read) are unchanged.
+        let (from, to) = (at(2, 1), st.encode(&[1, 1, 1, 1]));
+        let d_prob = w.cpt_prob(0, 1, &[2, 1], None);
+        assert!((w.b(0)[(to, from)] - d_prob * w.cpt_prob(1, 1, &[1], Some(0)) * w.cpt_prob(2, 1, &[1], None) * 0.6).abs() < 1e-12);
+        for u in 0..3 {
+            for s in 0..64 {
+                assert!((w.b(u).column(s).sum() - 1.0).abs() < 1e-12);
+            }
+        }
+        assert_eq!(w.cpt_counts(3), &counts[..]);
+        w.set_persistence_pooling(None).unwrap();
+        assert!((stay(&w, 1, 1) - 1.0 / 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn persistence_pooling_names_are_checked() {
+        let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
+        let mut w = WorldModel::new(st, 3, &ModelPriors::default()).unwrap();
+        for (factor, over) in [("q", "d"), ("p", "x"), ("p", "p"), ("L", "d")] {
+            let e = w.set_persistence_pooling(Some((factor, over))).unwrap_err();
+            assert!(matches!(e, AgentError::Structure(_)), "{factor}/{over}: {e}");
+        }
     }
 }

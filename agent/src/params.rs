@@ -176,6 +176,7 @@ pub enum GateLearning {
 /// | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
 /// | `gate_memory` | 20.0 | > 0 (inf allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
 /// | `gate_learning` | Endorsed | | reasoning ticks count in the gate's table as far as the planner endorses the habit |
+/// | `persistence_ignores` | `"d"` | a next-time parent's name, or `""` | the watched factor's persistence (rows where it was present) is pooled over this parent in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ScaledParams {
@@ -223,6 +224,8 @@ pub struct ScaledParams {
     pub gate_memory: f64,
     /// How the gate's table learns a situation as familiar.
     pub gate_learning: GateLearning,
+    /// The next-time parent the watched factor's persistence does not depend on (`""`: none).
+    pub persistence_ignores: String,
 }
 
 impl Default for ScaledParams {
@@ -250,6 +253,7 @@ impl Default for ScaledParams {
             gate_factor: "p".into(),
             gate_memory: 20.0,
             gate_learning: GateLearning::Endorsed,
+            persistence_ignores: "d".into(),
         }
     }
 }

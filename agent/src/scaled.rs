@@ -85,8 +85,11 @@ pub struct ScaledAgent {
 
 impl ScaledAgent {
     /// Build the agent from a trained world model and Q-table: `ν = ν0 σ(Q[s,·]/T)` (DESIGN §5).
-    pub fn new(model: WorldModel, q: &QLearning, params: ScaledParams) -> Result<ScaledAgent, AgentError> {
+    pub fn new(mut model: WorldModel, q: &QLearning, params: ScaledParams) -> Result<ScaledAgent, AgentError> {
         params.check()?;
+        let pooling = (!params.persistence_ignores.is_empty())
+            .then(|| (params.gate_factor.as_str(), params.persistence_ignores.as_str()));
+        model.set_persistence_pooling(pooling)?;
         let n = model.n_states();
         let na = model.n_actions();
         if q.n_states() != n {

@@ -22,6 +22,7 @@ pub const KEYS: &[&str] = &[
     "gate_factor",
     "gate_memory",
     "gate_learning",
+    "persistence_ignores",
 ];
 
 /// Applies `KEY=VALUE` overrides in order, then checks the result.
@@ -81,6 +82,9 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), BadIn
             }
         }
         "gate_factor" => p.gate_factor = value.to_string(),
+        "persistence_ignores" => {
+            p.persistence_ignores = if value == "none" { String::new() } else { value.to_string() }
+        }
         "gate_memory" => p.gate_memory = float()?,
         "gate_learning" => {
             p.gate_learning = match value {

@@ -7,6 +7,7 @@ use super::{AgentArgs, out_dir};
 use crate::experiments::trace;
 use crate::maps;
 use crate::methods::Method;
+use crate::protocol::Protocol;
 use crate::plots::{filmstrip, theta_trace};
 use crate::report::{Csv, num};
 
@@ -22,6 +23,14 @@ pub struct TraceArgs {
     /// Output folder for trace.csv, theta.svg and filmstrip.svg.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Evaluation episode to trace (0 = the first). Under `--protocol continual` the agent
+    /// first runs and learns from episodes 0..N, as a continual evaluation does.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
+    pub episode: u64,
+    /// Evaluation protocol of the traced episode: zero-shot (from the trained state) or
+    /// continual (after learning from the episodes before it).
+    #[arg(long, value_enum, default_value_t = Protocol::ZeroShot)]
+    pub protocol: Protocol,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -36,10 +45,21 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bundle = args.agent.bundle()?;
-    let (result, ticks) = trace(&bundle, &params, args.method, &map, args.agent.seed)?;
+    let (result, ticks) = trace(
+        &bundle,
+        &params,
+        args.method,
+        &map,
+        args.agent.seed,
+        args.protocol,
+        args.episode,
+    )?;
     let bits = |x: Option<f64>| x.map(|s| s / std::f64::consts::LN_2);
     let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
-    println!("{} on '{}', seed {}", args.method, map.name, args.agent.seed);
+    println!(
+        "{} on '{}', seed {}, episode {} ({})",
+        args.method, map.name, args.agent.seed, args.episode, args.protocol
+    );
     let dist = |x: &[f64]| x.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join("/");
     println!(
         "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}  {:<14} {:<14}",
