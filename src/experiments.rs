@@ -195,7 +195,13 @@ pub fn trace(
     let mut controller = method.controller(bundle, params)?;
     if protocol.effective(method, params) == Protocol::Continual {
         for ep in 0..episode {
-            run_episode(map, &disc, controller.as_mut(), eval_seeds(seed, map, method, ep), false);
+            run_episode(
+                map,
+                &disc,
+                controller.as_mut(),
+                eval_seeds(seed, map, method, ep),
+                false,
+            );
         }
     }
     Ok(run_episode(

@@ -7,6 +7,7 @@ mod common;
 use unforeseen::experiments::{evaluate, learn, trace};
 use unforeseen::methods::Method;
 use unforeseen::metrics::Aggregate;
+use unforeseen::protocol::Protocol;
 use unforeseen_agent::params::ScaledParams;
 
 #[test]
@@ -15,11 +16,11 @@ fn scaled_avoids_the_jaywalker_that_q_learning_hits() {
     let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
     let params = ScaledParams::default();
 
-    let (q, q_ticks) = trace(bundle, &params, Method::QLearning, &jaywalk, 11).unwrap();
+    let (q, q_ticks) = trace(bundle, &params, Method::QLearning, &jaywalk, 11, Protocol::ZeroShot, 0).unwrap();
     assert!(q.collision, "Q-learning should hit the jaywalker: {q:?}");
     assert!(q_ticks.iter().all(|t| !t.reasoned), "Q-learning never reasons");
 
-    let (s, s_ticks) = trace(bundle, &params, Method::Scaled, &jaywalk, 11).unwrap();
+    let (s, s_ticks) = trace(bundle, &params, Method::Scaled, &jaywalk, 11, Protocol::ZeroShot, 0).unwrap();
     assert!(
         !s.collision && s.success,
         "the scaled agent should avoid the jaywalker and arrive: {s:?}"
@@ -85,4 +86,22 @@ fn over_a_few_episodes_scaled_beats_q_learning_on_the_jaywalk() {
     assert!(s.success_rate >= 0.9, "scaled success {s:?}");
     assert!(s.mean_reward > q.mean_reward);
     assert!(s.inference_rate > 0.0 && s.inference_rate < 1.0);
+}
+
+/// `trace --episode N --protocol continual` shows the episode a continual evaluation meets
+/// at index N: the same outcome, return and reasoning as `evaluate`'s N-th episode.
+#[test]
+fn a_traced_continual_episode_is_the_one_a_continual_run_meets() {
+    let bundle = common::bundle();
+    let map = unforeseen::maps::load("stop_midway").unwrap();
+    let params = ScaledParams::default();
+    let mut agent = Method::Scaled.controller(bundle, &params).unwrap();
+    let run = evaluate(&map, agent.as_mut(), Method::Scaled, 4, 3, true).unwrap();
+    let (traced, ticks) = trace(bundle, &params, Method::Scaled, &map, 3, Protocol::Continual, 3).unwrap();
+    let last = &run[3];
+    assert_eq!(
+        (traced.ret, traced.success, traced.ticks, traced.reasoning_ticks),
+        (last.ret, last.success, last.ticks, last.reasoning_ticks)
+    );
+    assert_eq!(ticks.iter().filter(|t| t.reasoned).count() as u32, last.reasoning_ticks);
 }

@@ -208,7 +208,9 @@ impl Pooling {
         let index = |name: &str| {
             factors.iter().position(|f| f.name == name).ok_or_else(|| {
                 let names: Vec<&str> = factors.iter().map(|f| f.name.as_str()).collect();
-                AgentError::Structure(format!("persistence pooling names factor `{name}`, not one of {names:?}"))
+                AgentError::Structure(format!(
+                    "persistence pooling names factor `{name}`, not one of {names:?}"
+                ))
             })
         };
         let (f, g) = (index(factor)?, index(over)?);
@@ -668,7 +670,10 @@ mod tests {
         // counts (what the gate and agent files read) are unchanged.
         let (from, to) = (at(2, 1), st.encode(&[1, 1, 1, 1]));
         let d_prob = w.cpt_prob(0, 1, &[2, 1], None);
-        assert!((w.b(0)[(to, from)] - d_prob * w.cpt_prob(1, 1, &[1], Some(0)) * w.cpt_prob(2, 1, &[1], None) * 0.6).abs() < 1e-12);
+        assert!(
+            (w.b(0)[(to, from)] - d_prob * w.cpt_prob(1, 1, &[1], Some(0)) * w.cpt_prob(2, 1, &[1], None) * 0.6).abs()
+                < 1e-12
+        );
         for u in 0..3 {
             for s in 0..64 {
                 assert!((w.b(u).column(s).sum() - 1.0).abs() < 1e-12);

@@ -83,7 +83,11 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), BadIn
         }
         "gate_factor" => p.gate_factor = value.to_string(),
         "persistence_ignores" => {
-            p.persistence_ignores = if value == "none" { String::new() } else { value.to_string() }
+            p.persistence_ignores = if value == "none" {
+                String::new()
+            } else {
+                value.to_string()
+            }
         }
         "gate_memory" => p.gate_memory = float()?,
         "gate_learning" => {

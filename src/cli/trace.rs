@@ -7,8 +7,8 @@ use super::{AgentArgs, out_dir};
 use crate::experiments::trace;
 use crate::maps;
 use crate::methods::Method;
-use crate::protocol::Protocol;
 use crate::plots::{filmstrip, theta_trace};
+use crate::protocol::Protocol;
 use crate::report::{Csv, num};
 
 /// Arguments of `trace`.
