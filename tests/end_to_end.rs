@@ -105,3 +105,30 @@ fn a_traced_continual_episode_is_the_one_a_continual_run_meets() {
     );
     assert_eq!(ticks.iter().filter(|t| t.reasoned).count() as u32, last.reasoning_ticks);
 }
+
+/// Where the event is genuinely uncertain (on jaywalk_late the car meets the crosswalk on
+/// green about as often with a pedestrian as without), the paper's trigger keeps firing
+/// on either outcome; with the endorsed baseline (the default) reasoning fades once the
+/// habit does what reasoning chose, and learning causes no crash.
+#[test]
+fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
+    let bundle = common::bundle();
+    let map = unforeseen::maps::load("jaywalk_late").unwrap();
+    let reasoning = |params: &ScaledParams| {
+        let points = learn(bundle, params, &map, 30, 3, true).unwrap();
+        assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
+        let ticks = |ps: &[unforeseen::experiments::LearnPoint]| ps.iter().map(|p| p.reasoning_ticks).sum::<u32>();
+        (ticks(&points[..5]), ticks(&points[25..]))
+    };
+    let (first, last) = reasoning(&ScaledParams::default());
+    assert!(last < first, "reasoning ticks, first 5 episodes {first}, last 5 {last}");
+    let paper = ScaledParams {
+        gate_baseline: unforeseen_agent::params::GateBaseline::None,
+        ..ScaledParams::default()
+    };
+    let (_, last_paper) = reasoning(&paper);
+    assert!(
+        last < last_paper,
+        "last 5 episodes: {last} reasoning ticks, paper's trigger {last_paper}"
+    );
+}

@@ -16,6 +16,12 @@
 //! at most `memory` ticks (exponential forgetting), so that 6000 training episodes do not
 //! make a never-seen event cost hundreds of episodes to become familiar (measured: with
 //! unbounded counts, 50 learning episodes move the jaywalk surprise 12.6 -> 5.3 bits).
+//!
+//! Beyond the paper, the gate also keeps, per joint state, how often reasoning there
+//! endorsed the habit, and offers the surprise in excess of the surprise expected in
+//! such states ([`StateGate::excess_surprise`]): once the habit has been shown to do
+//! what reasoning would, the ordinary uncertainty of the situation (is a pedestrian
+//! there or not?) no longer triggers reasoning; only surprise beyond it does.
 
 use crate::error::AgentError;
 use crate::error::ParamError;
@@ -43,6 +49,10 @@ pub struct StateGate {
     value_of: Vec<usize>,
     /// Per joint state: `P(x(s) | parents(s))`, refreshed after learning.
     prob: Vec<f64>,
+    /// Per joint state: how often reasoning has endorsed the habit there (at most `memory`).
+    endorsed: Vec<f64>,
+    /// Per joint state: the surprise expected there, `min(1, endorsed / memory) · H(row)`.
+    expected: Vec<f64>,
 }
 
 impl StateGate {
@@ -122,6 +132,8 @@ impl StateGate {
             row_of,
             value_of,
             prob: vec![0.0; n],
+            endorsed: vec![0.0; n],
+            expected: vec![0.0; n],
         };
         gate.consolidate();
         Ok(gate)
@@ -156,6 +168,35 @@ impl StateGate {
         -ln(self.evidence(q))
     }
 
+    /// The surprise in excess of what is expected where the habit has proven itself:
+    /// `max(0, S - Σ_s q(s) c(s) H(row(s)))`, with `H(row)` the entropy of the state's row
+    /// of the table (the surprise one expects there on average) and `c(s)` in [0, 1] the
+    /// share of `memory` reasoning ticks in state `s` that endorsed the habit
+    /// ([`StateGate::endorse`]). Where reasoning never endorsed the habit, it is `S`.
+    ///
+    /// Beyond the paper, whose trigger reads `S` itself: a row that is genuinely uncertain
+    /// (a pedestrian at the crosswalk on green in half of the episodes) keeps `S` above
+    /// the trigger for either outcome, so without this the agent reasons there forever,
+    /// although its habit already does what reasoning would (EXPERIMENTS.md).
+    pub fn excess_surprise(&self, q: &[f64], surprise: f64) -> f64 {
+        let expected: f64 = q
+            .iter()
+            .zip(&self.expected)
+            .filter(|(w, _)| **w != 0.0)
+            .map(|(w, h)| w * h)
+            .sum();
+        (surprise - expected).max(0.0)
+    }
+
+    /// Records that on a reasoning tick in state `s`, reasoning's policy endorsed the
+    /// habit's action by `endorsement` in [0, 1] (1: the habit's action is reasoning's
+    /// choice). Takes effect at [`StateGate::consolidate`].
+    pub fn endorse(&mut self, s: usize, endorsement: f64) {
+        if let Some(e) = self.endorsed.get_mut(s) {
+            *e = (*e + endorsement.clamp(0.0, 1.0)).min(self.memory);
+        }
+    }
+
     /// `P(x = value | given = given_values)` (given values in the order of [`StateGate::given`]),
     /// e.g. the paper's `P(p=1 | L=1, d=2)` (Fig. 9b). NaN when out of range.
     pub fn probability(&self, value: usize, given_values: &[usize]) -> f64 {
@@ -183,7 +224,7 @@ impl StateGate {
     }
 
     /// Applies the bounded memory (rows rescaled to at most `memory` data counts) and
-    /// refreshes the per-state probabilities.
+    /// refreshes the per-state probabilities and expected surprises.
     pub fn consolidate(&mut self) {
         for row in self.data.chunks_mut(self.size) {
             let total: f64 = row.iter().sum();
@@ -193,7 +234,13 @@ impl StateGate {
             }
         }
         for s in 0..self.prob.len() {
-            self.prob[s] = self.cell(self.row_of[s], self.value_of[s]);
+            let row = self.row_of[s];
+            self.prob[s] = self.cell(row, self.value_of[s]);
+            let entropy: f64 = (0..self.size)
+                .map(|x| self.cell(row, x))
+                .map(|p| if p > 0.0 { -p * ln(p) } else { 0.0 })
+                .sum();
+            self.expected[s] = entropy * (self.endorsed[s] / self.memory).min(1.0);
         }
     }
 
@@ -258,5 +305,82 @@ mod tests {
         }
         assert!(StateGate::from_model(&w, "pedestrian", 20.0).is_err());
         assert!(StateGate::from_model(&w, "p", 0.0).is_err());
+    }
+
+    #[test]
+    fn excess_surprise_by_hand() {
+        let mut w = model();
+        let st = w.structure().clone();
+        // Row (L=1, d=2): 5 ticks with a pedestrian and 5 without, so P = 1/2 and H = ln 2.
+        for k in 0..10 {
+            w.observe_transition(st.encode(&[3, 2, 1, 0]), 1, st.encode(&[2, 2, 1, usize::from(k < 5)]));
+        }
+        let mut g = StateGate::from_model(&w, "p", 20.0).unwrap();
+        let (s_fast, s_slow) = (st.encode(&[2, 3, 1, 1]), st.encode(&[2, 0, 1, 1]));
+        let one_hot = |s: usize| {
+            let mut q = vec![0.0; 64];
+            q[s] = 1.0;
+            q
+        };
+        let ln2 = 2f64.ln();
+        let (q_fast, q_slow) = (one_hot(s_fast), one_hot(s_slow));
+        assert!((g.surprise(&q_slow) - ln2).abs() < 1e-12);
+        // Never endorsed: the excess is the surprise itself.
+        assert!((g.excess_surprise(&q_slow, ln2) - ln2).abs() < 1e-12);
+        // Ten full endorsements at v = 0 out of a memory of 20: half the entropy is expected there.
+        for _ in 0..10 {
+            g.endorse(s_slow, 1.0);
+        }
+        g.consolidate();
+        assert!((g.excess_surprise(&q_slow, ln2) - 0.5 * ln2).abs() < 1e-12);
+        // The same row at v = 3, where reasoning never endorsed the habit, stays fully surprising.
+        assert!((g.excess_surprise(&q_fast, ln2) - ln2).abs() < 1e-12);
+        // Partial endorsements count in part; the count saturates at the memory.
+        for _ in 0..40 {
+            g.endorse(s_slow, 0.5);
+        }
+        g.consolidate();
+        assert!(g.excess_surprise(&q_slow, ln2).abs() < 1e-12);
+        // A spread belief mixes the two states' expectations.
+        let mut q = vec![0.0; 64];
+        q[s_slow] = 0.5;
+        q[s_fast] = 0.5;
+        assert!((g.excess_surprise(&q, ln2) - 0.5 * ln2).abs() < 1e-12);
+    }
+}
+
+#[cfg(test)]
+mod properties {
+    use super::*;
+    use crate::params::ModelPriors;
+    use crate::structure::Structure;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// 0 <= excess surprise <= surprise, for any counts, endorsements and beliefs.
+        #[test]
+        fn excess_is_between_zero_and_the_surprise(
+            ticks in proptest::collection::vec((0usize..64, 0usize..3, 0usize..64), 0..40),
+            endorse in proptest::collection::vec((0usize..64, 0.0f64..1.0), 0..40),
+            belief in proptest::collection::vec(0.0f64..1.0, 64),
+        ) {
+            let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
+            let mut w = WorldModel::new(st, 3, &ModelPriors::default()).unwrap();
+            for (s, u, s2) in ticks {
+                w.observe_transition(s, u, s2);
+            }
+            let mut g = StateGate::from_model(&w, "p", 20.0).unwrap();
+            for (s, e) in endorse {
+                g.endorse(s, e);
+            }
+            g.consolidate();
+            let z: f64 = belief.iter().sum();
+            prop_assume!(z > 0.0);
+            let q: Vec<f64> = belief.iter().map(|b| b / z).collect();
+            let s = g.surprise(&q);
+            let x = g.excess_surprise(&q, s);
+            prop_assert!(s >= 0.0);
+            prop_assert!((0.0..=s + 1e-12).contains(&x), "excess {} surprise {}", x, s);
+        }
     }
 }

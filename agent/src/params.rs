@@ -150,6 +150,20 @@ pub enum GateLearning {
     Every,
 }
 
+/// What the trigger subtracts from the gate's surprise before `θ = 1 - exp(-Ω S)`
+/// ([`crate::gate::StateGate::excess_surprise`]). Beyond the paper, whose trigger reads `S`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum GateBaseline {
+    /// The surprise expected in the state, `c(s) H(row)`, where `c(s)` grows with the
+    /// reasoning ticks in that state that endorsed the habit (full after `gate_memory`):
+    /// the uncertainty of a situation stops triggering reasoning once the habit has
+    /// been shown to act there as reasoning would. Zero for a never-endorsed state.
+    #[default]
+    Endorsed,
+    /// Ablation (the paper's trigger): nothing; `θ` reads the surprise itself.
+    None,
+}
+
 /// Hyperparameters of the paper's agent ([`crate::scaled::ScaledAgent`]).
 ///
 /// | field | default | range | paper |
@@ -176,6 +190,7 @@ pub enum GateLearning {
 /// | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
 /// | `gate_memory` | 20.0 | > 0 (inf allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
 /// | `gate_learning` | Endorsed | | reasoning ticks count in the gate's table as far as the planner endorses the habit |
+/// | `gate_baseline` | Endorsed | | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `None` is the paper's trigger) |
 /// | `persistence_ignores` | `"d"` | a next-time parent's name, or `""` | the watched factor's persistence (rows where it was present) is pooled over this parent in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -224,6 +239,8 @@ pub struct ScaledParams {
     pub gate_memory: f64,
     /// How the gate's table learns a situation as familiar.
     pub gate_learning: GateLearning,
+    /// What the trigger subtracts from the gate's surprise.
+    pub gate_baseline: GateBaseline,
     /// The next-time parent the watched factor's persistence does not depend on (`""`: none).
     pub persistence_ignores: String,
 }
@@ -253,6 +270,7 @@ impl Default for ScaledParams {
             gate_factor: "p".into(),
             gate_memory: 20.0,
             gate_learning: GateLearning::Endorsed,
+            gate_baseline: GateBaseline::Endorsed,
             persistence_ignores: "d".into(),
         }
     }

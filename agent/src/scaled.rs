@@ -7,7 +7,10 @@
 //! VMP over the window -> `q_t`, EFE tree -> `ψ`, scaling `π_o(·|q_t)` -> `π'`, act.
 //!
 //! The trigger reads the surprise on the state ([`crate::gate`], §VI) by default, and
-//! the one-step joint surprise ([`crate::surprise`]) as an ablation. Planning always
+//! the one-step joint surprise ([`crate::surprise`]) as an ablation; by default it reads
+//! the surprise in excess of what is expected in states where reasoning has endorsed the
+//! habit ([`GateBaseline::Endorsed`], beyond the paper). `Decision::surprise` is always
+//! the surprise itself, `Decision::theta` what the trigger compared with `ε`. Planning always
 //! predicts with the full transition model, which keeps the pedestrian's persistence.
 
 use crate::controller::{Controller, Decision};
@@ -16,7 +19,7 @@ use crate::gate::StateGate;
 use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
-use crate::params::{ActionSelection, GateLearning, GateMode, ReasoningMode, ScaledParams, ScalingMode};
+use crate::params::{ActionSelection, GateBaseline, GateLearning, GateMode, ReasoningMode, ScaledParams, ScalingMode};
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s};
 use crate::q_learning::QLearning;
@@ -88,7 +91,7 @@ impl ScaledAgent {
     pub fn new(mut model: WorldModel, q: &QLearning, params: ScaledParams) -> Result<ScaledAgent, AgentError> {
         params.check()?;
         let pooling = (!params.persistence_ignores.is_empty())
-            .then(|| (params.gate_factor.as_str(), params.persistence_ignores.as_str()));
+            .then_some((params.gate_factor.as_str(), params.persistence_ignores.as_str()));
         model.set_persistence_pooling(pooling)?;
         let n = model.n_states();
         let na = model.n_actions();
@@ -307,11 +310,22 @@ impl Controller for ScaledAgent {
         }
         let gm = self.model.generative();
         bayes_step(gm, obs, &self.s_hat, &mut self.q_cur);
-        let s = match &self.gate {
-            Some(gate) => gate.surprise(&self.q_cur),
-            None => surprise(gm, obs, &self.s_hat),
+        // The surprise (reported) and what the trigger reads (the excess over the surprise
+        // expected where reasoning endorsed the habit, with `GateBaseline::Endorsed`).
+        let (s, trigger) = match &self.gate {
+            Some(gate) => {
+                let s = gate.surprise(&self.q_cur);
+                match self.params.gate_baseline {
+                    GateBaseline::Endorsed => (s, gate.excess_surprise(&self.q_cur, s)),
+                    GateBaseline::None => (s, s),
+                }
+            }
+            None => {
+                let s = surprise(gm, obs, &self.s_hat);
+                (s, s)
+            }
         };
-        let th = theta(s, self.params.omega);
+        let th = theta(trigger, self.params.omega);
         let reasoned = self.params.reasoning == ReasoningMode::Always || th > self.params.epsilon;
         let mut scaling_iters = 0;
         if reasoned {
@@ -356,7 +370,9 @@ impl Controller for ScaledAgent {
     /// each situation of the table (a cell `(x | parents)`) counts with the smallest
     /// endorsement, over this episode's reasoning ticks in it, of the updated habit's action
     /// by reasoning's policy: a situation becomes familiar only as far as the habit now does
-    /// what reasoning chose in every state of it the episode met.
+    /// what reasoning chose in every state of it the episode met. Each reasoning tick's
+    /// endorsement is also recorded for its state ([`crate::gate::StateGate::endorse`]),
+    /// which is what [`GateBaseline::Endorsed`] subtracts the expected surprise by.
     fn end_episode(&mut self) {
         if !self.params.learning || self.hist_obs.is_empty() {
             return;
@@ -380,17 +396,19 @@ impl Controller for ScaledAgent {
             }
         }
         if let Some(gate) = &mut self.gate {
-            // Each tick is attributed to the cell of its most likely state.
+            // Each tick is attributed to its most likely state and that state's cell.
             let mut weight = vec![1.0; gate.n_cells()];
-            if self.params.gate_learning == GateLearning::Endorsed {
-                let mut habit = vec![0.0; na];
-                for k in (0..steps).filter(|&k| self.hist_reasoned[k]) {
-                    let q = &self.hist_q[k * n..(k + 1) * n];
-                    learning::pi_o_belief(&self.nu, na, q, &mut habit);
-                    let e = endorsement(&self.hist_pi[k * na..(k + 1) * na], argmax(&habit));
-                    let cell = gate.cell_of(argmax(q));
+            let mut habit = vec![0.0; na];
+            for k in (0..steps).filter(|&k| self.hist_reasoned[k]) {
+                let q = &self.hist_q[k * n..(k + 1) * n];
+                learning::pi_o_belief(&self.nu, na, q, &mut habit);
+                let e = endorsement(&self.hist_pi[k * na..(k + 1) * na], argmax(&habit));
+                let s = argmax(q);
+                if self.params.gate_learning == GateLearning::Endorsed {
+                    let cell = gate.cell_of(s);
                     weight[cell] = f64::min(weight[cell], e);
                 }
+                gate.endorse(s, e);
             }
             for k in 0..steps {
                 let q = &self.hist_q[k * n..(k + 1) * n];

@@ -1,6 +1,6 @@
 //! `--set KEY=VALUE` overrides of the scaled agent's parameters (also used by sweeps).
 
-use unforeseen_agent::params::{ActionSelection, GateLearning, GateMode, ScaledParams};
+use unforeseen_agent::params::{ActionSelection, GateBaseline, GateLearning, GateMode, ScaledParams};
 
 use super::BadInput;
 
@@ -22,6 +22,7 @@ pub const KEYS: &[&str] = &[
     "gate_factor",
     "gate_memory",
     "gate_learning",
+    "gate_baseline",
     "persistence_ignores",
 ];
 
@@ -82,6 +83,17 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), BadIn
             }
         }
         "gate_factor" => p.gate_factor = value.to_string(),
+        "gate_baseline" => {
+            p.gate_baseline = match value {
+                "endorsed" => GateBaseline::Endorsed,
+                "none" => GateBaseline::None,
+                _ => {
+                    return Err(BadInput(format!(
+                        "--set gate_baseline={value}: expected endorsed or none"
+                    )));
+                }
+            }
+        }
         "persistence_ignores" => {
             p.persistence_ignores = if value == "none" {
                 String::new()
