@@ -69,7 +69,7 @@ pub fn evaluate_under(
     seed: u64,
     bar: &ProgressBar,
 ) -> anyhow::Result<Vec<EpisodeResult>> {
-    check_compatible(bundle, &map.name, Discretizer::new(&map.bins)?.n_states())?;
+    check_compatible(bundle, map)?;
     let make = || method.controller(bundle, params);
     evaluate_with(protocol, map, method, params, &make, episodes, seed, bar)
 }
@@ -187,7 +187,7 @@ pub fn trace(
     seed: u64,
 ) -> anyhow::Result<(EpisodeResult, Vec<Tick>)> {
     let disc = Discretizer::new(&map.bins)?;
-    check_compatible(bundle, &map.name, disc.n_states())?;
+    check_compatible(bundle, map)?;
     let mut controller = method.controller(bundle, params)?;
     Ok(run_episode(
         map,
@@ -235,7 +235,7 @@ pub fn learn(
     quiet: bool,
 ) -> anyhow::Result<Vec<LearnPoint>> {
     let disc = Discretizer::new(&map.bins)?;
-    check_compatible(bundle, &map.name, disc.n_states())?;
+    check_compatible(bundle, map)?;
     let mut agent = ScaledAgent::new(
         bundle.world_model.clone(),
         &bundle.q_learning,

@@ -34,6 +34,7 @@ fn config<'a>(scenarios: &'a [Scenario], params: &'a [ParamSet], jobs: usize, sh
         seed: 9,
         jobs,
         shard,
+        agents_identity: "the shared test agent, training seed 7".into(),
     }
 }
 
@@ -96,10 +97,17 @@ fn resume_after_a_truncated_file_completes_the_set_without_duplicates() {
     let full = dir.path().join("full.jsonl");
     let whole = run(&config(&scenarios, &params, 2, None), &full, false, true).unwrap();
 
-    // Simulate a kill: two complete lines and half of the third.
+    // Simulate a kill: the run's identity, two complete lines and half of the third.
     let text = std::fs::read_to_string(&full).unwrap();
     let lines: Vec<&str> = text.split_inclusive('\n').collect();
-    let cut = format!("{}{}{}", lines[0], lines[1], &lines[2][..lines[2].len() / 2]);
+    assert!(lines[0].starts_with("{\"run\":"), "{}", lines[0]);
+    let cut = format!(
+        "{}{}{}{}",
+        lines[0],
+        lines[1],
+        lines[2],
+        &lines[3][..lines[3].len() / 2]
+    );
     let partial = dir.path().join("partial.jsonl");
     std::fs::write(&partial, cut).unwrap();
     assert_eq!(read_lines(&partial).unwrap().len(), 2);
@@ -111,6 +119,9 @@ fn resume_after_a_truncated_file_completes_the_set_without_duplicates() {
     assert_eq!(keys.len(), whole.len(), "no duplicates");
     assert_eq!(without_timing(&resumed), without_timing(&whole));
     assert_eq!(file_without_timing(&partial), without_timing(&whole));
+    // The kept lines are the old bytes (their wall-clock timing included).
+    let after = std::fs::read_to_string(&partial).unwrap();
+    assert!(after.starts_with(&format!("{}{}{}", lines[0], lines[1], lines[2])));
 }
 
 #[test]

@@ -6,7 +6,8 @@ use clap::Args;
 use std::path::PathBuf;
 use unforeseen_agent::inspect::InspectModel;
 
-use super::{AgentArgs, BadInput};
+use super::AgentArgs;
+use crate::error::Error;
 use crate::report::write_json;
 
 /// Arguments of `export-model`.
@@ -34,26 +35,33 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         .split(',')
         .map(|v| v.trim().parse::<usize>())
         .collect::<Result<_, _>>()
-        .map_err(|e| BadInput(format!("--obs {}: {e} (expected integers, e.g. 2,3,1,1)", args.obs)))?;
+        .map_err(|e| {
+            Error::flag(
+                format!("--obs {}", args.obs),
+                format!("{e} (expected integers, e.g. 2,3,1,1)"),
+            )
+        })?;
     let bundle = args.agent.bundle()?;
     let model = &bundle.world_model;
     let structure = model.structure();
     let factors = structure.factors();
     if values.len() != factors.len() {
-        return Err(BadInput(format!(
-            "--obs {}: {} values given, the model has {} factors ({})",
-            args.obs,
-            values.len(),
-            factors.len(),
-            factors.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(",")
-        ))
+        return Err(Error::flag(
+            format!("--obs {}", args.obs),
+            format!(
+                "{} values given, the model has {} factors ({})",
+                values.len(),
+                factors.len(),
+                factors.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(",")
+            ),
+        )
         .into());
     }
     if let Some((v, f)) = values.iter().zip(factors).find(|(v, f)| **v >= f.size) {
-        return Err(BadInput(format!(
-            "--obs {}: {}={v} is out of range (0..{})",
-            args.obs, f.name, f.size
-        ))
+        return Err(Error::flag(
+            format!("--obs {}", args.obs),
+            format!("{}={v} is out of range (0..{})", f.name, f.size),
+        )
         .into());
     }
     let gm = model.planning_generative();
