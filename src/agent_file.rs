@@ -53,7 +53,12 @@ pub fn load(path: &Path) -> anyhow::Result<AgentBundle> {
         ));
     }
     let text = String::from_utf8(bytes).map_err(|_| bad(path, None, "not an agent file (not UTF-8 text)", create))?;
-    let bundle = AgentBundle::from_ron_str(&text).map_err(|e| match e {
+    parse(path, &text)
+}
+
+/// Parses and checks the text of an agent file; `path` names it in errors.
+pub fn parse(path: &Path, text: &str) -> anyhow::Result<AgentBundle> {
+    let bundle = AgentBundle::from_ron_str(text).map_err(|e| match e {
         PersistError::Invalid(f) => bad(
             path,
             Some(f.path),
@@ -124,4 +129,14 @@ pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> anyhow::Result<()> {
         .into());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// The map validator bounds the bins by the same number of joint states as the agent
+    /// crate bounds its learners, so every valid map can be trained on.
+    #[test]
+    fn maps_and_agents_share_the_state_bound() {
+        assert_eq!(unforeseen_sim::MAX_JOINT_STATES, unforeseen_agent::limits::MAX_STATES);
+    }
 }

@@ -241,3 +241,59 @@ fn only_regular_files_are_read_or_replaced() {
     );
     assert!(out.is_dir());
 }
+
+/// Issue 12: flags and maps that asked for more memory than any machine has aborted
+/// (exit 134): a VMP window of 99999999999 ticks (2.4 TB), a map of 64 x 64 bin edges
+/// (which check-map accepted). Both are refused up front with the bound and its reason.
+#[test]
+fn allocation_bounds_are_stated_and_enforced() {
+    assert_bad_input(
+        &unforeseen(&["eval", "--set", "vmp_window=99999999999", "--episodes", "1"]),
+        &["vmp_window", "1..=1000"],
+    );
+    assert_bad_input(
+        &unforeseen(&[
+            "batch",
+            "maps/jaywalk.ron",
+            "--method",
+            "never-brake",
+            "--episodes",
+            "1",
+            "--set",
+            "max_scaling_iters=4000000",
+        ]),
+        &["max_scaling_iters", "1..=10000"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("fine_bins.ron");
+    let edges = |step: f64| {
+        (0..64)
+            .map(|i| format!("{:.1}", i as f64 * step))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    std::fs::write(
+        &map,
+        format!(
+            "Map(bins: (distance_edges: [{}], speed_edges: [{}]))",
+            edges(1.0),
+            edges(0.1)
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("agent.ron");
+    assert_bad_input(
+        &unforeseen(&[
+            "train",
+            "--map",
+            map.to_str().unwrap(),
+            "--episodes",
+            "1",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        &["fine_bins.ron", "bins", "at most 1024"],
+    );
+    assert!(!out.exists());
+}

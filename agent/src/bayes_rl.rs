@@ -68,6 +68,17 @@ impl TryFrom<BayesRlRepr> for BayesRl {
         )?;
         check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
         r.params.check().map_err(|e| FieldError::from(e).within("params"))?;
+        for (name, x) in [
+            ("params.prior_concentration", r.params.prior_concentration),
+            ("params.reward_prior", r.params.reward_prior),
+        ] {
+            if !check::bounded(x) {
+                return Err(FieldError::new(
+                    name,
+                    format!("is {x}; must be at most {:e} in size", crate::limits::MAX_VALUE),
+                ));
+            }
+        }
         let (n, na) = (r.n_states, r.n_actions);
         let sa = n * na;
         let why = format!("n_states x n_actions = {n} x {na}");

@@ -2,6 +2,7 @@
 //! failure is a [`FieldError`] naming the field, e.g. `table[17]`.
 
 use crate::error::FieldError;
+use crate::limits::MAX_VALUE;
 
 /// `found == expected`, else "`path` has `found` entries, expected `expected` (`why`)".
 pub(crate) fn len(path: &str, found: usize, expected: usize, why: &str) -> Result<(), FieldError> {
@@ -24,23 +25,30 @@ pub(crate) fn size(path: &str, n: usize, lo: usize, hi: usize, why: &str) -> Res
     }
 }
 
-/// Every entry finite (rewards, Q-values, log preferences).
+/// `x` is finite and at most [`MAX_VALUE`] in size (false for NaN).
+pub(crate) fn bounded(x: f64) -> bool {
+    (-MAX_VALUE..=MAX_VALUE).contains(&x)
+}
+
+/// Every entry finite and at most [`MAX_VALUE`] in size (rewards, Q-values, log
+/// preferences).
 pub(crate) fn finite(path: &str, xs: &[f64]) -> Result<(), FieldError> {
-    match xs.iter().position(|x| !x.is_finite()) {
+    match xs.iter().position(|x| !bounded(*x)) {
         None => Ok(()),
         Some(i) => Err(FieldError::new(
             format!("{path}[{i}]"),
-            format!("must be a finite number, found {}", xs[i]),
+            format!("must be a finite number of size at most {MAX_VALUE:e}, found {}", xs[i]),
         )),
     }
 }
 
-/// Every entry a finite count >= 0, and their sum finite (Dirichlet counts, visits).
+/// Every entry a finite count in [0, [`MAX_VALUE`]], and their sum finite (Dirichlet
+/// counts, visits).
 pub(crate) fn counts(path: &str, xs: &[f64]) -> Result<(), FieldError> {
-    if let Some(i) = xs.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+    if let Some(i) = xs.iter().position(|x| !(0.0..=MAX_VALUE).contains(x)) {
         return Err(FieldError::new(
             format!("{path}[{i}]"),
-            format!("must be a finite count >= 0, found {}", xs[i]),
+            format!("must be a finite count in [0, {MAX_VALUE:e}], found {}", xs[i]),
         ));
     }
     if !xs.iter().sum::<f64>().is_finite() {

@@ -25,3 +25,9 @@ pub const BYTES_PER_STATE_SQUARED: usize = 46 * 8;
 pub fn agent_bytes(n: usize) -> usize {
     n.saturating_mul(n).saturating_mul(BYTES_PER_STATE_SQUARED)
 }
+
+/// Largest magnitude of a stored value (a Q-value, a reward sum, a log preference, a
+/// count): far beyond anything training produces (6000 episodes add about 10⁵ counts to
+/// a cell, rewards are tens per tick), and small enough that planning's sums and
+/// products never overflow to infinity.
+pub const MAX_VALUE: f64 = 1e15;

@@ -4,7 +4,7 @@
 
 use crate::check;
 use crate::error::{AgentError, FieldError, ParamError};
-use crate::limits::{MAX_ACTIONS, MAX_STATES};
+use crate::limits::{MAX_ACTIONS, MAX_STATES, MAX_VALUE};
 use crate::maths::{ln, log_softmax};
 use crate::params::ModelPriors;
 use crate::structure::Structure;
@@ -131,6 +131,9 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
     )?;
     check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
     r.priors.check().map_err(|e| FieldError::from(e).within("priors"))?;
+    check::finite("priors.transition_concentration", &[r.priors.transition_concentration])
+        .and(check::finite("priors.a_concentration", &[r.priors.a_concentration]))
+        .map_err(|e| FieldError::new(e.path.trim_end_matches("[0]"), e.message))?;
     if let Some(d) = &r.priors.d {
         check::len("priors.d", d.len(), n, "one prior probability per joint state")?;
     }
@@ -164,10 +167,10 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
         ));
     }
     for (s, col) in r.a_counts.column_iter().enumerate() {
-        if let Some(o) = col.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+        if let Some(o) = col.iter().position(|x| !(0.0..=MAX_VALUE).contains(x)) {
             return Err(FieldError::new(
                 format!("a_counts[{o},{s}]"),
-                format!("must be a finite count >= 0, found {}", col[o]),
+                format!("must be a finite count in [0, {MAX_VALUE:e}], found {}", col[o]),
             ));
         }
         let z: f64 = col.sum();

@@ -53,6 +53,16 @@ impl TryFrom<QLearningRepr> for QLearning {
                 format!("is {b}; must be below n_actions = {}", r.n_actions),
             ));
         }
+        if !check::bounded(r.params.bias) {
+            return Err(FieldError::new(
+                "params.bias",
+                format!(
+                    "is {}; must be at most {:e} in size",
+                    r.params.bias,
+                    crate::limits::MAX_VALUE
+                ),
+            ));
+        }
         if !(0.0..=1.0).contains(&r.epsilon) {
             return Err(FieldError::new(
                 "epsilon",

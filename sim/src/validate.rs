@@ -96,13 +96,13 @@ impl Check {
         } else if v < lo {
             self.fail(
                 path,
-                format!("{v} {unit} is below the accepted range [{lo}, {hi}] {unit}"),
+                format!("{} {unit} is below the accepted range [{lo}, {hi}] {unit}", short(v)),
                 why,
             );
         } else if v > hi {
             self.fail(
                 path,
-                format!("{v} {unit} is above the accepted range [{lo}, {hi}] {unit}"),
+                format!("{} {unit} is above the accepted range [{lo}, {hi}] {unit}", short(v)),
                 why,
             );
         }
@@ -175,6 +175,15 @@ impl Check {
                 );
             }
         }
+    }
+}
+
+/// `v` as written in messages: plain, or in scientific notation when tiny or huge.
+fn short(v: f64) -> String {
+    if v != 0.0 && !(1e-4..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
 }
 
@@ -332,9 +341,14 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
             "",
         );
     } else {
-        // A phase shorter than one physics sub-step is never shown.
-        let step = 1.0 / map.episode.physics_hz;
-        let shortest = if step.is_finite() && step > 0.0 { step } else { 0.0 };
+        // A phase shorter than one physics sub-step is never shown (checked once the
+        // physics rate itself is valid).
+        let hz = map.episode.physics_hz;
+        let shortest = if (PHYSICS_HZ.0..=PHYSICS_HZ.1).contains(&hz) {
+            1.0 / hz
+        } else {
+            0.0
+        };
         for (i, p) in l.cycle.iter().enumerate() {
             let path = format!("light.cycle[{i}].duration");
             if p.duration > 0.0 && p.duration < shortest {
@@ -506,7 +520,7 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
                 n.round(),
                 n.round() * f64::from(e.max_steps)
             ),
-            "shorten the episode, lengthen decision_dt less, or lower physics_hz (60 Hz is plenty)",
+            "lower max_steps or physics_hz (60 Hz is plenty for road speeds)",
         );
     }
 

@@ -72,6 +72,16 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         params.horizon,
         params.gamma,
     );
+    // JSON has no NaN or infinity (serde_json writes them as null): refuse rather than
+    // write a model no reader can use. A checked agent file never gets here.
+    let value = serde_json::to_value(&exported)?;
+    if let Some(at) = first_null(&value, String::new()) {
+        return Err(Error::Agent {
+            problem: format!("the planning model has a value that is not a finite number at {at}"),
+            fix: "retrain the agent with `unforeseen train`".into(),
+        }
+        .into());
+    }
     write_json(&args.out, &exported)?;
     println!(
         "wrote {} ({} states, {} actions, horizon {}, gamma {})",
@@ -82,4 +92,20 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         params.gamma
     );
     Ok(())
+}
+
+/// The path of the first null (a non-finite number) in `v`, e.g. `A[3][2]`.
+fn first_null(v: &serde_json::Value, at: String) -> Option<String> {
+    match v {
+        serde_json::Value::Null => Some(at),
+        serde_json::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| first_null(x, format!("{at}[{i}]"))),
+        serde_json::Value::Object(m) => m.iter().find_map(|(k, x)| {
+            let here = if at.is_empty() { k.clone() } else { format!("{at}.{k}") };
+            first_null(x, here)
+        }),
+        _ => None,
+    }
 }
