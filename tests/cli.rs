@@ -202,21 +202,31 @@ fn export_model_writes_what_inspect_reads_and_rejects_bad_observations() {
 #[test]
 fn a_closed_output_pipe_ends_the_program_quietly() {
     use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
-        .args(["check-map", "maps/jaywalk.ron", "--survivability-episodes", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run the binary");
-    // Close the reading end before the program prints (it first reads and checks the map).
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.success() && !err.contains("panicked"),
-        "{:?}: {err}",
-        out.status
-    );
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("m.json");
+    std::fs::write(&model, r#"{"A": [[1,0],[0,1]], "B": [[[1,0],[0,1]]], "C": [0,0], "D": [0.5,0.5], "obs": [0], "actions": [], "policy_len": 1, "gamma": 1.0}"#).unwrap();
+    let m = model.to_str().unwrap();
+    // `check-map ... | head` and `inspect --model m.json | head`.
+    for args in [
+        &["check-map", "maps/jaywalk.ron", "--survivability-episodes", "0"][..],
+        &["inspect", "--model", m][..],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run the binary");
+        // Close the reading end before the program prints (it first reads its input).
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            out.status.success() && !err.contains("panicked"),
+            "{args:?}: {:?}: {err}",
+            out.status
+        );
+    }
 }
 
 #[test]
