@@ -17,14 +17,22 @@ pub const MAX_ACTIONS: usize = 16;
 /// Most factors a structure may have (the paper's has four).
 pub const MAX_FACTORS: usize = 16;
 
+/// Most policies the planner may enumerate, `n_actions ^ horizon` (the paper's 3 actions
+/// at the largest horizon, 8, give 6561): the expected-free-energy tree keeps two numbers
+/// per policy and visits every node on each reasoning tick.
+pub const MAX_POLICIES: usize = 65_536;
+
+/// `n_actions ^ horizon` if it is at most [`MAX_POLICIES`].
+pub fn policies(n_actions: usize, horizon: usize) -> Option<usize> {
+    u32::try_from(horizon)
+        .ok()
+        .and_then(|h| n_actions.checked_pow(h))
+        .filter(|&p| p <= MAX_POLICIES)
+}
+
 /// Approximate memory of one trained agent (world model, flat and factored Bayesian RL,
 /// with three actions) per squared joint state, in bytes: 46 dense `N x N` matrices of f64.
 pub const BYTES_PER_STATE_SQUARED: usize = 46 * 8;
-
-/// Approximate memory of one trained agent with `n` joint states, bytes (saturating).
-pub fn agent_bytes(n: usize) -> usize {
-    n.saturating_mul(n).saturating_mul(BYTES_PER_STATE_SQUARED)
-}
 
 /// Largest magnitude of a stored value (a Q-value, a reward sum, a log preference, a
 /// count): far beyond anything training produces (6000 episodes add about 10⁵ counts to

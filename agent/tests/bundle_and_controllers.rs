@@ -205,4 +205,12 @@ fn inspect_rejects_bad_models_naming_the_field() {
     let bad_c = good.replace("\"C\": [0.0, 1.0]", "\"C\": [0.0]");
     assert!(matches!(inspect_json(&bad_c), Err(InspectError::Invalid(m)) if m.starts_with("C has")));
     assert!(matches!(inspect_json("{"), Err(InspectError::Json(_))));
+    // 100 one-state actions at policy length 8 would be 10^16 policies (an allocation
+    // abort): refused with the bound.
+    let b: Vec<&str> = vec!["[[1.0]]"; 100];
+    let many = format!(
+        r#"{{"A": [[1.0]], "B": [{}], "C": [0.0], "D": [1.0], "obs": [0], "actions": [], "policy_len": 8, "gamma": 1.0}}"#,
+        b.join(",")
+    );
+    assert!(matches!(inspect_json(&many), Err(InspectError::Invalid(m)) if m.contains("policies")));
 }
