@@ -59,8 +59,12 @@ impl ParamSet {
     }
 }
 
+/// Most parameter sets one sweep may have (the cross product of its `--set` lists).
+pub const MAX_PARAM_SETS: usize = 10_000;
+
 /// Expands `--set key=v1,v2` options into the cross product of parameter sets, in the
 /// order the options were given (the last varies fastest).
+/// At most [`MAX_PARAM_SETS`] sets.
 pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
     let mut out = vec![ParamSet(Vec::new())];
     let mut keys: Vec<&str> = Vec::new();
@@ -90,6 +94,15 @@ pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
             .find_map(|(i, v)| values[..i].contains(v).then_some(v))
         {
             return Err(Error::flag(&flag, format!("the value {v} is listed twice")));
+        }
+        if out.len().saturating_mul(values.len()) > MAX_PARAM_SETS {
+            return Err(Error::flag(
+                &flag,
+                format!(
+                    "the sweep would have {} parameter sets (at most {MAX_PARAM_SETS}: each runs every scenario and protocol); sweep fewer values, or split the sweep over several runs",
+                    out.len().saturating_mul(values.len())
+                ),
+            ));
         }
         out = out
             .into_iter()

@@ -74,6 +74,13 @@ fn bad_sweeps_and_job_counts_exit_2() {
         &batch(&["--set", "max_scaling_iters=4294967297"]),
         &["max_scaling_iters", "at most"],
     );
+    // A cross product beyond the bound is refused before anything is built.
+    let many: String = (1..=200).map(|i| format!("0.{i:03}")).collect::<Vec<_>>().join(",");
+    let (omega, gamma) = (format!("omega={many}"), format!("gamma={many}"));
+    assert_bad_input(
+        &batch(&["--set", &omega, "--set", &gamma]),
+        &["40000 parameter sets", "at most 10000"],
+    );
 }
 
 #[test]
