@@ -236,9 +236,8 @@ pub fn learn(
 ) -> anyhow::Result<Vec<LearnPoint>> {
     let disc = Discretizer::new(&map.bins)?;
     check_compatible(bundle, map)?;
-    let mut agent = ScaledAgent::new(
-        bundle.world_model.clone(),
-        &bundle.q_learning,
+    let mut agent = crate::methods::scaled_agent(
+        bundle,
         ScaledParams {
             learning: true,
             ..params.clone()

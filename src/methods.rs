@@ -147,12 +147,7 @@ impl Method {
     /// references take only the factor sizes of its world model).
     pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> anyhow::Result<Box<dyn Controller>> {
         let scaled = |params: ScaledParams| -> anyhow::Result<Box<dyn Controller>> {
-            let agent =
-                ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params).map_err(|e| Error::Agent {
-                    problem: format!("cannot build the scaled agent from this agent file: {e}"),
-                    fix: "check the --set overrides against the agent's world model, or retrain it".into(),
-                })?;
-            Ok(Box::new(agent))
+            Ok(Box::new(scaled_agent(bundle, params)?))
         };
         Ok(match self {
             Method::QLearning => Box::new(bundle.q_learning.clone()),
@@ -191,6 +186,15 @@ impl Method {
             }
         })
     }
+}
+
+/// The paper's agent from a trained bundle; a failure (parameters that do not fit the
+/// agent's world model, e.g. `--set gate_factor` naming no factor) is an [`Error::Agent`].
+pub fn scaled_agent(bundle: &AgentBundle, params: ScaledParams) -> Result<ScaledAgent, Error> {
+    ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params).map_err(|e| Error::Agent {
+        problem: format!("cannot build the scaled agent from this agent file: {e}"),
+        fix: "check the --set overrides against the agent's world model, or retrain it".into(),
+    })
 }
 
 impl std::fmt::Display for Method {
