@@ -494,8 +494,9 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunIdentity {
-    /// The program that ran the units: crate version and the fingerprint of the code
-    /// that determines results (build.rs).
+    /// The program that ran the units: crate version and a fingerprint of all the source
+    /// that determines results (the crates, `src/` and Cargo.lock; build.rs), so a
+    /// rebuilt program with changed code does not continue another's file.
     pub program: String,
     /// The agents: an agent file's content hash, or how they were trained.
     pub agents: String,
@@ -532,7 +533,7 @@ impl RunIdentity {
             program: format!(
                 "unforeseen {} (code {})",
                 env!("CARGO_PKG_VERSION"),
-                env!("UNFORESEEN_TRAINING_FINGERPRINT")
+                env!("UNFORESEEN_CODE_FINGERPRINT")
             ),
             agents: agents.to_string(),
             maps: scenarios
