@@ -42,7 +42,7 @@ fn fingerprint(root: &Path, inputs: &[&str]) -> u64 {
     files.dedup();
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for f in &files {
-        let rel = f.strip_prefix(&root).unwrap_or(f).to_string_lossy().replace('\\', "/");
+        let rel = f.strip_prefix(root).unwrap_or(f).to_string_lossy().replace('\\', "/");
         let bytes = std::fs::read(f).unwrap_or_default();
         for &b in rel
             .as_bytes()
