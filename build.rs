@@ -1,7 +1,9 @@
 //! Build script: a fingerprint of the source that determines a trained agent (the sim,
 //! discretizer and agent crates, the training loop, the rewards and the locked
 //! dependency versions), so the agent cache of `--train-seeds` (src/agents.rs) never
-//! serves an agent trained by different code.
+//! serves an agent trained by different code; and one of all the source that determines
+//! results (the same plus the whole `src/`), so that `batch --resume` never mixes lines
+//! of two programs (src/batch.rs, `RunIdentity`).
 
 use std::path::{Path, PathBuf};
 
@@ -15,17 +17,32 @@ const INPUTS: &[&str] = &[
     "Cargo.lock",
 ];
 
+/// Further sources whose contents determine evaluation results.
+const RESULT_INPUTS: &[&str] = &["src"];
+
 fn main() {
     let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    let training = fingerprint(&root, INPUTS);
+    println!("cargo:rustc-env=UNFORESEEN_TRAINING_FINGERPRINT={training:016x}");
+    let all: Vec<&str> = INPUTS.iter().chain(RESULT_INPUTS).copied().collect();
+    println!(
+        "cargo:rustc-env=UNFORESEEN_CODE_FINGERPRINT={:016x}",
+        fingerprint(&root, &all)
+    );
+}
+
+/// FNV-1a over the relative path and contents of every file under `inputs`, in order.
+fn fingerprint(root: &Path, inputs: &[&str]) -> u64 {
     let mut files = Vec::new();
-    for input in INPUTS {
+    for input in inputs {
         println!("cargo:rerun-if-changed={input}");
         collect(&root.join(input), &mut files);
     }
     files.sort();
+    files.dedup();
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for f in &files {
-        let rel = f.strip_prefix(&root).unwrap_or(f).to_string_lossy().replace('\\', "/");
+        let rel = f.strip_prefix(root).unwrap_or(f).to_string_lossy().replace('\\', "/");
         let bytes = std::fs::read(f).unwrap_or_default();
         for &b in rel
             .as_bytes()
@@ -38,7 +55,7 @@ fn main() {
             h = h.wrapping_mul(0x0000_0100_0000_01b3);
         }
     }
-    println!("cargo:rustc-env=UNFORESEEN_TRAINING_FINGERPRINT={h:016x}");
+    h
 }
 
 /// Every file under `path` (or `path` itself).

@@ -10,11 +10,9 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::Map;
 
 use crate::agent_file::check_compatible;
-use crate::cli::BadInput;
 use crate::training::{TrainConfig, train_with_bar};
 
 /// Most training seeds one run accepts (each agent takes seconds to train).
@@ -134,9 +132,9 @@ fn load_cached(path: &Path, map: &Map, key: &str) -> Option<AgentBundle> {
     }
     let checked = crate::agent_file::load(path).and_then(|bundle| {
         if bundle.meta.get("cache_key").map(String::as_str) != Some(key) {
-            return Err(BadInput("its cache key differs from its file name".into()).into());
+            anyhow::bail!("its cache key differs from its file name");
         }
-        check_compatible(&bundle, &map.name, Discretizer::new(&map.bins)?.n_states())?;
+        check_compatible(&bundle, map)?;
         Ok(bundle)
     });
     match checked {

@@ -7,6 +7,11 @@
 //! episodes is run once per (scenario, parameter set, seed), and its line covers every
 //! protocol asked. Over training seeds, [`summarize`] gives each figure's mean, 95%
 //! interval, range and worst seed, and checks the maps' expectations on the mean.
+//!
+//! A results file starts with the [`RunIdentity`] of the run that wrote it (program
+//! version, agents, map contents, methods, parameter sets, protocols, training seeds,
+//! episodes, seed). `--resume` refuses a file of another run, saying what differs, and
+//! keeps the lines it reuses byte for byte.
 
 use anyhow::Context;
 use rayon::prelude::*;
@@ -19,7 +24,7 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::{Map, MethodName};
 
 use crate::agents::Agent;
-use crate::cli::BadInput;
+use crate::error::Error;
 use crate::experiments::evaluate_under;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
@@ -54,34 +59,50 @@ impl ParamSet {
     }
 }
 
+/// Most parameter sets one sweep may have (the cross product of its `--set` lists).
+pub const MAX_PARAM_SETS: usize = 10_000;
+
 /// Expands `--set key=v1,v2` options into the cross product of parameter sets, in the
 /// order the options were given (the last varies fastest).
-pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, BadInput> {
+/// At most [`MAX_PARAM_SETS`] sets.
+pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
     let mut out = vec![ParamSet(Vec::new())];
     let mut keys: Vec<&str> = Vec::new();
     for set in sets {
+        let flag = format!("--set {set}");
         let (key, values) = set
             .split_once('=')
-            .ok_or_else(|| BadInput(format!("--set {set}: expected KEY=V1,V2,..., e.g. --set horizon=1,2,3")))?;
+            .ok_or_else(|| Error::flag(&flag, "expected KEY=V1,V2,..., e.g. --set horizon=1,2,3"))?;
         let key = key.trim();
         if keys.contains(&key) {
-            return Err(BadInput(format!(
-                "--set {set}: `{key}` is set twice; give all its values in one --set, e.g. --set {key}=1,2"
-            )));
+            return Err(Error::flag(
+                &flag,
+                format!("`{key}` is set twice; give all its values in one --set, e.g. --set {key}=1,2"),
+            ));
         }
         keys.push(key);
         let values: Vec<&str> = values.split(',').map(str::trim).collect();
         if values.iter().any(|v| v.is_empty()) {
-            return Err(BadInput(format!(
-                "--set {set}: an empty value; separate values by single commas, e.g. --set {key}=1,2"
-            )));
+            return Err(Error::flag(
+                &flag,
+                format!("an empty value; separate values by single commas, e.g. --set {key}=1,2"),
+            ));
         }
         if let Some(v) = values
             .iter()
             .enumerate()
             .find_map(|(i, v)| values[..i].contains(v).then_some(v))
         {
-            return Err(BadInput(format!("--set {set}: the value {v} is listed twice")));
+            return Err(Error::flag(&flag, format!("the value {v} is listed twice")));
+        }
+        if out.len().saturating_mul(values.len()) > MAX_PARAM_SETS {
+            return Err(Error::flag(
+                &flag,
+                format!(
+                    "the sweep would have {} parameter sets (at most {MAX_PARAM_SETS}: each runs every scenario and protocol); sweep fewer values, or split the sweep over several runs",
+                    out.len().saturating_mul(values.len())
+                ),
+            ));
         }
         out = out
             .into_iter()
@@ -101,7 +122,7 @@ impl ParamSet {
     /// The scaled agent's parameters with these overrides applied (checked).
     pub fn scaled_params(&self) -> anyhow::Result<ScaledParams> {
         let sets: Vec<String> = self.0.iter().map(|(k, v)| format!("{k}={v}")).collect();
-        crate::cli::params::apply(ScaledParams::default(), &sets)
+        Ok(crate::overrides::apply(ScaledParams::default(), &sets)?)
     }
 }
 
@@ -366,9 +387,27 @@ pub struct BatchConfig<'a> {
     pub jobs: usize,
     /// Optional shard.
     pub shard: Option<Shard>,
+    /// What determines the agents, for the run's identity: an agent file's content hash
+    /// or the training recipe (see [`crate::cli::batch`]). Two runs with the same text
+    /// here run the same agents.
+    pub agents_identity: String,
 }
 
 impl BatchConfig<'_> {
+    /// The identity of this run (the first line of its results file).
+    pub fn identity(&self) -> RunIdentity {
+        RunIdentity::new(
+            self.scenarios,
+            self.methods,
+            self.params,
+            self.protocols,
+            self.train_seeds,
+            self.episodes,
+            self.seed,
+            &self.agents_identity,
+        )
+    }
+
     /// All units of the run, in canonical order.
     pub fn units(&self) -> anyhow::Result<Vec<Unit>> {
         units(
@@ -449,29 +488,252 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine
     })
 }
 
-/// Reads the complete lines of an existing results file (a truncated last line from a
-/// killed run is dropped).
-pub fn read_lines(path: &Path) -> anyhow::Result<Vec<ResultLine>> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
-    };
-    let mut lines = Vec::new();
-    for (i, line) in text.split_inclusive('\n').enumerate() {
-        if !line.ends_with('\n') {
+/// What determines a batch run's results, written as the first line of its results file
+/// (`{"run": {...}}`). `--resume` continues a file only if its identity is this run's;
+/// the shard is not part of it (shards of one run concatenate into one file).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunIdentity {
+    /// The program that ran the units: crate version and a fingerprint of all the source
+    /// that determines results (the crates, `src/` and Cargo.lock; build.rs), so a
+    /// rebuilt program with changed code does not continue another's file.
+    pub program: String,
+    /// The agents: an agent file's content hash, or how they were trained.
+    pub agents: String,
+    /// The scenarios in order: name and a hash of the map's full contents (bases merged).
+    pub maps: Vec<(String, String)>,
+    /// Methods in order.
+    pub methods: Vec<String>,
+    /// Parameter sets in order (labels).
+    pub param_sets: Vec<String>,
+    /// Protocols in order.
+    pub protocols: Vec<Protocol>,
+    /// Training seeds in order.
+    pub train_seeds: Vec<Option<u64>>,
+    /// Episodes per unit.
+    pub episodes: u64,
+    /// Evaluation seed.
+    pub seed: u64,
+}
+
+impl RunIdentity {
+    /// The identity of a run of these inputs.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        scenarios: &[Scenario],
+        methods: &[Method],
+        params: &[ParamSet],
+        protocols: &[Protocol],
+        train_seeds: &[Option<u64>],
+        episodes: u64,
+        seed: u64,
+        agents: &str,
+    ) -> Self {
+        RunIdentity {
+            program: format!(
+                "unforeseen {} (code {})",
+                env!("CARGO_PKG_VERSION"),
+                env!("UNFORESEEN_CODE_FINGERPRINT")
+            ),
+            agents: agents.to_string(),
+            maps: scenarios
+                .iter()
+                .map(|s| {
+                    let text = serde_json::to_string(&s.map).unwrap_or_default();
+                    (s.map.name.clone(), crate::seeds::content_hash(text.as_bytes()))
+                })
+                .collect(),
+            methods: methods.iter().map(|m| m.name().to_string()).collect(),
+            param_sets: params.iter().map(ParamSet::label).collect(),
+            protocols: protocols.to_vec(),
+            train_seeds: train_seeds.to_vec(),
+            episodes,
+            seed,
+        }
+    }
+
+    /// One phrase per field that differs from `other` (`this` is the file's).
+    pub fn differences(&self, other: &RunIdentity) -> Vec<String> {
+        let a = serde_json::to_value(self).unwrap_or_default();
+        let b = serde_json::to_value(other).unwrap_or_default();
+        let short = |v: &serde_json::Value| {
+            let t = v.to_string();
+            if t.chars().count() > 160 {
+                format!("{}...", t.chars().take(160).collect::<String>())
+            } else {
+                t
+            }
+        };
+        let mut out = Vec::new();
+        if let (Some(a), Some(b)) = (a.as_object(), b.as_object()) {
+            for (k, va) in a {
+                let vb = &b[k];
+                if va != vb {
+                    out.push(format!("{k}: the file has {}, this run {}", short(va), short(vb)));
+                }
+            }
+        }
+        out
+    }
+
+    /// The identity as the first line of a results file.
+    fn to_line(&self) -> String {
+        let mut s = serde_json::json!({ "run": self }).to_string();
+        s.push('\n');
+        s
+    }
+}
+
+/// The first line of a results file.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct IdentityLine {
+    run: RunIdentity,
+}
+
+/// A result line read back from a results file, with its text as written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeptLine {
+    /// 1-based line number in the file.
+    pub line: usize,
+    /// The text of the line, newline included, kept byte for byte.
+    pub raw: String,
+    /// The parsed line.
+    pub parsed: ResultLine,
+}
+
+/// The complete lines of a results file: its run identities (one, or one per
+/// concatenated shard) and its result lines.
+#[derive(Debug, Clone, Default)]
+pub struct ResultsFile {
+    /// Identity lines, with their line numbers.
+    pub identities: Vec<(usize, RunIdentity)>,
+    /// Result lines.
+    pub lines: Vec<KeptLine>,
+}
+
+fn results_error(path: &Path, problem: String) -> anyhow::Error {
+    Error::Results {
+        path: path.to_path_buf(),
+        problem,
+    }
+    .into()
+}
+
+/// Reads the complete lines of a results file (a missing file has none; a truncated last
+/// line from a killed run is dropped, so that unit runs again).
+pub fn read_results(path: &Path) -> anyhow::Result<ResultsFile> {
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(ResultsFile::default()),
+        Ok(m) if !m.is_file() => {
+            return Err(Error::NotRegularFile {
+                path: path.to_path_buf(),
+            }
+            .into());
+        }
+        _ => {}
+    }
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut file = ResultsFile::default();
+    for (i, raw) in text.split_inclusive('\n').enumerate() {
+        if !raw.ends_with('\n') {
             break; // truncated by a kill: redo that unit
         }
-        let parsed: ResultLine = serde_json::from_str(line.trim_end()).map_err(|e| {
-            BadInput(format!(
-                "{}:{}: not a batch result line ({e}); remove the line or the file",
-                path.display(),
-                i + 1
-            ))
+        let body = raw.trim_end();
+        if body.starts_with("{\"run\":") {
+            let id: IdentityLine = serde_json::from_str(body).map_err(|e| {
+                results_error(
+                    path,
+                    format!("line {}: not a run identity ({e}); remove the line or the file", i + 1),
+                )
+            })?;
+            file.identities.push((i + 1, id.run));
+            continue;
+        }
+        let parsed: ResultLine = serde_json::from_str(body).map_err(|e| {
+            results_error(
+                path,
+                format!(
+                    "line {}: not a batch result line ({e}); remove the line or the file",
+                    i + 1
+                ),
+            )
         })?;
-        lines.push(parsed);
+        file.lines.push(KeptLine {
+            line: i + 1,
+            raw: raw.to_string(),
+            parsed,
+        });
     }
-    Ok(lines)
+    Ok(file)
+}
+
+/// The result lines of a results file (see [`read_results`]).
+pub fn read_lines(path: &Path) -> anyhow::Result<Vec<ResultLine>> {
+    Ok(read_results(path)?.lines.into_iter().map(|l| l.parsed).collect())
+}
+
+/// The lines of `out` that `--resume` keeps for a run of identity `identity` and units
+/// `units`: refuses a file written by another run (saying what differs), a file that
+/// mixes runs or lacks an identity, and lines that are not units of this run or repeat one.
+pub fn resume_lines(
+    out: &Path,
+    identity: &RunIdentity,
+    units: &[Unit],
+    scenarios: &[Scenario],
+) -> anyhow::Result<Vec<KeptLine>> {
+    let file = read_results(out)?;
+    let fix = "give another --out, or leave out --resume to start it over (the file is replaced)";
+    let Some((first_line, first)) = file.identities.first() else {
+        if file.lines.is_empty() {
+            return Ok(Vec::new());
+        }
+        return Err(results_error(
+            out,
+            format!("--resume: the file does not say which run wrote it (no identity line; an older version?); {fix}"),
+        ));
+    };
+    if let Some((line, other)) = file.identities.iter().find(|(_, id)| id != first) {
+        return Err(results_error(
+            out,
+            format!(
+                "--resume: the file mixes two runs (line {line} differs from line {first_line}: {}); {fix}",
+                other.differences(first).join("; ")
+            ),
+        ));
+    }
+    if first != identity {
+        return Err(results_error(
+            out,
+            format!(
+                "--resume: the file was written by another run ({}); {fix}",
+                first.differences(identity).join("; ")
+            ),
+        ));
+    }
+    let mut seen: BTreeSet<usize> = BTreeSet::new();
+    for l in &file.lines {
+        let unit = units.get(l.parsed.unit).filter(|u| u.key(scenarios) == l.parsed.key());
+        if unit.is_none() {
+            return Err(results_error(
+                out,
+                format!(
+                    "line {}: unit {} ({} {} {}) is not a unit of this run; {fix}",
+                    l.line, l.parsed.unit, l.parsed.scenario, l.parsed.method, l.parsed.param_set
+                ),
+            ));
+        }
+        if !seen.insert(l.parsed.unit) {
+            return Err(results_error(
+                out,
+                format!(
+                    "line {}: unit {} is in the file twice; remove one of its lines",
+                    l.line, l.parsed.unit
+                ),
+            ));
+        }
+    }
+    Ok(file.lines)
 }
 
 fn to_line(r: &ResultLine) -> String {
@@ -480,17 +742,26 @@ fn to_line(r: &ResultLine) -> String {
     s
 }
 
-/// Runs the batch, streaming each finished unit to `out` (appending after the lines
-/// kept by `resume`), then rewrites `out` in canonical order. Returns all lines of
-/// this shard in canonical order.
+/// Runs the batch, streaming each finished unit to `out` after the run's identity and
+/// the lines kept by `resume` (see [`resume_lines`]), then rewrites `out` in canonical
+/// order (kept lines byte for byte). Returns all lines of the file in canonical order.
 pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, quiet: bool) -> anyhow::Result<Vec<ResultLine>> {
-    let mine = cfg.shard_units()?;
-    let kept: Vec<ResultLine> = if resume { read_lines(out)? } else { Vec::new() };
-    let done: BTreeSet<UnitKey> = kept.iter().map(ResultLine::key).collect();
-    let todo: Vec<&Unit> = mine.iter().filter(|u| !done.contains(&u.key(cfg.scenarios))).collect();
+    let all = cfg.units()?;
+    let range = cfg.shard.map_or(0..all.len(), |s| s.range(all.len()));
+    let identity = cfg.identity();
+    let kept: Vec<KeptLine> = if resume {
+        resume_lines(out, &identity, &all, cfg.scenarios)?
+    } else {
+        Vec::new()
+    };
+    let done: BTreeSet<usize> = kept.iter().map(|l| l.parsed.unit).collect();
+    let todo: Vec<&Unit> = all[range].iter().filter(|u| !done.contains(&u.index)).collect();
 
-    // Keep only complete lines, then stream new ones as they finish.
-    crate::report::write_atomic(out, kept.iter().map(to_line).collect::<String>().as_bytes())?;
+    // The identity and the kept lines, then the new lines as they finish.
+    let head: String = std::iter::once(identity.to_line())
+        .chain(kept.iter().map(|l| l.raw.clone()))
+        .collect();
+    crate::report::write_atomic(out, head.as_bytes())?;
     let file = std::fs::OpenOptions::new()
         .append(true)
         .open(out)
@@ -498,23 +769,31 @@ pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, quiet: bool) -> anyh
     let sink = Mutex::new(file);
     let bar = crate::progress::bar(todo.len() as u64, "batch units", quiet);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(cfg.jobs.max(1)).build()?;
-    let fresh: Vec<ResultLine> = pool.install(|| {
+    let fresh: Vec<KeptLine> = pool.install(|| {
         todo.par_iter()
             .map(|u| {
                 let line = run_unit(cfg, u)?;
+                let raw = to_line(&line);
                 let mut f = sink.lock().expect("result file lock");
-                f.write_all(to_line(&line).as_bytes())?;
+                f.write_all(raw.as_bytes())?;
                 f.flush()?;
                 bar.inc(1);
-                Ok(line)
+                Ok(KeptLine {
+                    line: 0,
+                    raw,
+                    parsed: line,
+                })
             })
             .collect::<anyhow::Result<Vec<_>>>()
     })?;
     bar.finish_and_clear();
-    let mut lines: Vec<ResultLine> = kept.into_iter().chain(fresh).collect();
-    lines.sort_by_key(|l| l.unit);
-    crate::report::write_atomic(out, lines.iter().map(to_line).collect::<String>().as_bytes())?;
-    Ok(lines)
+    let mut lines: Vec<KeptLine> = kept.into_iter().chain(fresh).collect();
+    lines.sort_by_key(|l| l.parsed.unit);
+    let text: String = std::iter::once(identity.to_line())
+        .chain(lines.iter().map(|l| l.raw.clone()))
+        .collect();
+    crate::report::write_atomic(out, text.as_bytes())?;
+    Ok(lines.into_iter().map(|l| l.parsed).collect())
 }
 
 /// An expectation checked on the mean over training seeds, with its worst seed.
@@ -688,8 +967,26 @@ pub fn summary_path(out: &Path) -> PathBuf {
 }
 
 /// Loads scenarios from files and folders (every `*.ron` in a folder, sorted), or the
-/// embedded maps when none are given.
+/// embedded maps when none are given. Two scenarios with one name (the same map listed
+/// twice, or maps named alike in different folders) are an [`Error::DuplicateScenario`]:
+/// results and `--resume` tell scenarios apart by name.
 pub fn load_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
+    let scenarios = read_scenarios(paths)?;
+    for (i, s) in scenarios.iter().enumerate() {
+        if let Some(first) = scenarios[..i].iter().find(|f| f.map.name == s.map.name) {
+            return Err(Error::DuplicateScenario {
+                name: s.map.name.clone(),
+                first: first.source.clone(),
+                second: s.source.clone(),
+            }
+            .into());
+        }
+    }
+    Ok(scenarios)
+}
+
+/// The scenarios of `paths`, in order, possibly with repeated names.
+fn read_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
     if paths.is_empty() {
         return unforeseen_sim::embedded::names()
             .iter()

@@ -69,7 +69,7 @@ pub fn evaluate_under(
     seed: u64,
     bar: &ProgressBar,
 ) -> anyhow::Result<Vec<EpisodeResult>> {
-    check_compatible(bundle, &map.name, Discretizer::new(&map.bins)?.n_states())?;
+    check_compatible(bundle, map)?;
     let make = || method.controller(bundle, params);
     evaluate_with(protocol, map, method, params, &make, episodes, seed, bar)
 }
@@ -191,7 +191,7 @@ pub fn trace(
     episode: u64,
 ) -> anyhow::Result<(EpisodeResult, Vec<Tick>)> {
     let disc = Discretizer::new(&map.bins)?;
-    check_compatible(bundle, &map.name, disc.n_states())?;
+    check_compatible(bundle, map)?;
     let mut controller = method.controller(bundle, params)?;
     if protocol.effective(method, params) == Protocol::Continual {
         for ep in 0..episode {
@@ -250,10 +250,9 @@ pub fn learn(
     quiet: bool,
 ) -> anyhow::Result<Vec<LearnPoint>> {
     let disc = Discretizer::new(&map.bins)?;
-    check_compatible(bundle, &map.name, disc.n_states())?;
-    let mut agent = ScaledAgent::new(
-        bundle.world_model.clone(),
-        &bundle.q_learning,
+    check_compatible(bundle, map)?;
+    let mut agent = crate::methods::scaled_agent(
+        bundle,
         ScaledParams {
             learning: true,
             ..params.clone()

@@ -25,16 +25,19 @@
 //!   [`stats`] (mean, 95% Student-t interval, range, worst seed);
 //! * [`report`] writes JSON/CSV atomically and [`plots`] draws SVG figures;
 //! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
-//! * [`cli`] is the command line.
+//! * [`error`] is the library's typed error (what the user can fix);
+//! * [`cli`] is the command line, and alone decides messages and exit codes.
 
 pub mod agent_file;
 pub mod agents;
 pub mod batch;
 pub mod cli;
+pub mod error;
 pub mod experiments;
 pub mod maps;
 pub mod methods;
 pub mod metrics;
+pub mod overrides;
 pub mod plots;
 pub mod progress;
 pub mod protocol;

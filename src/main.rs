@@ -1,7 +1,7 @@
 //! The `unforeseen` command line; see `unforeseen --help`.
 
 use clap::Parser;
-use unforeseen::cli::{Cli, is_bad_input, run};
+use unforeseen::cli::{Cli, exit_code, run};
 
 fn main() {
     // Rust ignores SIGPIPE, so printing into a closed pipe (`unforeseen check-map maps/ | head`)
@@ -20,6 +20,6 @@ fn main() {
     let cli = Cli::parse();
     if let Err(err) = run(cli) {
         eprintln!("error: {err:#}");
-        std::process::exit(if is_bad_input(&err) { 2 } else { 1 });
+        std::process::exit(exit_code(&err));
     }
 }

@@ -6,6 +6,7 @@ use unforeseen_agent::params::{GateLearning, GateMode, ReasoningMode, ScaledPara
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 
+use crate::error::Error;
 use crate::reference::{BrakeOnPedestrian, NeverBrake};
 
 /// A method (or ablation) the runner can drive.
@@ -146,19 +147,14 @@ impl Method {
     /// references take only the factor sizes of its world model).
     pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> anyhow::Result<Box<dyn Controller>> {
         let scaled = |params: ScaledParams| -> anyhow::Result<Box<dyn Controller>> {
-            Ok(Box::new(ScaledAgent::new(
-                bundle.world_model.clone(),
-                &bundle.q_learning,
-                params,
-            )?))
+            Ok(Box::new(scaled_agent(bundle, params)?))
         };
         Ok(match self {
             Method::QLearning => Box::new(bundle.q_learning.clone()),
             Method::BayesRl => Box::new(bundle.bayes_rl.clone()),
-            Method::BayesRlFactored => Box::new(bundle.bayes_rl_factored.clone().ok_or_else(|| {
-                crate::cli::BadInput(
-                    "this agent file has no factored Bayesian-RL model; retrain it with `unforeseen train`".into(),
-                )
+            Method::BayesRlFactored => Box::new(bundle.bayes_rl_factored.clone().ok_or_else(|| Error::Agent {
+                problem: "this agent file has no factored Bayesian-RL model".into(),
+                fix: "retrain it with `unforeseen train`".into(),
             })?),
             Method::Scaled => scaled(params.clone())?,
             Method::ScaledAlways => scaled(ScaledParams {
@@ -190,6 +186,15 @@ impl Method {
             }
         })
     }
+}
+
+/// The paper's agent from a trained bundle; a failure (parameters that do not fit the
+/// agent's world model, e.g. `--set gate_factor` naming no factor) is an [`Error::Agent`].
+pub fn scaled_agent(bundle: &AgentBundle, params: ScaledParams) -> Result<ScaledAgent, Error> {
+    ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params).map_err(|e| Error::Agent {
+        problem: format!("cannot build the scaled agent from this agent file: {e}"),
+        fix: "check the --set overrides against the agent's world model, or retrain it".into(),
+    })
 }
 
 impl std::fmt::Display for Method {

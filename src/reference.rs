@@ -22,7 +22,7 @@
 use unforeseen_agent::controller::{Controller, Decision};
 use unforeseen_sim::Action;
 
-use crate::cli::BadInput;
+use crate::error::Error;
 
 /// A one-hot distribution over the three actions at `action` (the policy a scripted
 /// controller acts from).
@@ -54,14 +54,17 @@ impl BrakeOnPedestrian {
     /// A controller for observations of factor sizes `[n_d, n_v, n_L, n_p]` (the order
     /// of the joint index: d, v, L, p). Fails unless there are four factors of at least
     /// the paper's minimal sizes (d has "arrived" and "not arrived", L and p are binary).
-    pub fn new(sizes: &[usize]) -> Result<Self, BadInput> {
+    pub fn new(sizes: &[usize]) -> Result<Self, Error> {
         match *sizes {
             [n_d, n_v, 2, 2] if n_d >= 2 && n_v >= 1 => Ok(Self {
                 sizes: [n_d, n_v, 2, 2],
             }),
-            _ => Err(BadInput(format!(
-                "brake-on-pedestrian needs the four factors d, v, L, p (L and p binary), got factor sizes {sizes:?}"
-            ))),
+            _ => Err(Error::Agent {
+                problem: format!(
+                    "brake-on-pedestrian needs the four factors d, v, L, p (L and p binary), got factor sizes {sizes:?}"
+                ),
+                fix: "use an agent of the intersection's d, v, L, p state space".into(),
+            }),
         }
     }
 

@@ -13,10 +13,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     if let Ok(meta) = std::fs::metadata(path)
         && !meta.is_file()
     {
-        return Err(crate::cli::BadInput(format!(
-            "{}: exists and is not a regular file; write results to a file path",
-            path.display()
-        ))
+        return Err(crate::error::Error::NotRegularFile {
+            path: path.to_path_buf(),
+        }
         .into());
     }
     let dir = match path.parent() {

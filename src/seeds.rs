@@ -26,6 +26,13 @@ pub fn episode_seed(seed: u64, stream: &str, episode: u64) -> u64 {
     mix(fnv1a(&[&seed.to_le_bytes(), stream.as_bytes(), &episode.to_le_bytes()]))
 }
 
+/// A 64-bit content hash of `bytes` as 16 hex digits (FNV-1a then SplitMix64): stable
+/// across runs, builds and platforms, for telling files and settings apart (not for
+/// security).
+pub fn content_hash(bytes: &[u8]) -> String {
+    format!("{:016x}", mix(fnv1a(&[bytes])))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

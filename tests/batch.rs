@@ -34,6 +34,7 @@ fn config<'a>(scenarios: &'a [Scenario], params: &'a [ParamSet], jobs: usize, sh
         seed: 9,
         jobs,
         shard,
+        agents_identity: "the shared test agent, training seed 7".into(),
     }
 }
 
@@ -96,10 +97,17 @@ fn resume_after_a_truncated_file_completes_the_set_without_duplicates() {
     let full = dir.path().join("full.jsonl");
     let whole = run(&config(&scenarios, &params, 2, None), &full, false, true).unwrap();
 
-    // Simulate a kill: two complete lines and half of the third.
+    // Simulate a kill: the run's identity, two complete lines and half of the third.
     let text = std::fs::read_to_string(&full).unwrap();
     let lines: Vec<&str> = text.split_inclusive('\n').collect();
-    let cut = format!("{}{}{}", lines[0], lines[1], &lines[2][..lines[2].len() / 2]);
+    assert!(lines[0].starts_with("{\"run\":"), "{}", lines[0]);
+    let cut = format!(
+        "{}{}{}{}",
+        lines[0],
+        lines[1],
+        lines[2],
+        &lines[3][..lines[3].len() / 2]
+    );
     let partial = dir.path().join("partial.jsonl");
     std::fs::write(&partial, cut).unwrap();
     assert_eq!(read_lines(&partial).unwrap().len(), 2);
@@ -111,6 +119,9 @@ fn resume_after_a_truncated_file_completes_the_set_without_duplicates() {
     assert_eq!(keys.len(), whole.len(), "no duplicates");
     assert_eq!(without_timing(&resumed), without_timing(&whole));
     assert_eq!(file_without_timing(&partial), without_timing(&whole));
+    // The kept lines are the old bytes (their wall-clock timing included).
+    let after = std::fs::read_to_string(&partial).unwrap();
+    assert!(after.starts_with(&format!("{}{}{}", lines[0], lines[1], lines[2])));
 }
 
 #[test]
@@ -256,4 +267,138 @@ fn the_cli_fails_when_an_expectation_fails_and_names_it() {
             && err.contains("min 1"),
         "{err}"
     );
+}
+
+/// Issue 12: resume matched lines on (map name, method, parameters) only, so another
+/// --episodes, --seed, --agent or --set sweep kept the old lines, and kept lines were
+/// rewritten with last-digit float changes. Now a results file names its run, a file
+/// of another run is refused saying what differs (and left as it was), and a resume
+/// with nothing to do leaves the file byte for byte.
+#[test]
+fn resume_refuses_another_runs_file_and_keeps_its_own_byte_for_byte() {
+    let scenarios = scenarios();
+    let params = vec![ParamSet(Vec::new())];
+    let methods = [Method::NeverBrake, Method::QLearning];
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.jsonl");
+    let base = || BatchConfig {
+        methods: &methods,
+        ..config(&scenarios, &params, 2, None)
+    };
+    run(&base(), &out, false, true).unwrap();
+    let before = std::fs::read_to_string(&out).unwrap();
+    run(&base(), &out, true, true).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(&out).unwrap(),
+        before,
+        "nothing to do: same bytes"
+    );
+
+    let sweep = sweep(&["horizon=1,2".to_string()]).unwrap();
+    let scaled = [Method::NeverBrake, Method::Scaled];
+    let one_map = &scenarios[..1];
+    let refused = |cfg: BatchConfig<'_>, field: &str| {
+        let err = run(&cfg, &out, true, true).expect_err(field);
+        let message = format!("{err:#}");
+        assert_eq!(unforeseen::cli::exit_code(&err), 2, "{message}");
+        assert!(
+            message.contains("another run") && message.contains(&format!("{field}:")) && message.contains("--out"),
+            "{field}: {message}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&out).unwrap(),
+            before,
+            "{field}: the file is left alone"
+        );
+    };
+    refused(BatchConfig { episodes: 4, ..base() }, "episodes");
+    refused(BatchConfig { seed: 10, ..base() }, "seed");
+    refused(
+        BatchConfig {
+            agents_identity: "another agent".into(),
+            ..base()
+        },
+        "agents",
+    );
+    refused(
+        BatchConfig {
+            params: &sweep,
+            methods: &scaled,
+            ..base()
+        },
+        "param_sets",
+    );
+    refused(
+        BatchConfig {
+            scenarios: one_map,
+            ..base()
+        },
+        "maps",
+    );
+    let mut edited = scenarios.clone();
+    edited[0].map.reward.goal += 1.0;
+    refused(
+        BatchConfig {
+            scenarios: &edited,
+            ..base()
+        },
+        "maps",
+    );
+
+    // A file that does not name its run, one that repeats a unit, and one with a line of
+    // another run are refused too.
+    let lines: Vec<&str> = before.split_inclusive('\n').collect();
+    for (name, text, needle) in [
+        ("no identity", lines[1..].concat(), "does not say which run"),
+        ("repeated unit", format!("{before}{}", lines[1]), "twice"),
+        (
+            "foreign unit",
+            format!("{before}{}", lines[1].replace("\"unit\":0", "\"unit\":7")),
+            "not a unit of this run",
+        ),
+    ] {
+        std::fs::write(&out, &text).unwrap();
+        let err = run(&base(), &out, true, true).expect_err(name);
+        assert!(format!("{err:#}").contains(needle), "{name}: {err:#}");
+        assert_eq!(unforeseen::cli::exit_code(&err), 2);
+    }
+}
+
+/// Issue 12: two maps with one name in different folders shared result keys (the
+/// second map's units were skipped on resume without a warning).
+#[test]
+fn two_maps_with_one_name_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let jay = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps").join("jaywalk.ron");
+    let copy = dir.path().join("jaywalk.ron");
+    std::fs::copy(&jay, &copy).unwrap();
+    let err = load_scenarios(&[jay.clone(), copy.clone()]).unwrap_err();
+    let message = format!("{err:#}");
+    assert_eq!(unforeseen::cli::exit_code(&err), 2);
+    assert!(
+        message.contains("'jaywalk'") && message.contains(&copy.display().to_string()) && message.contains("name:"),
+        "{message}"
+    );
+    // The same map listed twice (a folder and one of its files) too.
+    let folder = jay.parent().unwrap().to_path_buf();
+    assert!(load_scenarios(&[folder, jay]).is_err());
+}
+
+/// Results never replace, or block on, something that is not a regular file.
+#[test]
+fn results_must_go_to_a_regular_file() {
+    let scenarios = scenarios();
+    let params = vec![ParamSet(Vec::new())];
+    let methods = [Method::NeverBrake];
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = BatchConfig {
+        methods: &methods,
+        ..config(&scenarios, &params, 1, None)
+    };
+    for resume in [false, true] {
+        let err = run(&cfg, dir.path(), resume, true).unwrap_err();
+        assert!(format!("{err:#}").contains("not a regular file"), "{err:#}");
+        assert_eq!(unforeseen::cli::exit_code(&err), 2);
+    }
+    assert!(dir.path().is_dir());
 }

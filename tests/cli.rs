@@ -74,6 +74,13 @@ fn bad_sweeps_and_job_counts_exit_2() {
         &batch(&["--set", "max_scaling_iters=4294967297"]),
         &["max_scaling_iters", "at most"],
     );
+    // A cross product beyond the bound is refused before anything is built.
+    let many: String = (1..=200).map(|i| format!("0.{i:03}")).collect::<Vec<_>>().join(",");
+    let (omega, gamma) = (format!("omega={many}"), format!("gamma={many}"));
+    assert_bad_input(
+        &batch(&["--set", &omega, "--set", &gamma]),
+        &["40000 parameter sets", "at most 10000"],
+    );
 }
 
 #[test]
@@ -202,21 +209,31 @@ fn export_model_writes_what_inspect_reads_and_rejects_bad_observations() {
 #[test]
 fn a_closed_output_pipe_ends_the_program_quietly() {
     use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
-        .args(["check-map", "maps/jaywalk.ron", "--survivability-episodes", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run the binary");
-    // Close the reading end before the program prints (it first reads and checks the map).
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.success() && !err.contains("panicked"),
-        "{:?}: {err}",
-        out.status
-    );
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("m.json");
+    std::fs::write(&model, r#"{"A": [[1,0],[0,1]], "B": [[[1,0],[0,1]]], "C": [0,0], "D": [0.5,0.5], "obs": [0], "actions": [], "policy_len": 1, "gamma": 1.0}"#).unwrap();
+    let m = model.to_str().unwrap();
+    // `check-map ... | head` and `inspect --model m.json | head`.
+    for args in [
+        &["check-map", "maps/jaywalk.ron", "--survivability-episodes", "0"][..],
+        &["inspect", "--model", m][..],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run the binary");
+        // Close the reading end before the program prints (it first reads its input).
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            out.status.success() && !err.contains("panicked"),
+            "{args:?}: {:?}: {err}",
+            out.status
+        );
+    }
 }
 
 #[test]
@@ -240,4 +257,60 @@ fn only_regular_files_are_read_or_replaced() {
         &["taken", "not a regular file"],
     );
     assert!(out.is_dir());
+}
+
+/// Issue 12: flags and maps that asked for more memory than any machine has aborted
+/// (exit 134): a VMP window of 99999999999 ticks (2.4 TB), a map of 64 x 64 bin edges
+/// (which check-map accepted). Both are refused up front with the bound and its reason.
+#[test]
+fn allocation_bounds_are_stated_and_enforced() {
+    assert_bad_input(
+        &unforeseen(&["eval", "--set", "vmp_window=99999999999", "--episodes", "1"]),
+        &["vmp_window", "1..=1000"],
+    );
+    assert_bad_input(
+        &unforeseen(&[
+            "batch",
+            "maps/jaywalk.ron",
+            "--method",
+            "never-brake",
+            "--episodes",
+            "1",
+            "--set",
+            "max_scaling_iters=4000000",
+        ]),
+        &["max_scaling_iters", "1..=10000"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("fine_bins.ron");
+    let edges = |step: f64| {
+        (0..64)
+            .map(|i| format!("{:.1}", i as f64 * step))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    std::fs::write(
+        &map,
+        format!(
+            "Map(bins: (distance_edges: [{}], speed_edges: [{}]))",
+            edges(1.0),
+            edges(0.1)
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("agent.ron");
+    assert_bad_input(
+        &unforeseen(&[
+            "train",
+            "--map",
+            map.to_str().unwrap(),
+            "--episodes",
+            "1",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        &["fine_bins.ron", "bins", "at most 1024"],
+    );
+    assert!(!out.exists());
 }

@@ -26,3 +26,26 @@ pub fn bundle() -> &'static AgentBundle {
         train(&map, &small_config(7)).expect("training").0
     })
 }
+
+/// A map file of a tiny state space (d: 3 bins, v: 2, so 24 states) on the embedded
+/// intersection, with short episodes: for tests that build many agents or episodes.
+pub const TINY_MAP: &str = "Map(base: \"intersection\", name: \"tiny\", bins: (distance_edges: [0.0, 45.0], speed_edges: [4.5]), episode: (max_steps: 12))";
+
+/// The tiny map.
+pub fn tiny_map() -> unforeseen_sim::Map {
+    let embedded = |base: &str| {
+        let name = base.strip_suffix(".ron").unwrap_or(base);
+        unforeseen_sim::embedded::source(name).map(|t| (format!("embedded:{name}"), t.to_string()))
+    };
+    unforeseen_sim::Map::from_str_named("tiny.ron", TINY_MAP, &embedded).expect("the tiny map is valid")
+}
+
+/// An agent trained for 30 episodes on the tiny map (seed 3), as agent-file text.
+pub fn tiny_agent_text() -> &'static str {
+    static TEXT: OnceLock<String> = OnceLock::new();
+    TEXT.get_or_init(|| {
+        let mut cfg = TrainConfig::new(30, 3);
+        cfg.quiet = true;
+        train(&tiny_map(), &cfg).expect("training").0.to_ron_string()
+    })
+}

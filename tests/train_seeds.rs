@@ -201,11 +201,9 @@ fn batch_over_training_seeds_writes_one_line_per_seed_and_checks_the_mean() {
     ];
     let stdout = ok(&unforeseen(&args, "2"));
     assert!(stdout.contains("2 expectation(s) checked"), "{stdout}");
-    let lines: Vec<Value> = std::fs::read_to_string(&out)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("{\"run\":"), "the run's identity comes first");
+    let lines: Vec<Value> = text.lines().skip(1).map(|l| serde_json::from_str(l).unwrap()).collect();
     // q-learning: one line per seed covering both protocols; scaled: per protocol and seed.
     let ids: Vec<(String, String, u64)> = lines
         .iter()
@@ -252,7 +250,9 @@ fn batch_over_training_seeds_writes_one_line_per_seed_and_checks_the_mean() {
     resume.push("--resume");
     ok(&unforeseen(&resume, "1"));
     let strip_lines = |t: &str| -> Vec<Value> {
+        // Result lines only (concatenated shards carry one identity line each).
         t.lines()
+            .filter(|l| !l.starts_with("{\"run\":"))
             .map(|l| {
                 let mut v: Value = serde_json::from_str(l).unwrap();
                 strip(&mut v);
@@ -261,10 +261,7 @@ fn batch_over_training_seeds_writes_one_line_per_seed_and_checks_the_mean() {
             })
             .collect()
     };
-    assert_eq!(
-        strip_lines(&before),
-        strip_lines(&std::fs::read_to_string(&out).unwrap())
-    );
+    assert_eq!(before, std::fs::read_to_string(&out).unwrap(), "byte for byte");
 
     // Shards (each trains or loads only its seeds) concatenate into the whole file.
     let mut parts = String::new();
@@ -276,4 +273,15 @@ fn batch_over_training_seeds_writes_one_line_per_seed_and_checks_the_mean() {
         parts.push_str(&std::fs::read_to_string(&part).unwrap());
     }
     assert_eq!(strip_lines(&parts), strip_lines(&before));
+
+    // The concatenated parts resume as one run (each part names the same run): nothing
+    // is left to run, and the rewritten file has one identity line and the same lines.
+    let joined = dir.path().join("joined.jsonl");
+    std::fs::write(&joined, &parts).unwrap();
+    let mut whole: Vec<&str> = args[..args.len() - 1].to_vec();
+    whole.extend([joined.to_str().unwrap(), "--resume"]);
+    ok(&unforeseen(&whole, "1"));
+    let rewritten = std::fs::read_to_string(&joined).unwrap();
+    assert_eq!(rewritten.matches("{\"run\":").count(), 1);
+    assert_eq!(strip_lines(&rewritten), strip_lines(&before));
 }

@@ -3,15 +3,19 @@
 //! tick on the posterior-mean MDP (value iteration warm-started from the last values,
 //! or finite-horizon lookahead). Terminal transitions lead to an absorbing state of value 0.
 
+use crate::check;
 use crate::controller::{Controller, Decision, one_hot};
-use crate::error::{AgentError, ParamError};
+use crate::error::{AgentError, FieldError, ParamError};
+use crate::limits::{MAX_ACTIONS, MAX_STATES};
 use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{BayesModel, BayesRlParams, ModelPriors, Planner};
 use serde::{Deserialize, Serialize};
 
-/// Model-based Bayesian RL.
+/// Model-based Bayesian RL. Reading one (serde) checks every stored value (see
+/// [`BayesRl::try_from`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "BayesRlRepr")]
 pub struct BayesRl {
     n_states: usize,
     n_actions: usize,
@@ -32,6 +36,115 @@ pub struct BayesRl {
     last: Option<(usize, usize)>,
 }
 
+/// The stored fields of a [`BayesRl`], before they are checked.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, rename = "BayesRl")]
+struct BayesRlRepr {
+    n_states: usize,
+    n_actions: usize,
+    params: BayesRlParams,
+    counts: Vec<f64>,
+    terminal: Vec<f64>,
+    visits: Vec<f64>,
+    reward_sum: Vec<f64>,
+    factored: Option<WorldModel>,
+}
+
+impl TryFrom<BayesRlRepr> for BayesRl {
+    type Error = FieldError;
+    /// Sizes in range; parameters valid; `counts` of `n_states * n_actions * n_states`
+    /// and `terminal`, `visits`, `reward_sum` of `n_states * n_actions` entries; counts
+    /// finite and >= 0, reward sums finite; each pair's visits equal to its terminal
+    /// count plus its successor counts (else the posterior-mean rows do not sum to 1 and
+    /// planning diverges); a factored model exactly when the parameters ask for one, of
+    /// the same sizes.
+    fn try_from(r: BayesRlRepr) -> Result<Self, FieldError> {
+        check::size(
+            "n_states",
+            r.n_states,
+            1,
+            MAX_STATES,
+            "the joint states of the map's bins",
+        )?;
+        check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
+        r.params.check().map_err(|e| FieldError::from(e).within("params"))?;
+        for (name, x) in [
+            ("params.prior_concentration", r.params.prior_concentration),
+            ("params.reward_prior", r.params.reward_prior),
+        ] {
+            if !check::bounded(x) {
+                return Err(FieldError::new(
+                    name,
+                    format!("is {x}; must be at most {:e} in size", crate::limits::MAX_VALUE),
+                ));
+            }
+        }
+        let (n, na) = (r.n_states, r.n_actions);
+        let sa = n * na;
+        let why = format!("n_states x n_actions = {n} x {na}");
+        check::len("counts", r.counts.len(), sa * n, &format!("{why} x n_states"))?;
+        check::len("terminal", r.terminal.len(), sa, &why)?;
+        check::len("visits", r.visits.len(), sa, &why)?;
+        check::len("reward_sum", r.reward_sum.len(), sa, &why)?;
+        check::counts("counts", &r.counts)?;
+        check::counts("terminal", &r.terminal)?;
+        check::counts("visits", &r.visits)?;
+        check::finite("reward_sum", &r.reward_sum)?;
+        for i in 0..sa {
+            let seen = r.terminal[i] + r.counts[i * n..(i + 1) * n].iter().sum::<f64>();
+            if (r.visits[i] - seen).abs() > 1e-9 * r.visits[i].max(1.0) {
+                return Err(FieldError::new(
+                    format!("visits[{i}]"),
+                    format!(
+                        "is {}, but state {} action {} has {seen} recorded outcomes (terminal plus successor counts); they must be equal",
+                        r.visits[i],
+                        i / na,
+                        i % na
+                    ),
+                ));
+            }
+        }
+        match (&r.params.model, &r.factored) {
+            (BayesModel::Flat, None) => {}
+            (BayesModel::Factored(st), Some(m)) => {
+                if st != m.structure() || m.n_actions() != na {
+                    return Err(FieldError::new(
+                        "factored",
+                        "its structure or actions differ from params.model's",
+                    ));
+                }
+                if st.joint_size() != n {
+                    return Err(FieldError::new(
+                        "params.model",
+                        format!(
+                            "the factored structure has {} joint states, n_states is {n}",
+                            st.joint_size()
+                        ),
+                    ));
+                }
+            }
+            (BayesModel::Flat, Some(_)) => {
+                return Err(FieldError::new("factored", "present, but params.model is Flat"));
+            }
+            (BayesModel::Factored(_), None) => {
+                return Err(FieldError::new("factored", "missing, but params.model is Factored"));
+            }
+        }
+        Ok(BayesRl {
+            n_states: n,
+            n_actions: na,
+            params: r.params,
+            counts: r.counts,
+            terminal: r.terminal,
+            visits: r.visits,
+            reward_sum: r.reward_sum,
+            factored: r.factored,
+            cache: None,
+            last: None,
+        })
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 struct Cache {
     /// Posterior-mean transition to non-terminal successors `[(s * A + a) * N + s']`.
@@ -46,8 +159,11 @@ impl BayesRl {
     /// A posterior with prior counts only.
     pub fn new(n_states: usize, n_actions: usize, params: BayesRlParams) -> Result<BayesRl, AgentError> {
         params.check()?;
-        if n_states == 0 || n_actions == 0 {
-            return Err(ParamError::new("n_states/n_actions", 0, ">= 1").into());
+        if !(1..=MAX_STATES).contains(&n_states) {
+            return Err(ParamError::new("n_states", n_states, "in 1..=1024 (see limits::MAX_STATES)").into());
+        }
+        if !(1..=MAX_ACTIONS).contains(&n_actions) {
+            return Err(ParamError::new("n_actions", n_actions, "in 1..=16 (see limits::MAX_ACTIONS)").into());
         }
         let factored = match &params.model {
             BayesModel::Flat => None,
@@ -84,6 +200,14 @@ impl BayesRl {
     /// Parameters.
     pub fn params(&self) -> &BayesRlParams {
         &self.params
+    }
+    /// Number of states.
+    pub fn n_states(&self) -> usize {
+        self.n_states
+    }
+    /// Number of actions.
+    pub fn n_actions(&self) -> usize {
+        self.n_actions
     }
 
     /// Update the Dirichlet counts and the running mean reward with one transition.

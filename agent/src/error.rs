@@ -24,12 +24,57 @@ impl ParamError {
     }
 }
 
+/// A stored value of the wrong shape or out of range, found when reading a persisted
+/// learner (see [`crate::persist`]). `path` names the field inside the learner, e.g.
+/// `table[17]` or `a_counts[3,2]`; the loader prefixes the learner's own path
+/// (`q_learning.table[17]`).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{path}: {message}")]
+pub struct FieldError {
+    /// Field path, e.g. `cpt[2][5]`.
+    pub path: String,
+    /// What is wrong, e.g. `must be a finite count >= 0, found NaN`.
+    pub message: String,
+}
+
+impl FieldError {
+    pub(crate) fn new(path: impl Into<String>, message: impl Into<String>) -> Self {
+        Self {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The same error one level down: `prefix.path` (or `prefix[i]` paths as given).
+    pub fn within(mut self, prefix: &str) -> Self {
+        if !prefix.is_empty() {
+            self.path = if self.path.is_empty() {
+                prefix.to_string()
+            } else if self.path.starts_with('[') {
+                format!("{prefix}{}", self.path)
+            } else {
+                format!("{prefix}.{}", self.path)
+            };
+        }
+        self
+    }
+}
+
+impl From<ParamError> for FieldError {
+    fn from(e: ParamError) -> Self {
+        FieldError::new(e.name, format!("is {}; must be {}", e.value, e.expected))
+    }
+}
+
 /// Errors building or using a world model or an agent.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum AgentError {
     /// A hyperparameter is out of range.
     #[error(transparent)]
     Param(#[from] ParamError),
+    /// A stored value is of the wrong shape or out of range (a damaged agent file).
+    #[error(transparent)]
+    Field(#[from] FieldError),
     /// The factor structure is invalid (bad parent index, cycle, zero size...).
     #[error("invalid structure: {0}")]
     Structure(String),
@@ -66,11 +111,24 @@ pub enum PersistError {
         /// Version this build reads.
         expected: u32,
     },
-    /// The file is not a valid bundle; the message names `line:col`.
+    /// The file is not a valid bundle (syntax, types, unknown fields); the message names
+    /// `line:col` and, when known, the field.
     #[error("corrupt agent bundle: {message}")]
     Corrupt {
         /// Parser message including `line:col`.
         message: String,
+    },
+    /// The file parses but a value is of the wrong shape or out of range; `path` names
+    /// the field from the top of the bundle, e.g. `world_model.a_counts[3,2]`.
+    #[error("invalid agent bundle: {0}")]
+    Invalid(FieldError),
+    /// The file is larger than any agent this build can write.
+    #[error("{bytes} bytes is larger than any agent file (at most {limit} bytes)")]
+    TooLarge {
+        /// Size of the input.
+        bytes: usize,
+        /// [`crate::persist::MAX_FILE_BYTES`].
+        limit: usize,
     },
 }
 

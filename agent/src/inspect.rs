@@ -176,6 +176,14 @@ pub fn validate(m: &InspectModel) -> Result<GenerativeModel, InspectError> {
     if !(1..=8).contains(&m.policy_len) {
         return Err(invalid(format!("policy_len = {} (must be in 1..=8)", m.policy_len)));
     }
+    if crate::limits::policies(m.B.len(), m.policy_len).is_none() {
+        return Err(invalid(format!(
+            "{} actions ^ policy_len {} is more than {} policies (limits::MAX_POLICIES)",
+            m.B.len(),
+            m.policy_len,
+            crate::limits::MAX_POLICIES
+        )));
+    }
     if !(m.gamma > 0.0 && m.gamma.is_finite()) {
         return Err(invalid(format!("gamma = {} (must be finite and > 0)", m.gamma)));
     }

@@ -9,7 +9,7 @@
 //! Module map (named after the paper): [`maths`], [`params`], [`structure`], [`model`], [`transition`] (factored `B`),
 //! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
-//! [`scaled`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`].
+//! [`scaled`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
 //!
 //! ```
 //! use unforeseen_agent::{controller::Controller, model::WorldModel, params::*,
@@ -25,11 +25,13 @@
 //! assert!(d.action < 3);
 //! ```
 pub mod bayes_rl;
+mod check;
 pub mod controller;
 pub mod error;
 pub mod gate;
 pub mod inspect;
 pub mod learning;
+pub mod limits;
 pub mod maths;
 pub mod model;
 pub mod params;

@@ -2,7 +2,9 @@
 //! factor CPTs with Dirichlet counts, the joint `B[u]` materialised from them,
 //! the observation model `A` with Dirichlet counts, preferences `C` and the state prior `D`.
 
-use crate::error::{AgentError, ParamError};
+use crate::check;
+use crate::error::{AgentError, FieldError, ParamError};
+use crate::limits::{MAX_ACTIONS, MAX_STATES, MAX_VALUE};
 use crate::maths::{ln, log_softmax};
 use crate::params::ModelPriors;
 use crate::structure::{Parent, Structure};
@@ -85,16 +87,130 @@ impl GenerativeModel {
 }
 
 #[derive(Serialize, Deserialize, Clone)]
+#[serde(deny_unknown_fields, rename = "WorldModel")]
 struct WorldModelRepr {
     structure: Structure,
     n_actions: usize,
     priors: ModelPriors,
     cpt: Vec<Vec<f64>>,
+    #[serde(deserialize_with = "checked_matrix")]
     a_counts: DMatrix<f64>,
     c: Vec<f64>,
     d_counts: Vec<f64>,
     #[serde(default)]
     terminal: Vec<usize>,
+}
+
+/// A `DMatrix` stored as nalgebra writes it, `(data, nrows, ncols)` in column-major
+/// order, checking `nrows * ncols` without overflow (nalgebra's own reader multiplies
+/// unchecked: a damaged file could claim a `2^32 x 2^32` matrix with no data).
+fn checked_matrix<'de, D: serde::Deserializer<'de>>(de: D) -> Result<DMatrix<f64>, D::Error> {
+    use serde::de::Error;
+    let (data, nrows, ncols): (Vec<f64>, usize, usize) = Deserialize::deserialize(de)?;
+    if nrows.checked_mul(ncols) != Some(data.len()) {
+        return Err(D::Error::custom(format!(
+            "a {nrows} x {ncols} matrix needs {nrows} x {ncols} entries, found {}",
+            data.len()
+        )));
+    }
+    Ok(DMatrix::from_vec(nrows, ncols, data))
+}
+
+/// Checks the stored fields of a world model (names as in the file), before anything
+/// is computed from them: sizes within [`crate::limits`], CPTs of the structure's
+/// shape, `A`'s columns and `D` positive finite counts, `C` a normalised log distribution,
+/// terminal states in range.
+fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
+    let n = r.structure.joint_size();
+    check::size(
+        "structure",
+        n,
+        1,
+        MAX_STATES,
+        "joint states: the product of the factor sizes",
+    )?;
+    check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
+    r.priors.check().map_err(|e| FieldError::from(e).within("priors"))?;
+    check::finite("priors.transition_concentration", &[r.priors.transition_concentration])
+        .and(check::finite("priors.a_concentration", &[r.priors.a_concentration]))
+        .map_err(|e| FieldError::new(e.path.trim_end_matches("[0]"), e.message))?;
+    if let Some(d) = &r.priors.d {
+        check::len("priors.d", d.len(), n, "one prior probability per joint state")?;
+    }
+    let factors = r.structure.factors();
+    check::len(
+        "cpt",
+        r.cpt.len(),
+        factors.len(),
+        "one table per factor of the structure",
+    )?;
+    for (f, counts) in r.cpt.iter().enumerate() {
+        let path = format!("cpt[{f}]");
+        let configs = r.structure.n_configs(f, r.n_actions);
+        let want = check::product(&path, configs, factors[f].size)?;
+        check::len(
+            &path,
+            counts.len(),
+            want,
+            &format!(
+                "{configs} parent configurations x {} values of factor `{}`",
+                factors[f].size, factors[f].name
+            ),
+        )?;
+        check::counts(&path, counts)?;
+    }
+    let (no, ns) = (r.a_counts.nrows(), r.a_counts.ncols());
+    if ns != n || !(1..=MAX_STATES).contains(&no) {
+        return Err(FieldError::new(
+            "a_counts",
+            format!("is {no} x {ns}; must be n_obs x {n} (one column per joint state, 1..={MAX_STATES} observations)"),
+        ));
+    }
+    for (s, col) in r.a_counts.column_iter().enumerate() {
+        if let Some(o) = col.iter().position(|x| !(0.0..=MAX_VALUE).contains(x)) {
+            return Err(FieldError::new(
+                format!("a_counts[{o},{s}]"),
+                format!("must be a finite count in [0, {MAX_VALUE:e}], found {}", col[o]),
+            ));
+        }
+        let z: f64 = col.sum();
+        if !(z > 0.0 && z.is_finite()) {
+            return Err(FieldError::new(
+                format!("a_counts[..,{s}]"),
+                format!("column {s} sums to {z}; each state's observation counts need a positive finite total"),
+            ));
+        }
+    }
+    check::len(
+        "c",
+        r.c.len(),
+        no,
+        "one log preference per observation (rows of a_counts)",
+    )?;
+    check::finite("c", &r.c)?;
+    let m = r.c.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let lse = m + r.c.iter().map(|v| (v - m).exp()).sum::<f64>().ln();
+    if lse.abs() > 1e-6 {
+        return Err(FieldError::new(
+            "c",
+            format!("is not a normalised log distribution: ln Σ exp(C) = {lse}, must be 0 (± 1e-6)"),
+        ));
+    }
+    check::len("d_counts", r.d_counts.len(), n, "one count per joint state")?;
+    check::counts("d_counts", &r.d_counts)?;
+    if r.d_counts.iter().sum::<f64>() <= 0.0 {
+        return Err(FieldError::new(
+            "d_counts",
+            "all zero; the initial-state counts need a positive total",
+        ));
+    }
+    if let Some(i) = r.terminal.iter().position(|&s| s >= n) {
+        return Err(FieldError::new(
+            format!("terminal[{i}]"),
+            format!("state {} is out of range (0..{n})", r.terminal[i]),
+        ));
+    }
+    Ok(())
 }
 
 /// The agent's world model (§II-A, §V): Dirichlet-count CPTs per factor, `A` counts,
@@ -135,43 +251,9 @@ impl From<WorldModel> for WorldModelRepr {
 }
 
 impl TryFrom<WorldModelRepr> for WorldModel {
-    type Error = AgentError;
-    fn try_from(r: WorldModelRepr) -> Result<Self, AgentError> {
-        let n = r.structure.joint_size();
-        for (f, counts) in r.cpt.iter().enumerate() {
-            if f >= r.structure.factors().len() {
-                break;
-            }
-            let want = r.structure.n_configs(f, r.n_actions) * r.structure.factors()[f].size;
-            if counts.len() != want {
-                return Err(AgentError::SizeMismatch {
-                    what: format!("CPT counts of factor {f}"),
-                    expected: want,
-                    found: counts.len(),
-                });
-            }
-        }
-        if r.cpt.len() != r.structure.factors().len() {
-            return Err(AgentError::SizeMismatch {
-                what: "number of CPTs".into(),
-                expected: r.structure.factors().len(),
-                found: r.cpt.len(),
-            });
-        }
-        if r.terminal.iter().any(|&s| s >= n) {
-            return Err(AgentError::OutOfRange {
-                what: "terminal state",
-                index: n,
-                size: n,
-            });
-        }
-        if r.a_counts.ncols() != n || r.c.len() != r.a_counts.nrows() || r.d_counts.len() != n {
-            return Err(AgentError::SizeMismatch {
-                what: "A/C/D sizes".into(),
-                expected: n,
-                found: r.a_counts.ncols(),
-            });
-        }
+    type Error = FieldError;
+    fn try_from(r: WorldModelRepr) -> Result<Self, FieldError> {
+        check_repr(&r)?;
         let mut w = WorldModel {
             gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], r.c, vec![]),
             gm_plan: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], vec![], vec![]),
@@ -254,10 +336,15 @@ impl WorldModel {
     /// uniform (set it with [`WorldModel::set_preferences`]), `D` from the priors.
     pub fn new(structure: Structure, n_actions: usize, priors: &ModelPriors) -> Result<WorldModel, AgentError> {
         priors.check()?;
-        if n_actions == 0 {
-            return Err(ParamError::new("n_actions", 0, ">= 1").into());
+        if !(1..=MAX_ACTIONS).contains(&n_actions) {
+            return Err(ParamError::new("n_actions", n_actions, "in 1..=16 (see limits::MAX_ACTIONS)").into());
         }
         let n = structure.joint_size();
+        if n > MAX_STATES {
+            return Err(AgentError::Structure(format!(
+                "{n} joint states; at most {MAX_STATES} (see limits::MAX_STATES)"
+            )));
+        }
         let cpt = (0..structure.factors().len())
             .map(|f| {
                 vec![priors.transition_concentration; structure.n_configs(f, n_actions) * structure.factors()[f].size]

@@ -37,13 +37,25 @@ fn non_negative(name: &'static str, x: f64) -> Result<(), ParamError> {
         Err(ParamError::new(name, x, "finite and >= 0"))
     }
 }
-fn at_least_one(name: &'static str, x: usize) -> Result<(), ParamError> {
-    if x >= 1 {
+/// `1 <= x <= max`, else `expected` (which states the range and why): counts that size an
+/// allocation or a loop, so that no setting asks for more memory or time than a run has.
+fn at_most(name: &'static str, x: usize, max: usize, expected: &'static str) -> Result<(), ParamError> {
+    if (1..=max).contains(&x) {
         Ok(())
     } else {
-        Err(ParamError::new(name, x, ">= 1"))
+        Err(ParamError::new(name, x, expected))
     }
 }
+
+/// Largest VMP window, ticks: the perception keeps one belief per tick of the window
+/// (1000 x 1024 states x 8 bytes = 8 MB at most); episodes are 40 ticks by default.
+pub const MAX_VMP_WINDOW: usize = 1000;
+/// Largest iteration cap of the scaling and VMP loops (each runs on every reasoning tick).
+pub const MAX_ITERATIONS: usize = 10_000;
+/// Largest number of value-iteration sweeps of the Bayesian-RL planner per tick.
+pub const MAX_PLANNER_ITERATIONS: usize = 100_000;
+/// Largest lookahead depth of the Bayesian-RL planner.
+pub const MAX_LOOKAHEAD: usize = 100;
 
 /// Priors of the world model's Dirichlet counts (§II-A world model, §V learning).
 ///
@@ -54,6 +66,7 @@ fn at_least_one(name: &'static str, x: usize) -> Result<(), ParamError> {
 /// | `a_noise` | 0.0 | [0, 1) | mass of each column of A spread uniformly over the other observations (0 = identity A) |
 /// | `d` | `None` (uniform) | length = states, sums to 1 | initial state prior D |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ModelPriors {
     /// Prior count per CPT cell (b0 >= 0). With 0, a parent configuration never seen is uniform.
     pub transition_concentration: f64,
@@ -173,12 +186,12 @@ pub enum GateBaseline {
 /// | `gamma` γ | 0.5 | > 0 | Cor. 1 q(π) = σ(-γG), §VI |
 /// | `varsigma` ς | 0.05 | >= 0 | eq. "stopping_criterion", §VI |
 /// | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
-/// | `max_scaling_iters` | 50 | >= 1 | cap of the scaling loop |
+/// | `max_scaling_iters` | 50 | 1..=10000 | cap of the scaling loop |
 /// | `horizon` H | 3 | 1..=8 | policy length (3^H policies) |
-/// | `vmp_window` W | 4 | >= 1 | VMP window (ticks) |
+/// | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks) |
 /// | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
 /// | `vmp_tol` | 1e-6 | > 0 | VMP convergence threshold on max |Δ q| |
-/// | `vmp_max_iters` | 32 | >= 1 | VMP iteration cap |
+/// | `vmp_max_iters` | 32 | 1..=10000 | VMP iteration cap |
 /// | `scaling_mode` | Iterative | | Theorem 1 iterative / closed form |
 /// | `action_selection` | Mode | | mode or sample |
 /// | `reasoning` | Triggered | | triggered or always (ablation) |
@@ -286,14 +299,29 @@ impl ScaledParams {
         positive("gamma", self.gamma)?;
         non_negative("varsigma", self.varsigma)?;
         in_half_open01("kappa_pi", self.kappa_pi)?;
-        at_least_one("max_scaling_iters", self.max_scaling_iters as usize)?;
+        at_most(
+            "max_scaling_iters",
+            self.max_scaling_iters as usize,
+            MAX_ITERATIONS,
+            "in 1..=10000 (the scaling loop runs on every reasoning tick)",
+        )?;
         if !(1..=8).contains(&self.horizon) {
             return Err(ParamError::new("horizon", self.horizon, "in 1..=8"));
         }
-        at_least_one("vmp_window", self.vmp_window)?;
+        at_most(
+            "vmp_window",
+            self.vmp_window,
+            MAX_VMP_WINDOW,
+            "in 1..=1000 (the perception keeps a belief per tick of the window)",
+        )?;
         in_half_open01("vmp_kappa", self.vmp_kappa)?;
         positive("vmp_tol", self.vmp_tol)?;
-        at_least_one("vmp_max_iters", self.vmp_max_iters as usize)?;
+        at_most(
+            "vmp_max_iters",
+            self.vmp_max_iters as usize,
+            MAX_ITERATIONS,
+            "in 1..=10000 (VMP runs on every reasoning tick)",
+        )?;
         non_negative("learning_rate", self.learning_rate)?;
         positive("nu0", self.nu0)?;
         positive("nu_temperature", self.nu_temperature)?;
@@ -320,7 +348,7 @@ impl ScaledParams {
 /// | `bias_action` | `Some(1)` ("speed up") | < n_actions | action whose initial Q gets `bias` (§VI velocity preference) |
 /// | `bias` | 1.0 | finite | initial Q of `bias_action` (others start at 0) |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct QParams {
     /// Learning rate α.
     pub alpha: f64,
@@ -372,6 +400,7 @@ impl QParams {
 
 /// Planner of the Bayesian-RL baseline (§VI).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Planner {
     /// Value iteration on the posterior-mean MDP, warm-started from the previous values.
     ValueIteration {
@@ -402,12 +431,12 @@ pub enum BayesModel {
 /// |---|---|---|---|
 /// | `prior_concentration` | 0.1 | >= 0 | Dirichlet prior count per successor state |
 /// | `discount` | 0.95 | [0, 1) | discount of the planner |
-/// | `planner` | ValueIteration{200, 1e-6} | iterations >= 1, tol > 0, horizon >= 1 | |
+/// | `planner` | ValueIteration{200, 1e-6} | iterations 1..=100000, tol > 0, horizon 1..=100 | |
 /// | `model` | Flat | | flat or factored |
 /// | `learn_online` | true | | update the posterior from `Controller::observe` at test time |
 /// | `reward_prior` | 0.0 | finite | mean reward assumed for unvisited (s, a) |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct BayesRlParams {
     /// Prior concentration.
     pub prior_concentration: f64,
@@ -448,10 +477,20 @@ impl BayesRlParams {
         }
         match self.planner {
             Planner::ValueIteration { iterations, tol } => {
-                at_least_one("planner.iterations", iterations as usize)?;
+                at_most(
+                    "planner.iterations",
+                    iterations as usize,
+                    MAX_PLANNER_ITERATIONS,
+                    "in 1..=100000 (value-iteration sweeps per tick)",
+                )?;
                 positive("planner.tol", tol)?;
             }
-            Planner::Lookahead { horizon } => at_least_one("planner.horizon", horizon)?,
+            Planner::Lookahead { horizon } => at_most(
+                "planner.horizon",
+                horizon,
+                MAX_LOOKAHEAD,
+                "in 1..=100 (lookahead steps per tick)",
+            )?,
         }
         if !self.reward_prior.is_finite() {
             return Err(ParamError::new("reward_prior", self.reward_prior, "finite"));

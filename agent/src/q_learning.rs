@@ -1,21 +1,90 @@
 //! Tabular Q-learning, the base learner and first baseline (§VI): ε-greedy training,
 //! Q initialised with a bias toward speeding up (the paper's velocity preference).
 
+use crate::check;
 use crate::controller::{Controller, Decision, one_hot};
-use crate::error::{AgentError, ParamError};
+use crate::error::{AgentError, FieldError, ParamError};
+use crate::limits::{MAX_ACTIONS, MAX_STATES};
 use crate::maths::argmax;
 use crate::params::QParams;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
-/// A Q-table over `n_states x n_actions`, laid out `[s * n_actions + a]`.
+/// A Q-table over `n_states x n_actions`, laid out `[s * n_actions + a]`. Reading one
+/// (serde) checks every stored value (see [`QLearning::try_from`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "QLearningRepr")]
 pub struct QLearning {
     n_states: usize,
     n_actions: usize,
     params: QParams,
     epsilon: f64,
     table: Vec<f64>,
+}
+
+/// The stored fields of a [`QLearning`], before they are checked.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, rename = "QLearning")]
+struct QLearningRepr {
+    n_states: usize,
+    n_actions: usize,
+    params: QParams,
+    epsilon: f64,
+    table: Vec<f64>,
+}
+
+impl TryFrom<QLearningRepr> for QLearning {
+    type Error = FieldError;
+    /// Sizes in range, parameters valid, `epsilon` in [0, 1], a table of exactly
+    /// `n_states * n_actions` finite values.
+    fn try_from(r: QLearningRepr) -> Result<Self, FieldError> {
+        check::size(
+            "n_states",
+            r.n_states,
+            1,
+            MAX_STATES,
+            "the joint states of the map's bins",
+        )?;
+        check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
+        r.params.check().map_err(|e| FieldError::from(e).within("params"))?;
+        if let Some(b) = r.params.bias_action.filter(|b| *b >= r.n_actions) {
+            return Err(FieldError::new(
+                "params.bias_action",
+                format!("is {b}; must be below n_actions = {}", r.n_actions),
+            ));
+        }
+        if !check::bounded(r.params.bias) {
+            return Err(FieldError::new(
+                "params.bias",
+                format!(
+                    "is {}; must be at most {:e} in size",
+                    r.params.bias,
+                    crate::limits::MAX_VALUE
+                ),
+            ));
+        }
+        if !(0.0..=1.0).contains(&r.epsilon) {
+            return Err(FieldError::new(
+                "epsilon",
+                format!("is {}; must be in [0, 1]", r.epsilon),
+            ));
+        }
+        let want = check::product("table", r.n_states, r.n_actions)?;
+        check::len(
+            "table",
+            r.table.len(),
+            want,
+            &format!("n_states x n_actions = {} x {}", r.n_states, r.n_actions),
+        )?;
+        check::finite("table", &r.table)?;
+        Ok(QLearning {
+            n_states: r.n_states,
+            n_actions: r.n_actions,
+            params: r.params,
+            epsilon: r.epsilon,
+            table: r.table,
+        })
+    }
 }
 
 impl QLearning {

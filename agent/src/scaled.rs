@@ -95,6 +95,14 @@ impl ScaledAgent {
         model.set_persistence_pooling(pooling)?;
         let n = model.n_states();
         let na = model.n_actions();
+        if crate::limits::policies(na, params.horizon).is_none() {
+            return Err(crate::error::ParamError::new(
+                "horizon",
+                params.horizon,
+                "such that n_actions ^ horizon <= 65536 (limits::MAX_POLICIES)",
+            )
+            .into());
+        }
         if q.n_states() != n {
             return Err(AgentError::SizeMismatch {
                 what: "Q-table states vs world-model states".into(),

@@ -19,6 +19,7 @@ pub enum Parent {
 
 /// One state factor: name, number of values, parents, and whether the action is a parent.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Factor {
     /// Name, e.g. `"v"`.
     pub name: String,
@@ -62,6 +63,12 @@ impl Structure {
         let n = factors.len();
         if n == 0 {
             return Err(AgentError::Structure("no factors".into()));
+        }
+        if n > crate::limits::MAX_FACTORS {
+            return Err(AgentError::Structure(format!(
+                "{n} factors; at most {} (see limits::MAX_FACTORS)",
+                crate::limits::MAX_FACTORS
+            )));
         }
         for f in &factors {
             if f.size == 0 {

@@ -55,6 +55,20 @@ fn bundle_round_trip_and_errors() {
         Err(PersistError::Corrupt { message }) => assert!(message.contains(':'), "{message}"),
         other => panic!("expected Corrupt, got {other:?}"),
     }
+    // A stored value out of range is refused, naming its field from the top of the file
+    // (the learner's own path joined to where it sits in the bundle).
+    let nan = text.replacen("a_counts: ([\n            1000.0", "a_counts: ([\n            NaN", 1);
+    assert_ne!(nan, text);
+    match AgentBundle::from_ron_str(&nan) {
+        Err(PersistError::Invalid(f)) => assert_eq!(f.path, "world_model.a_counts[0,0]", "{f}"),
+        other => panic!("expected Invalid, got {other:?}"),
+    }
+    // Unknown fields are refused (a typo never passes for a default).
+    let unknown = text.replacen("q_learning: (", "q_learning: (\n        alpha: 0.5,", 1);
+    match AgentBundle::from_ron_str(&unknown) {
+        Err(PersistError::Corrupt { message }) => assert!(message.contains("q_learning.alpha"), "{message}"),
+        other => panic!("expected Corrupt, got {other:?}"),
+    }
 }
 
 #[test]
@@ -191,4 +205,12 @@ fn inspect_rejects_bad_models_naming_the_field() {
     let bad_c = good.replace("\"C\": [0.0, 1.0]", "\"C\": [0.0]");
     assert!(matches!(inspect_json(&bad_c), Err(InspectError::Invalid(m)) if m.starts_with("C has")));
     assert!(matches!(inspect_json("{"), Err(InspectError::Json(_))));
+    // 100 one-state actions at policy length 8 would be 10^16 policies (an allocation
+    // abort): refused with the bound.
+    let b: Vec<&str> = vec!["[[1.0]]"; 100];
+    let many = format!(
+        r#"{{"A": [[1.0]], "B": [{}], "C": [0.0], "D": [1.0], "obs": [0], "actions": [], "policy_len": 8, "gamma": 1.0}}"#,
+        b.join(",")
+    );
+    assert!(matches!(inspect_json(&many), Err(InspectError::Invalid(m)) if m.contains("policies")));
 }

@@ -40,4 +40,8 @@ pub use map::{
     Bins, Crosswalk, Episode, Expectation, Light, LightCondition, Map, MethodName, Offset, Pause, Phase, Reward, Road,
     Side, SpawnRule, Trigger, Vehicle,
 };
+pub use validate::{
+    DECISION_DT, MAX_EPISODE_SUBSTEPS, MAX_JOINT_STATES, MAX_LIST, MAX_METRES, MAX_PEDESTRIANS, MAX_SPAWN_RULES,
+    MAX_STEPS, MAX_SUBSTEPS, PHYSICS_HZ,
+};
 pub use world::{Action, PedestrianSnapshot, Snapshot, StepOutcome, World};

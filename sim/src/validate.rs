@@ -1,16 +1,40 @@
 //! Semantic checks on a fully merged map. Every violated rule is reported,
 //! each with its field path and a hint.
+//!
+//! Besides consistency, a map is bounded in what it may ask of a run (the limits below,
+//! listed with their reasons in maps/README.md): physical quantities lie in sensible
+//! ranges, an episode has a bounded number of physics sub-steps and pedestrians, and the
+//! bins give a bounded number of joint states (so the agent's model fits in memory).
 
+use crate::light::LightPhase;
 use crate::map::{Map, Offset, Trigger};
 
 /// Largest number of physics sub-steps per decision tick.
 pub const MAX_SUBSTEPS: f64 = 10_000.0;
 /// Largest episode length, decision ticks.
 pub const MAX_STEPS: u32 = 100_000;
+/// Most physics sub-steps per episode (`max_steps x decision_dt x physics_hz`): a
+/// sub-step takes about 1.75 µs here, so an episode stays under about 0.35 s of
+/// physics (the default episode has 2400).
+pub const MAX_EPISODE_SUBSTEPS: f64 = 200_000.0;
 /// Largest length / coordinate accepted, m.
 pub const MAX_METRES: f64 = 100_000.0;
-/// Most entries in any list (light phases, bin edges, rules, expectations).
+/// Most entries in any list (light phases, bin edges, expectations).
 pub const MAX_LIST: usize = 64;
+/// Most pedestrian spawn rules.
+pub const MAX_SPAWN_RULES: usize = 16;
+/// Most pedestrians one episode can spawn (every rule firing every time it can): each
+/// is a physics body simulated every sub-step.
+pub const MAX_PEDESTRIANS: f64 = 100.0;
+/// Most joint discrete states the bins may give (`(distance edges + 1) x (speed edges + 1)
+/// x 2 x 2`): the agent's world model and Bayesian RL keep dense N x N matrices per
+/// action, about 370 bytes x N² per trained agent (400 MB at 1024 states). Equal to
+/// the agent crate's `limits::MAX_STATES`.
+pub const MAX_JOINT_STATES: usize = 1024;
+/// Decision interval range, s.
+pub const DECISION_DT: (f64, f64) = (0.05, 60.0);
+/// Physics rate range, Hz.
+pub const PHYSICS_HZ: (f64, f64) = (10.0, 10_000.0);
 
 /// One violated rule.
 #[derive(Debug, Clone)]
@@ -61,6 +85,29 @@ impl Check {
         }
     }
 
+    /// A finite number in `[lo, hi]` (`unit` for messages, `why` the reason of the range);
+    /// with `lo > 0`, zero and negative values get the plain "must be greater than 0".
+    fn within(&mut self, path: &str, v: f64, (lo, hi): (f64, f64), unit: &str, why: &str) {
+        if !self.finite(path, v) {
+            return;
+        }
+        if lo > 0.0 && v <= 0.0 {
+            self.positive(path, v);
+        } else if v < lo {
+            self.fail(
+                path,
+                format!("{} {unit} is below the accepted range [{lo}, {hi}] {unit}", short(v)),
+                why,
+            );
+        } else if v > hi {
+            self.fail(
+                path,
+                format!("{} {unit} is above the accepted range [{lo}, {hi}] {unit}", short(v)),
+                why,
+            );
+        }
+    }
+
     /// A finite number >= 0.
     fn non_negative(&mut self, path: &str, v: f64) {
         if self.finite(path, v) && v < 0.0 {
@@ -78,8 +125,16 @@ impl Check {
 
     /// A (min, max) range of positive/non-negative numbers.
     fn range(&mut self, path: &str, r: (f64, f64), positive: bool) {
+        self.range_within(path, r, positive, None);
+    }
+
+    /// [`Check::range`], each end also within `bounds` (`(lo, hi, unit, why)`).
+    fn range_within(&mut self, path: &str, r: (f64, f64), positive: bool, bounds: Option<((f64, f64), &str, &str)>) {
         let before = self.out.len();
-        if positive {
+        if let Some((b, unit, why)) = bounds {
+            self.within(&format!("{path}.0"), r.0, b, unit, why);
+            self.within(&format!("{path}.1"), r.1, b, unit, why);
+        } else if positive {
             self.positive(&format!("{path}.0"), r.0);
             self.positive(&format!("{path}.1"), r.1);
         } else {
@@ -123,6 +178,15 @@ impl Check {
     }
 }
 
+/// `v` as written in messages: plain, or in scientific notation when tiny or huge.
+fn short(v: f64) -> String {
+    if v != 0.0 && !(1e-4..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// All rule violations of `map` (empty when it is valid).
 pub(crate) fn validate(map: &Map) -> Vec<Problem> {
     let mut c = Check { out: Vec::new() };
@@ -136,7 +200,14 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
         }
     }
     let r = &map.road;
-    c.positive("road.lane_width", r.lane_width);
+    let body = "use real units: metres, seconds, m/s, kg";
+    c.within(
+        "road.lane_width",
+        r.lane_width,
+        (1.0, 10.0),
+        "m",
+        "a lane is 2.5 to 4 m wide",
+    );
     if r.lanes == 0 || r.lanes > 16 {
         c.fail(
             "road.lanes",
@@ -144,23 +215,65 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
             "two lanes is the usual road",
         );
     }
-    c.non_negative("road.sidewalk_width", r.sidewalk_width);
+    c.within(
+        "road.sidewalk_width",
+        r.sidewalk_width,
+        (0.0, 20.0),
+        "m",
+        "pedestrians wait on the sidewalk",
+    );
     c.finite("road.goal_x", r.goal_x);
 
     let w = &map.crosswalk;
     c.finite("crosswalk.x", w.x);
-    c.positive("crosswalk.width", w.width);
+    c.within(
+        "crosswalk.width",
+        w.width,
+        (0.5, 50.0),
+        "m",
+        "a zebra crossing is 2.5 to 6 m wide",
+    );
 
     let v = &map.vehicle;
-    c.positive("vehicle.length", v.length);
-    c.positive("vehicle.width", v.width);
-    c.positive("vehicle.mass", v.mass);
+    c.within(
+        "vehicle.length",
+        v.length,
+        (1.0, 20.0),
+        "m",
+        "a car is about 4.5 m long, a lorry up to 20 m",
+    );
+    c.within("vehicle.width", v.width, (0.5, 4.0), "m", "a car is about 1.8 m wide");
+    c.within(
+        "vehicle.mass",
+        v.mass,
+        (50.0, 60_000.0),
+        "kg",
+        "a car is about 1500 kg, a lorry up to 60 t",
+    );
     c.finite("vehicle.start_x", v.start_x);
     c.non_negative("vehicle.start_speed", v.start_speed);
-    c.positive("vehicle.max_accel", v.max_accel);
-    c.positive("vehicle.max_brake", v.max_brake);
-    c.positive("vehicle.max_speed", v.max_speed);
-    c.non_negative("vehicle.damping", v.damping);
+    c.within(
+        "vehicle.max_accel",
+        v.max_accel,
+        (0.1, 20.0),
+        "m/s²",
+        "2 g is beyond any car",
+    );
+    c.within(
+        "vehicle.max_brake",
+        v.max_brake,
+        (0.1, 20.0),
+        "m/s²",
+        "2 g is beyond any car",
+    );
+    c.within(
+        "vehicle.max_speed",
+        v.max_speed,
+        (0.1, 70.0),
+        "m/s",
+        "70 m/s is 252 km/h",
+    );
+    c.within("vehicle.damping", v.damping, (0.0, 10.0), "1/s", body);
     if v.start_speed.is_finite() && v.max_speed.is_finite() && v.start_speed > v.max_speed {
         c.fail(
             "vehicle.start_speed",
@@ -228,29 +341,66 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
             "",
         );
     } else {
+        // A phase shorter than one physics sub-step is never shown (checked once the
+        // physics rate itself is valid).
+        let hz = map.episode.physics_hz;
+        let shortest = if (PHYSICS_HZ.0..=PHYSICS_HZ.1).contains(&hz) {
+            1.0 / hz
+        } else {
+            0.0
+        };
         for (i, p) in l.cycle.iter().enumerate() {
-            c.positive(&format!("light.cycle[{i}].duration"), p.duration);
+            let path = format!("light.cycle[{i}].duration");
+            if p.duration > 0.0 && p.duration < shortest {
+                c.fail(
+                    &path,
+                    format!("{} s is shorter than one physics sub-step ({shortest} s)", p.duration),
+                    "a phase must last at least one sub-step (1 / episode.physics_hz)",
+                );
+            } else {
+                c.within(&path, p.duration, (0.0, 1e6), "s", "a phase lasts seconds to hours");
+            }
         }
     }
     if let Offset::Fixed(o) = l.offset {
         c.finite("light.offset", o);
     }
 
-    for (i, p) in map.pedestrians.iter().enumerate().take(MAX_LIST + 1) {
-        if i == MAX_LIST {
-            c.fail("pedestrians", format!("more than {MAX_LIST} spawn rules"), "");
-            break;
-        }
+    if map.pedestrians.len() > MAX_SPAWN_RULES {
+        c.fail(
+            "pedestrians",
+            format!(
+                "{} spawn rules is too many (at most {MAX_SPAWN_RULES})",
+                map.pedestrians.len()
+            ),
+            "every rule is checked every physics sub-step; merge rules or split the scenario",
+        );
+    }
+    for (i, p) in map.pedestrians.iter().enumerate().take(MAX_SPAWN_RULES) {
         let path = format!("pedestrians[{i}]");
         match p.trigger {
             Trigger::RedStarts | Trigger::GreenStarts => {}
             Trigger::AtTime(t) => c.non_negative(&format!("{path}.trigger"), t),
             Trigger::CarWithin { min, max } => c.range(&format!("{path}.trigger"), (min, max), false),
-            Trigger::CarArrivesWithin(t) => c.positive(&format!("{path}.trigger"), t),
+            Trigger::CarArrivesWithin(t) => c.within(&format!("{path}.trigger"), t, (0.0, 3600.0), "s", body),
         }
         c.probability(&format!("{path}.probability"), p.probability, false);
-        c.range(&format!("{path}.speed"), p.speed, true);
-        c.range(&format!("{path}.delay"), p.delay, false);
+        c.range_within(
+            &format!("{path}.speed"),
+            p.speed,
+            true,
+            Some((
+                (0.01, 12.0),
+                "m/s",
+                "people walk at 0.5 to 2 m/s and sprint at up to 12",
+            )),
+        );
+        c.range_within(
+            &format!("{path}.delay"),
+            p.delay,
+            false,
+            Some(((0.0, 3600.0), "s", "a delay of seconds to an hour")),
+        );
         if p.delay.0 < 0.0 {
             c.fail(&format!("{path}.delay"), "delays cannot be negative", "");
         }
@@ -274,10 +424,28 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
                 "widen road.sidewalk_width or start closer to the kerb",
             );
         }
-        c.positive(&format!("{path}.radius"), p.radius);
+        c.within(
+            &format!("{path}.radius"),
+            p.radius,
+            (0.05, 1.5),
+            "m",
+            "a person's body radius is about 0.3 m",
+        );
         if let Some(pa) = p.pause {
             c.non_negative(&format!("{path}.pause.after"), pa.after);
-            c.non_negative(&format!("{path}.pause.duration"), pa.duration);
+            c.within(&format!("{path}.pause.duration"), pa.duration, (0.0, 3600.0), "s", body);
+        }
+    }
+    if map.pedestrians.len() <= MAX_SPAWN_RULES {
+        let most = most_pedestrians(map);
+        if most > MAX_PEDESTRIANS {
+            c.fail(
+                "pedestrians",
+                format!(
+                    "the rules can spawn up to {most:.0} pedestrians in one episode (at most {MAX_PEDESTRIANS}: each is a physics body simulated every sub-step)"
+                ),
+                "lengthen the light cycle, shorten the episode or use fewer RedStarts/GreenStarts rules",
+            );
         }
     }
 
@@ -285,6 +453,20 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
     c.edges("bins.distance_edges", &b.distance_edges, "m");
     c.edges("bins.speed_edges", &b.speed_edges, "m/s");
     c.probability("bins.observation_noise", b.observation_noise, true);
+    if b.distance_edges.len() <= MAX_LIST && b.speed_edges.len() <= MAX_LIST {
+        let (nd, nv) = (b.distance_edges.len() + 1, b.speed_edges.len() + 1);
+        let states = nd * nv * 4;
+        if states > MAX_JOINT_STATES {
+            let gb = (states * states * 370) as f64 / 1e9;
+            c.fail(
+                "bins",
+                format!(
+                    "the bins give {nd} x {nv} x 2 x 2 = {states} joint states (at most {MAX_JOINT_STATES}: the agent keeps dense N x N matrices per action, about {gb:.1} GB here)"
+                ),
+                "use fewer distance_edges or speed_edges (the default 3 + 3 give 64 states)",
+            );
+        }
+    }
 
     let rw = &map.reward;
     c.finite("reward.progress_per_metre", rw.progress_per_metre);
@@ -293,8 +475,20 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
     c.finite("reward.step_cost", rw.step_cost);
 
     let e = &map.episode;
-    c.positive("episode.decision_dt", e.decision_dt);
-    c.positive("episode.physics_hz", e.physics_hz);
+    c.within(
+        "episode.decision_dt",
+        e.decision_dt,
+        DECISION_DT,
+        "s",
+        "the agent decides a few times a second to once a minute",
+    );
+    c.within(
+        "episode.physics_hz",
+        e.physics_hz,
+        PHYSICS_HZ,
+        "Hz",
+        "below 10 Hz a car at speed skips past a pedestrian between steps",
+    );
     let n = e.decision_dt * e.physics_hz;
     if e.decision_dt > 0.0 && e.physics_hz > 0.0 && n.is_finite() {
         if n.round() < 1.0 || (n - n.round()).abs() > 1e-6 * n.max(1.0) {
@@ -316,6 +510,17 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
             "episode.max_steps",
             format!("must be 1..={MAX_STEPS}, got {}", e.max_steps),
             "",
+        );
+    } else if n.is_finite() && n.round() * f64::from(e.max_steps) > MAX_EPISODE_SUBSTEPS {
+        c.fail(
+            "episode",
+            format!(
+                "max_steps x decision_dt x physics_hz = {} x {} = {} physics sub-steps per episode (at most {MAX_EPISODE_SUBSTEPS}: about 0.35 s of physics per episode here)",
+                e.max_steps,
+                n.round(),
+                n.round() * f64::from(e.max_steps)
+            ),
+            "lower max_steps or physics_hz (60 Hz is plenty for road speeds)",
         );
     }
 
@@ -351,4 +556,30 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
         }
     }
     c.out
+}
+
+/// The most pedestrians `map`'s rules can spawn in one episode: each one-off trigger
+/// once, each phase-start trigger at every start of its phase (at most once per such
+/// phase per cycle, plus the phase in force at time 0), whatever the probabilities.
+fn most_pedestrians(map: &Map) -> f64 {
+    let episode = f64::from(map.episode.max_steps) * map.episode.decision_dt;
+    let cycle = map.light.cycle_length();
+    map.pedestrians
+        .iter()
+        .map(|p| {
+            let want = match p.trigger {
+                Trigger::RedStarts => LightPhase::Red,
+                Trigger::GreenStarts => LightPhase::Green,
+                _ => return 1.0,
+            };
+            let k = map.light.cycle.iter().filter(|ph| ph.phase == want).count() as f64;
+            if k == 0.0 {
+                0.0
+            } else if cycle > 0.0 && cycle.is_finite() && episode.is_finite() {
+                k * ((episode / cycle).floor() + 2.0)
+            } else {
+                f64::INFINITY
+            }
+        })
+        .sum()
 }

@@ -284,3 +284,94 @@ proptest! {
         });
     }
 }
+
+/// Issue 12: maps that passed check-map but ran for hours, asked for terabytes, or made
+/// no physical sense. Each is refused with the field, the limit and its reason.
+#[test]
+fn runaway_and_absurd_maps_are_refused_with_the_limit() {
+    let edges = |n: usize, step: f64| {
+        (0..n)
+            .map(|i| format!("{:.1}", i as f64 * step))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let many_rules = vec!["(trigger: RedStarts)"; 64].join(", ");
+    let sixteen_rules = vec!["(trigger: RedStarts)"; 16].join(", ");
+    let cases: Vec<(String, &[&str])> = vec![
+        (
+            format!(
+                "Map(bins: (distance_edges: [{}], speed_edges: [{}]))",
+                edges(64, 1.0),
+                edges(64, 0.1)
+            ),
+            &["bins", "16900 joint states", "at most 1024", "GB"],
+        ),
+        (
+            "Map(episode: (max_steps: 100000, physics_hz: 10000.0))".into(),
+            &["episode", "sub-steps per episode", "at most 200000"],
+        ),
+        (
+            format!(
+                "Map(pedestrians: [{many_rules}], light: (cycle: [(phase: Red, duration: 0.0167), (phase: Green, duration: 0.0167)]))"
+            ),
+            &["pedestrians", "64 spawn rules", "at most 16"],
+        ),
+        (
+            format!(
+                "Map(pedestrians: [{sixteen_rules}], light: (cycle: [(phase: Red, duration: 0.0167), (phase: Green, duration: 0.0167)]))"
+            ),
+            &["pedestrians", "in one episode", "at most 100"],
+        ),
+        (
+            "Map(light: (cycle: [(phase: Red, duration: 0.001), (phase: Green, duration: 10.0)]))".into(),
+            &["light.cycle[0].duration", "shorter than one physics sub-step"],
+        ),
+        (
+            "Map(pedestrians: [(radius: 999999.0)])".into(),
+            &["pedestrians[0].radius", "[0.05, 1.5] m"],
+        ),
+        (
+            "Map(pedestrians: [(speed: (1.0, 999.0))])".into(),
+            &["pedestrians[0].speed.1", "m/s"],
+        ),
+        (
+            "Map(vehicle: (max_speed: 999999.0))".into(),
+            &["vehicle.max_speed", "[0.1, 70] m/s"],
+        ),
+        ("Map(vehicle: (length: 500.0))".into(), &["vehicle.length", "[1, 20] m"]),
+        ("Map(vehicle: (length: 1e-300))".into(), &["vehicle.length", "1e-300"]),
+        ("Map(vehicle: (mass: 1e-300))".into(), &["vehicle.mass", "1e-300 kg"]),
+        ("Map(road: (lane_width: 1e-300))".into(), &["road.lane_width", "1e-300"]),
+        (
+            "Map(episode: (decision_dt: 10000.0, physics_hz: 0.01))".into(),
+            &["episode.decision_dt", "[0.05, 60] s"],
+        ),
+        (
+            "Map(episode: (decision_dt: 10000.0, physics_hz: 0.01))".into(),
+            &["episode.physics_hz", "[10, 10000] Hz"],
+        ),
+    ];
+    for (text, needles) in &cases {
+        let (_, lines) = reject(text);
+        assert!(has(&lines, needles), "{text}\n{lines:#?}");
+        assert!(
+            lines.iter().all(|l| l.contains("(hint: ")),
+            "a reason for every limit: {lines:#?}"
+        );
+    }
+}
+
+/// The limits leave every shipped map valid.
+#[test]
+fn the_shipped_maps_are_within_the_limits() {
+    for name in unforeseen_sim::embedded::names() {
+        unforeseen_sim::embedded::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../maps");
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|x| x == "ron") {
+            Map::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        }
+    }
+}

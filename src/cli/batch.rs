@@ -8,8 +8,8 @@ use super::table::{cell, print_grid, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use crate::agents::Agent;
 use crate::batch::{
-    BatchConfig, ResultLine, Scenario, Shard, SummaryRow, Unit, UnitKey, load_scenarios, read_lines, run, summarize,
-    summary_path, sweep, units,
+    BatchConfig, ResultLine, RunIdentity, Scenario, Shard, SummaryRow, Unit, load_scenarios, resume_lines, run,
+    summarize, summary_path, sweep, units,
 };
 use crate::methods::Method;
 use crate::protocol::ProtocolChoice;
@@ -46,7 +46,10 @@ pub struct BatchArgs {
     /// over training seeds goes beside it (`results.summary.json`).
     #[arg(long, value_name = "FILE", default_value = "results.jsonl")]
     pub out: PathBuf,
-    /// Keep the complete lines already in --out and run only the missing units.
+    /// Keep the complete lines already in --out and run only the missing units. The file
+    /// must have been written by the same run (same program, agents, maps, methods,
+    /// parameter sets, protocols, training seeds, episodes and seed; the shard may
+    /// differ): otherwise it is refused, saying what differs.
     #[arg(long)]
     pub resume: bool,
     /// Run only shard I of N (1-based) of the canonical unit order.
@@ -99,30 +102,44 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         None => Vec::new(), // the single agent's seed, known once it is loaded
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs.max(1)).build()?;
-    let agents = pool.install(|| -> anyhow::Result<Vec<Agent>> {
+    let (agents, agents_identity) = pool.install(|| -> anyhow::Result<(Vec<Agent>, String)> {
         if args.seeds.train_seeds.is_none() {
-            return Ok(vec![single_agent(&args)?]);
+            let (agent, identity) = single_agent(&args)?;
+            return Ok((vec![agent], identity));
         }
+        let identity = seeds_identity(&axis, args.train_episodes)?;
         // Only the seeds of this shard's units that are still to run.
         let all = units(scenarios.len(), &methods, &params, &protocols, &axis)?;
         let range = args.shard.map_or(0..all.len(), |s| s.range(all.len()));
-        let kept = if args.resume {
-            read_lines(&args.out)?
+        let done: BTreeSet<usize> = if args.resume {
+            let run = RunIdentity::new(
+                &scenarios,
+                &methods,
+                &params,
+                &protocols,
+                &axis,
+                args.episodes,
+                args.seed,
+                &identity,
+            );
+            resume_lines(&args.out, &run, &all, &scenarios)?
+                .iter()
+                .map(|l| l.parsed.unit)
+                .collect()
         } else {
-            Vec::new()
+            BTreeSet::new()
         };
-        let done: BTreeSet<UnitKey> = kept.iter().map(ResultLine::key).collect();
-        let todo: Vec<&Unit> = all[range]
-            .iter()
-            .filter(|u| !done.contains(&u.key(&scenarios)))
-            .collect();
+        let todo: Vec<&Unit> = all[range].iter().filter(|u| !done.contains(&u.index)).collect();
         let used: Vec<u64> = axis
             .iter()
             .flatten()
             .copied()
             .filter(|&s| todo.iter().any(|u| u.train_seed == Some(s)))
             .collect();
-        args.seeds.train(&used, "intersection", args.train_episodes, args.quiet)
+        let agents = args
+            .seeds
+            .train(&used, "intersection", args.train_episodes, args.quiet)?;
+        Ok((agents, identity))
     })?;
     let axis = if axis.is_empty() {
         vec![agents[0].train_seed]
@@ -140,6 +157,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         seed: args.seed,
         jobs: args.jobs,
         shard: args.shard,
+        agents_identity,
     };
     let lines = run(&cfg, &args.out, args.resume, args.quiet)?;
     let rows = summarize(&lines);
@@ -156,6 +174,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             "schema": 1,
             "results": args.out.display().to_string(),
             "shard": args.shard.map(|s| format!("{}/{}", s.index, s.count)),
+            "run": cfg.identity(),
             "checked": checked,
             "failed": failures.len(),
             "rows": rows,
@@ -178,8 +197,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The one agent of a run without --train-seeds: --agent, or trained from --seed.
-fn single_agent(args: &BatchArgs) -> anyhow::Result<Agent> {
+/// The one agent of a run without --train-seeds (--agent, or trained from --seed), and
+/// what determines it for the run's identity: the agent file's content, or the training
+/// recipe.
+fn single_agent(args: &BatchArgs) -> anyhow::Result<(Agent, String)> {
     let bundle = super::load_or_train(
         args.agent.as_deref(),
         "intersection",
@@ -187,7 +208,30 @@ fn single_agent(args: &BatchArgs) -> anyhow::Result<Agent> {
         args.seed,
         args.quiet,
     )?;
-    Ok(Agent::from_bundle(bundle))
+    let identity = match &args.agent {
+        Some(_) => format!(
+            "agent file with contents {}",
+            crate::seeds::content_hash(bundle.to_ron_string().as_bytes())
+        ),
+        None => seeds_identity(&[Some(args.seed)], args.train_episodes)?,
+    };
+    Ok((Agent::from_bundle(bundle), identity))
+}
+
+/// What determines agents trained on the embedded intersection for `episodes` episodes
+/// with each of `seeds`: their cache keys (training map contents, episodes, seed,
+/// training configuration, version and training code).
+fn seeds_identity(seeds: &[Option<u64>], episodes: u64) -> anyhow::Result<String> {
+    let map = crate::maps::load("intersection")?;
+    let keys = seeds
+        .iter()
+        .flatten()
+        .map(|&seed| crate::agents::cache_key(&map, &crate::training::TrainConfig::new(episodes, seed)))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok(format!(
+        "trained on intersection for {episodes} episodes, agents {}",
+        crate::seeds::content_hash(keys.join(",").as_bytes())
+    ))
 }
 
 /// Prints one row per (scenario, method, parameters, protocol) over its training seeds.

@@ -4,7 +4,7 @@
 use clap::Args;
 use std::path::PathBuf;
 
-use super::BadInput;
+use crate::error::Error;
 use crate::survivability;
 use unforeseen_sim::Map;
 
@@ -43,7 +43,11 @@ pub fn run(args: CheckMapArgs) -> anyhow::Result<()> {
         }
     }
     if bad > 0 {
-        return Err(BadInput(format!("{bad} of {} map file(s) failed the check", args.files.len())).into());
+        return Err(Error::MapsFailed {
+            failed: bad,
+            total: args.files.len(),
+        }
+        .into());
     }
     Ok(())
 }

@@ -6,7 +6,8 @@ use clap::Args;
 use std::path::PathBuf;
 use unforeseen_agent::inspect::InspectModel;
 
-use super::{AgentArgs, BadInput};
+use super::AgentArgs;
+use crate::error::Error;
 use crate::report::write_json;
 
 /// Arguments of `export-model`.
@@ -34,26 +35,33 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         .split(',')
         .map(|v| v.trim().parse::<usize>())
         .collect::<Result<_, _>>()
-        .map_err(|e| BadInput(format!("--obs {}: {e} (expected integers, e.g. 2,3,1,1)", args.obs)))?;
+        .map_err(|e| {
+            Error::flag(
+                format!("--obs {}", args.obs),
+                format!("{e} (expected integers, e.g. 2,3,1,1)"),
+            )
+        })?;
     let bundle = args.agent.bundle()?;
     let model = &bundle.world_model;
     let structure = model.structure();
     let factors = structure.factors();
     if values.len() != factors.len() {
-        return Err(BadInput(format!(
-            "--obs {}: {} values given, the model has {} factors ({})",
-            args.obs,
-            values.len(),
-            factors.len(),
-            factors.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(",")
-        ))
+        return Err(Error::flag(
+            format!("--obs {}", args.obs),
+            format!(
+                "{} values given, the model has {} factors ({})",
+                values.len(),
+                factors.len(),
+                factors.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(",")
+            ),
+        )
         .into());
     }
     if let Some((v, f)) = values.iter().zip(factors).find(|(v, f)| **v >= f.size) {
-        return Err(BadInput(format!(
-            "--obs {}: {}={v} is out of range (0..{})",
-            args.obs, f.name, f.size
-        ))
+        return Err(Error::flag(
+            format!("--obs {}", args.obs),
+            format!("{}={v} is out of range (0..{})", f.name, f.size),
+        )
         .into());
     }
     let gm = model.planning_generative();
@@ -64,6 +72,16 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         params.horizon,
         params.gamma,
     );
+    // JSON has no NaN or infinity (serde_json writes them as null): refuse rather than
+    // write a model no reader can use. A checked agent file never gets here.
+    let value = serde_json::to_value(&exported)?;
+    if let Some(at) = first_null(&value, String::new()) {
+        return Err(Error::Agent {
+            problem: format!("the planning model has a value that is not a finite number at {at}"),
+            fix: "retrain the agent with `unforeseen train`".into(),
+        }
+        .into());
+    }
     write_json(&args.out, &exported)?;
     println!(
         "wrote {} ({} states, {} actions, horizon {}, gamma {})",
@@ -74,4 +92,20 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         params.gamma
     );
     Ok(())
+}
+
+/// The path of the first null (a non-finite number) in `v`, e.g. `A[3][2]`.
+fn first_null(v: &serde_json::Value, at: String) -> Option<String> {
+    match v {
+        serde_json::Value::Null => Some(at),
+        serde_json::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| first_null(x, format!("{at}[{i}]"))),
+        serde_json::Value::Object(m) => m.iter().find_map(|(k, x)| {
+            let here = if at.is_empty() { k.clone() } else { format!("{at}.{k}") };
+            first_null(x, here)
+        }),
+        _ => None,
+    }
 }

@@ -4,7 +4,7 @@
 use clap::Args;
 use std::path::PathBuf;
 
-use super::BadInput;
+use crate::error::Error;
 
 /// Arguments of `inspect`.
 #[derive(Debug, Clone, Args)]
@@ -16,10 +16,14 @@ pub struct InspectArgs {
 
 /// Runs `inspect`, printing the report as JSON on stdout.
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(&args.model)
-        .map_err(|e| BadInput(format!("{}: cannot read ({e})", args.model.display())))?;
-    let out = unforeseen_agent::inspect::inspect_json(&text)
-        .map_err(|e| BadInput(format!("{}: {e}", args.model.display())))?;
+    let text = std::fs::read_to_string(&args.model).map_err(|e| Error::ModelFile {
+        path: args.model.clone(),
+        problem: format!("cannot read ({e})"),
+    })?;
+    let out = unforeseen_agent::inspect::inspect_json(&text).map_err(|e| Error::ModelFile {
+        path: args.model.clone(),
+        problem: e.to_string(),
+    })?;
     println!("{out}");
     Ok(())
 }

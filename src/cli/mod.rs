@@ -1,5 +1,7 @@
-//! The command line (clap). Each command lives in its own file; library errors become
-//! messages here, and bad input (maps, agent files, arguments) exits with code 2.
+//! The command line (clap). Each command lives in its own file. Library errors become
+//! messages here, and only here is the exit code decided ([`exit_code`]): 2 for input
+//! the user can fix (maps, agent files, results files, flags: the library's
+//! [`crate::error::Error`] and the map errors), 1 for any other failure.
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -21,11 +23,6 @@ pub mod table;
 pub mod trace;
 pub mod train;
 pub mod train_seeds;
-
-/// Bad input from the user (a map, an agent file, an argument): exit code 2.
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct BadInput(pub String);
 
 /// Active inference as the test-time scaling law for physical AI agents, on a Rapier 2D
 /// intersection. With no command, runs `compare` on the embedded default maps.
@@ -81,10 +78,13 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
-/// Whether an error (or anything in its chain) is bad input, to pick exit code 2.
-pub fn is_bad_input(err: &anyhow::Error) -> bool {
-    err.chain()
-        .any(|e| e.is::<BadInput>() || e.is::<crate::maps::MapLookupError>() || e.is::<unforeseen_sim::MapError>())
+/// The exit code for an error: 2 when it (or anything in its chain) is input the user
+/// can fix, 1 otherwise.
+pub fn exit_code(err: &anyhow::Error) -> i32 {
+    let bad_input = err.chain().any(|e| {
+        e.is::<crate::error::Error>() || e.is::<crate::maps::MapLookupError>() || e.is::<unforeseen_sim::MapError>()
+    });
+    if bad_input { 2 } else { 1 }
 }
 
 /// Options shared by the commands that drive a trained agent.
@@ -95,7 +95,7 @@ pub struct AgentArgs {
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
     /// Scaled-agent parameter overrides, e.g. `--set omega=0.3 --set horizon=2`
-    /// (keys: omega, epsilon, gamma, varsigma, horizon, kappa_pi, vmp_window, max_scaling_iters, nu0, nu_temperature, learning_rate, sample, gate, gate_factor, gate_memory, gate_learning).
+    /// (keys: omega, epsilon, gamma, varsigma, horizon, kappa_pi, vmp_window, max_scaling_iters, nu0, nu_temperature, learning_rate, sample, gate, gate_factor, gate_memory, gate_learning, gate_baseline, persistence_ignores).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// Run seed: the evaluation episodes and, without `--agent`, the training run derive from it.
@@ -119,7 +119,7 @@ impl AgentArgs {
 
     /// The scaled agent's parameters with the `--set` overrides applied.
     pub fn params(&self) -> anyhow::Result<ScaledParams> {
-        params::apply(ScaledParams::default(), &self.set)
+        Ok(params::apply(ScaledParams::default(), &self.set)?)
     }
 }
 

@@ -6,8 +6,8 @@ use plotters::style::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED, RGBColor};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use super::BadInput;
 use crate::batch::read_lines;
+use crate::error::Error;
 use crate::plots::{Series, line_panels};
 
 /// Arguments of `plot-sweep`.
@@ -30,11 +30,13 @@ const COLORS: [RGBColor; 6] = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
 pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
     let lines = read_lines(&args.results)?;
     if lines.is_empty() {
-        return Err(BadInput(format!(
-            "{}: no result lines; run `unforeseen batch --set KEY=V1,V2 --out {}` first",
-            args.results.display(),
-            args.results.display()
-        ))
+        return Err(Error::Results {
+            path: args.results.clone(),
+            problem: format!(
+                "no result lines; run `unforeseen batch --set KEY=V1,V2 --out {}` first",
+                args.results.display()
+            ),
+        }
         .into());
     }
     // Swept keys: those taking more than one numeric value.

@@ -1,0 +1,262 @@
+//! Issue 12: a fuzz test over the library API (no processes, so it is fast). Valid maps
+//! (every shipped scenario) and a valid agent file are mutated by a seeded mutator —
+//! numbers replaced by NaN, infinities, negatives, huge and tiny values, lines deleted
+//! or repeated, unknown fields inserted, characters changed, files cut short — and each
+//! result is loaded. Nothing may panic, abort on an allocation or hang: a rejected input
+//! is a bad-input error (exit code 2) naming the file; an accepted map builds a world
+//! that steps; an accepted agent drives a few episodes with finite, valid decisions.
+//!
+//! `UNFORESEEN_FUZZ_CASES=N` sets the number of cases of each kind (default 300).
+
+mod common;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::path::Path;
+use unforeseen::methods::Method;
+use unforeseen::runner::{EpisodeSeeds, run_episode};
+use unforeseen_agent::params::ScaledParams;
+use unforeseen_discretizer::Discretizer;
+use unforeseen_sim::{Action, Map, World};
+
+fn cases() -> usize {
+    std::env::var("UNFORESEEN_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(300)
+}
+
+/// Values a number may be replaced with: out of range, non-finite, huge, tiny, edges.
+const SPECIAL: &[&str] = &[
+    "NaN",
+    "inf",
+    "-inf",
+    "-1.0",
+    "-0.5",
+    "0.0",
+    "0",
+    "1",
+    "2",
+    "3",
+    "64",
+    "65",
+    "1e-300",
+    "1e300",
+    "-1e308",
+    "99999999999",
+    "4294967296",
+    "18446744073709551615",
+    "0.999999",
+];
+
+/// Byte spans of the numbers in `text` (a digit, or a minus sign before one, then digits,
+/// dots, exponents).
+fn numbers(text: &str) -> Vec<(usize, usize)> {
+    let b = text.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        let starts = b[i].is_ascii_digit() || (b[i] == b'-' && b.get(i + 1).is_some_and(u8::is_ascii_digit));
+        let after_word = i > 0 && (b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_');
+        if starts && !after_word {
+            let mut j = i + 1;
+            while j < b.len() && (b[j].is_ascii_digit() || b"._eE+-".contains(&b[j])) {
+                j += 1;
+            }
+            out.push((i, j));
+            i = j;
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// One to three random edits of `text`.
+fn mutate(text: &str, rng: &mut ChaCha8Rng) -> String {
+    let mut t = text.to_string();
+    for _ in 0..rng.random_range(1..=3) {
+        if t.is_empty() {
+            break;
+        }
+        let lines: Vec<&str> = t.split_inclusive('\n').collect();
+        t = match rng.random_range(0..8) {
+            // A number becomes a special value (the most common edit: most bugs are here).
+            0..=2 => {
+                let spans = numbers(&t);
+                if spans.is_empty() {
+                    continue;
+                }
+                // Half the time among the first eighth of the numbers, so that the small
+                // sections before the long count arrays (parameters, Q-table, CPTs) get
+                // their share.
+                let pick = if rng.random_range(0..2) == 0 {
+                    spans.len()
+                } else {
+                    spans.len().div_ceil(8)
+                };
+                let (a, b) = spans[rng.random_range(0..pick)];
+                let v = SPECIAL[rng.random_range(0..SPECIAL.len())];
+                format!("{}{v}{}", &t[..a], &t[b..])
+            }
+            // A number scaled by a power of ten, perhaps negated.
+            3 => {
+                let spans = numbers(&t);
+                if spans.is_empty() {
+                    continue;
+                }
+                let (a, b) = spans[rng.random_range(0..spans.len())];
+                let x: f64 = t[a..b].parse().unwrap_or(1.0);
+                let sign = if rng.random_range(0..4) == 0 { -1.0 } else { 1.0 };
+                let v = sign * x * 10f64.powi(rng.random_range(-12..=12));
+                format!("{}{v:?}{}", &t[..a], &t[b..])
+            }
+            // A line deleted or repeated (list lengths, missing fields, duplicates).
+            4 => {
+                let i = rng.random_range(0..lines.len());
+                let mut l = lines.clone();
+                l.remove(i);
+                l.concat()
+            }
+            5 => {
+                let i = rng.random_range(0..lines.len());
+                let n = rng.random_range(1..=8);
+                let mut l = lines.clone();
+                for _ in 0..n {
+                    l.insert(i, lines[i]);
+                }
+                l.concat()
+            }
+            // An unknown field, or one character replaced.
+            6 => {
+                let i = rng.random_range(0..lines.len());
+                let mut l: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
+                if rng.random_range(0..2) == 0 {
+                    l.insert(i, "    zzz_unknown: 1,\n".into());
+                } else {
+                    let line = &l[i];
+                    let chars: Vec<char> = line.chars().collect();
+                    let k = rng.random_range(0..chars.len());
+                    let pool = b"()[]{},:;\"'#/\\0-9aZ \x07";
+                    let c = pool[rng.random_range(0..pool.len())] as char;
+                    l[i] = chars[..k]
+                        .iter()
+                        .chain(std::iter::once(&c))
+                        .chain(&chars[k + 1..])
+                        .collect();
+                }
+                l.concat()
+            }
+            // Cut short.
+            _ => {
+                let mut k = rng.random_range(0..t.len());
+                while !t.is_char_boundary(k) {
+                    k -= 1;
+                }
+                t[..k].to_string()
+            }
+        };
+    }
+    t
+}
+
+fn embedded(base: &str) -> Option<(String, String)> {
+    let name = base.strip_suffix(".ron").unwrap_or(base);
+    unforeseen_sim::embedded::source(name).map(|t| (format!("embedded:{name}"), t.to_string()))
+}
+
+#[test]
+fn mutated_maps_are_refused_or_run_within_the_limits() {
+    let names = unforeseen_sim::embedded::names();
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let (mut accepted, n) = (0, cases());
+    for case in 0..n {
+        let name = names[case % names.len()];
+        let text = mutate(unforeseen_sim::embedded::source(name).unwrap(), &mut rng);
+        let map = match Map::from_str_named("fuzz.ron", &text, &embedded) {
+            Ok(map) => map,
+            Err(e) => {
+                assert!(e.to_string().starts_with("fuzz.ron"), "case {case}: {e}");
+                continue;
+            }
+        };
+        accepted += 1;
+        // Accepted maps stay within the stated limits...
+        let states = Discretizer::new(&map.bins).expect("valid bins").n_states();
+        assert!(
+            states <= unforeseen_sim::MAX_JOINT_STATES,
+            "case {case}: {states} states\n{text}"
+        );
+        let per_episode = f64::from(map.episode.substeps()) * f64::from(map.episode.max_steps);
+        assert!(
+            per_episode <= unforeseen_sim::MAX_EPISODE_SUBSTEPS,
+            "case {case}\n{text}"
+        );
+        // ...and their worlds step.
+        let mut world = World::from_map(&map, case as u64);
+        for _ in 0..3 {
+            if world.is_done() {
+                break;
+            }
+            let out = world.step(Action::SpeedUp);
+            assert!(out.progress.is_finite(), "case {case}\n{text}");
+        }
+    }
+    eprintln!("maps: {n} mutated, {accepted} accepted");
+    assert!(accepted > 0 && accepted < n, "the mutator should make both kinds");
+}
+
+#[test]
+fn mutated_agent_files_are_refused_or_drive_the_car() {
+    let valid = common::tiny_agent_text();
+    let map = common::tiny_map();
+    let disc = Discretizer::new(&map.bins).unwrap();
+    let path = Path::new("agent.ron");
+    let params = ScaledParams::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let (mut accepted, n) = (0, cases());
+    for case in 0..n {
+        let text = mutate(valid, &mut rng);
+        let bundle = match unforeseen::agent_file::parse(path, &text) {
+            Ok(b) => b,
+            Err(e) => {
+                assert_eq!(unforeseen::cli::exit_code(&e), 2, "case {case}: {e:#}");
+                assert!(format!("{e:#}").starts_with("agent.ron: "), "case {case}: {e:#}");
+                continue;
+            }
+        };
+        accepted += 1;
+        if unforeseen::agent_file::check_compatible(&bundle, &map).is_err() {
+            continue;
+        }
+        for method in [
+            Method::QLearning,
+            Method::BayesRl,
+            Method::BayesRlFactored,
+            Method::Scaled,
+        ] {
+            let Ok(mut controller) = method.controller(&bundle, &params) else {
+                continue;
+            };
+            // Two episodes on one controller: the second after test-time learning.
+            for episode in 0..2 {
+                let seeds = EpisodeSeeds {
+                    world: case as u64 + episode,
+                    controller: episode,
+                };
+                let (result, ticks) = run_episode(&map, &disc, controller.as_mut(), seeds, true);
+                assert!(result.ret.is_finite(), "case {case} {method}");
+                // Every decision (the last frame is the terminal state, with no decision).
+                for t in &ticks[..ticks.len() - 1] {
+                    assert!(
+                        t.policy.len() == 3 && t.policy.iter().all(|p| p.is_finite() && *p >= 0.0),
+                        "case {case} {method}: policy {:?}",
+                        t.policy
+                    );
+                }
+            }
+        }
+    }
+    eprintln!("agent files: {n} mutated, {accepted} accepted");
+    assert!(accepted > 0 && accepted < n, "the mutator should make both kinds");
+}
