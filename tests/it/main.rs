@@ -1,0 +1,12 @@
+//! The root crate's integration tests, one module per subject, in one test binary (one
+//! link instead of one per file keeps `cargo test` builds short). Modules share one
+//! small trained agent (`common::bundle`).
+
+mod batch;
+mod cli;
+mod common;
+mod compare_determinism;
+mod end_to_end;
+mod protocols;
+mod reference;
+mod train_seeds;
