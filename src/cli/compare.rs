@@ -11,7 +11,7 @@ use super::{AgentArgs, out_dir};
 use crate::agents::Agent;
 use crate::maps;
 use crate::methods::{Method, PaperFigures};
-use crate::plots::{BarPanel, BarRow, grouped_bars};
+use crate::plots::{BarPanel, BarRow, bar_key, grouped_bars};
 use crate::protocol::{Protocol, ProtocolChoice};
 use crate::report::{Csv, num, write_json};
 use crate::study::{METRICS, MethodSummary, ProtocolTable, StudySetup, run_study};
@@ -396,10 +396,10 @@ fn seeds_csv(tables: &[ProtocolTable]) -> Csv {
 fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
     type PaperOf = fn(&PaperFigures) -> f64;
     let panels: [(&str, &str, PaperOf); 4] = [
-        ("train reward", "train_reward", |p| p.train_reward),
-        ("test reward (unforeseen)", "test_reward", |p| p.test_reward),
-        ("success rate", "success_rate", |p| p.success_rate),
-        ("inference rate", "inference_rate", |p| p.inference_rate),
+        ("train reward (training map)", "train_reward", |p| p.train_reward),
+        ("test reward (test map)", "test_reward", |p| p.test_reward),
+        ("success rate (test map)", "success_rate", |p| p.success_rate),
+        ("inference rate (test map)", "inference_rate", |p| p.inference_rate),
     ];
     let labels: Vec<Vec<String>> = tables
         .iter()
@@ -410,18 +410,9 @@ fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
         .zip(&labels)
         .map(|(t, labels)| {
             let n = t.methods.first().map_or(0, |m| m.train_seeds.len());
-            let ours = if n > 1 {
-                format!("blue: ours, mean over {n} agents with 95% interval whiskers")
-            } else {
-                "blue: ours".into()
-            };
-            let paper = if t.protocol == Protocol::ZeroShot {
-                "; grey: the paper's (§VI)"
-            } else {
-                ""
-            };
             BarRow {
-                title: format!("{} protocol. {ours}{paper}", t.protocol),
+                title: format!("{} protocol: {}", t.protocol, t.protocol.meaning()),
+                key: bar_key(n, t.protocol == Protocol::ZeroShot),
                 panels: panels
                     .iter()
                     .map(|&(title, metric, paper)| BarPanel {

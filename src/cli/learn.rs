@@ -1,7 +1,7 @@
 //! `unforeseen learn`: test-time learning curves over repeated encounters (paper Fig. 9).
 
 use clap::Args;
-use plotters::style::{BLUE, GREEN, RED};
+use plotters::style::{BLUE, RED, RGBColor};
 use std::path::PathBuf;
 
 use super::{AgentArgs, out_dir};
@@ -109,7 +109,7 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
             (
                 "(a) surprise at the event (bits)",
                 vec![Series {
-                    label: "gate's surprise, first tick with a pedestrian on green",
+                    label: "gate's surprise at the first pedestrian on green",
                     points: x(&|p| p.event_surprise_bits),
                     color: RED,
                 }],
@@ -125,7 +125,7 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
                     Series {
                         label: "planner: P(p'=1 | p=1, L'=1, d'=2)",
                         points: x(&|p| Some(p.p_stay_green_d2)),
-                        color: GREEN,
+                        color: RGBColor(0, 150, 0),
                     },
                 ],
             ),

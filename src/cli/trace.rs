@@ -124,7 +124,15 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         &points,
         params.epsilon,
     )?;
-    filmstrip(&dir.join("filmstrip.svg"), &map, &ticks)?;
+    filmstrip(
+        &dir.join("filmstrip.svg"),
+        &format!(
+            "{} on {}, seed {}: {outcome} after {} ticks (from above, one strip per decision tick)",
+            args.method, map.name, args.agent.seed, result.ticks
+        ),
+        &map,
+        &ticks,
+    )?;
     println!("wrote {}/trace.csv, theta.svg, filmstrip.svg", dir.display());
     Ok(())
 }

@@ -7,6 +7,8 @@ mod cli;
 mod common;
 mod compare_determinism;
 mod end_to_end;
+mod figures;
 mod protocols;
 mod reference;
+mod svg_text;
 mod train_seeds;
