@@ -23,7 +23,8 @@
 //! * [`agents`] trains one agent per training seed, in parallel, with an on-disk cache;
 //! * [`study`] runs `compare` over agents and protocols and summarizes over seeds with
 //!   [`stats`] (mean, 95% Student-t interval, range, worst seed);
-//! * [`report`] writes JSON/CSV atomically and [`plots`] draws SVG figures;
+//! * [`report`] writes JSON/CSV atomically, [`plots`] draws SVG figures and [`replay`]
+//!   writes an episode as a self-contained HTML page that plays it;
 //! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
 //! * [`cli`] is the command line.
 
@@ -39,6 +40,7 @@ pub mod plots;
 pub mod progress;
 pub mod protocol;
 pub mod reference;
+pub mod replay;
 pub mod report;
 pub mod rewards;
 pub mod runner;

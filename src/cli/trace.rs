@@ -8,7 +8,8 @@ use crate::experiments::trace;
 use crate::maps;
 use crate::methods::Method;
 use crate::plots::{filmstrip, theta_trace};
-use crate::report::{Csv, num};
+use crate::replay::replay_html;
+use crate::report::{Csv, num, write_atomic};
 
 /// Arguments of `trace`.
 #[derive(Debug, Clone, Args)]
@@ -19,9 +20,14 @@ pub struct TraceArgs {
     /// Method to trace.
     #[arg(long, value_enum, default_value_t = Method::Scaled)]
     pub method: Method,
-    /// Output folder for trace.csv, theta.svg and filmstrip.svg.
+    /// Output folder for trace.csv, theta.svg and filmstrip.svg [default: out/trace].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Also write the episode as one self-contained HTML page (no network) that plays
+    /// the car, the pedestrians and the light beside theta and the actions, with a
+    /// slider to scrub, e.g. `--html out/trace/replay.html`.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -134,5 +140,15 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         &ticks,
     )?;
     println!("wrote {}/trace.csv, theta.svg, filmstrip.svg", dir.display());
+    if let Some(html) = &args.html {
+        let title = format!("{} on {}, seed {}", args.method, map.name, args.agent.seed);
+        let outcome = format!(
+            "{} {outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
+            args.method, result.ticks, result.ret, result.reasoning_ticks
+        );
+        let page = replay_html(&title, &outcome, &map, &ticks, params.epsilon)?;
+        write_atomic(html, page.as_bytes())?;
+        println!("wrote {} (open it in a browser)", html.display());
+    }
     Ok(())
 }

@@ -10,5 +10,6 @@ mod end_to_end;
 mod figures;
 mod protocols;
 mod reference;
+mod replay;
 mod svg_text;
 mod train_seeds;
