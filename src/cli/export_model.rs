@@ -64,6 +64,7 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         params.horizon,
         params.gamma,
     );
+    super::warn_replacing_file(&args.out);
     write_json(&args.out, &exported)?;
     println!(
         "wrote {} ({} states, {} actions, horizon {}, gamma {})",

@@ -167,6 +167,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
             )
         })
         .collect();
+    super::warn_replacing_file(&args.out);
     line_panels(
         &args.out,
         "x as named in the panel title (each point: mean over training seeds)",

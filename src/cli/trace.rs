@@ -3,7 +3,7 @@
 use clap::Args;
 use std::path::PathBuf;
 
-use super::{AgentArgs, out_dir};
+use super::{AgentArgs, warn_replacing};
 use crate::experiments::trace;
 use crate::maps;
 use crate::methods::Method;
@@ -20,9 +20,10 @@ pub struct TraceArgs {
     /// Method to trace.
     #[arg(long, value_enum, default_value_t = Method::Scaled)]
     pub method: Method,
-    /// Output folder for trace.csv, theta.svg and filmstrip.svg [default: out/trace].
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
+    /// Output folder for trace.csv, theta.svg and filmstrip.svg (files from an earlier
+    /// run there are replaced, with a warning).
+    #[arg(long, value_name = "DIR", default_value = "out/trace")]
+    pub out: PathBuf,
     /// Also write the episode as one self-contained HTML page (no network) that plays
     /// the car, the pedestrians and the light beside theta and the actions, with a
     /// slider to scrub, e.g. `--html out/trace/replay.html`.
@@ -118,7 +119,9 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         "{outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
         result.ticks, result.ret, result.reasoning_ticks
     );
-    let dir = out_dir(&args.out, "out/trace");
+    let dir = &args.out;
+    warn_replacing(dir, &["trace.csv", "theta.svg", "filmstrip.svg"]);
+    crate::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     csv.write(&dir.join("trace.csv"))?;
     let points: Vec<_> = decided
         .iter()

@@ -8,6 +8,7 @@ mod common;
 mod compare_determinism;
 mod end_to_end;
 mod figures;
+mod outputs;
 mod protocols;
 mod reference;
 mod replay;
