@@ -10,6 +10,7 @@ mod end_to_end;
 mod figures;
 mod outputs;
 mod protocols;
+mod readme;
 mod reference;
 mod replay;
 mod svg_text;
