@@ -27,6 +27,9 @@
 //!   writes an episode as a self-contained HTML page that plays it;
 //! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
 //! * [`cli`] is the command line.
+//!
+//! `docs/ARCHITECTURE.md` in the repository describes the layout, the data flow and the
+//! equations, with the paper's sections.
 
 pub mod agent_file;
 pub mod agents;

@@ -6,6 +6,7 @@ mod batch;
 mod cli;
 mod common;
 mod compare_determinism;
+mod doc_paths;
 mod end_to_end;
 mod figures;
 mod outputs;
