@@ -496,7 +496,7 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, Option<f64>, bool, S
     if measured {
         key.push(KeyEntry::new(Swatch::Line(BLUE), "theta (normalized surprise)"));
     }
-    key.push(KeyEntry::new(Swatch::Blank, "above the curve: each tick's action"));
+    key.push(KeyEntry::new(Swatch::Blank, "at the top: each tick's action"));
     let key_w = key_column_width(&key) + 24;
     const PLOT_W: i32 = 900;
     const ACTION_FONT: f64 = 10.0;

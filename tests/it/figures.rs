@@ -138,3 +138,18 @@ fn filmstrips_of_real_episodes_fit() {
         }
     }
 }
+
+#[test]
+fn the_committed_figures_fit() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs")
+        .join("figures");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).unwrap().flatten() {
+        if entry.path().extension().is_some_and(|e| e == "svg") {
+            assert_text_fits(&entry.path());
+            checked += 1;
+        }
+    }
+    assert!(checked > 0, "docs/figures has figures");
+}
