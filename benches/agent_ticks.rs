@@ -2,7 +2,7 @@
 //! horizon `H`, a feed-forward tick, the end-of-episode test-time learning update, and
 //! the reasoning tick as the joint state space grows.
 //!
-//! Run with `cargo bench --bench agent_ticks`. See BENCHMARKS.md for the figures.
+//! Run with `cargo bench --features bench --bench agent_ticks`. See BENCHMARKS.md for the figures.
 
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::{RngExt, SeedableRng};

@@ -2,7 +2,7 @@
 //! training throughput, and the closed loop (world + discretizer + scaled agent) at
 //! 10 Hz decisions / 60 Hz physics.
 //!
-//! Run with `cargo bench --bench loop`. See BENCHMARKS.md for the figures.
+//! Run with `cargo bench --features bench --bench loop`. See BENCHMARKS.md for the figures.
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;

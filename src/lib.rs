@@ -23,10 +23,14 @@
 //! * [`agents`] trains one agent per training seed, in parallel, with an on-disk cache;
 //! * [`study`] runs `compare` over agents and protocols and summarizes over seeds with
 //!   [`stats`] (mean, 95% Student-t interval, range, worst seed);
-//! * [`report`] writes JSON/CSV atomically and [`plots`] draws SVG figures;
+//! * [`report`] writes JSON/CSV atomically, [`plots`] draws SVG figures and [`replay`]
+//!   writes an episode as a self-contained HTML page that plays it;
 //! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
 //! * [`error`] is the library's typed error (what the user can fix);
 //! * [`cli`] is the command line, and alone decides messages and exit codes.
+//!
+//! `docs/ARCHITECTURE.md` in the repository describes the layout, the data flow and the
+//! equations, with the paper's sections.
 
 pub mod agent_file;
 pub mod agents;
@@ -42,6 +46,7 @@ pub mod plots;
 pub mod progress;
 pub mod protocol;
 pub mod reference;
+pub mod replay;
 pub mod report;
 pub mod rewards;
 pub mod runner;

@@ -17,6 +17,7 @@ fn main() {
         }
         default_hook(info);
     }));
+    unforeseen::progress::start_clock();
     let cli = Cli::parse();
     if let Err(err) = run(cli) {
         eprintln!("error: {err:#}");

@@ -1,4 +1,4 @@
-//! The methods compared in §VI, and the ablations of DESIGN.md §6, built from one
+//! The methods compared in §VI, and the ablations of docs/ARCHITECTURE.md §5, built from one
 //! trained [`AgentBundle`] so every method shares the same training data.
 
 use unforeseen_agent::controller::Controller;
@@ -47,7 +47,7 @@ pub enum Method {
 impl Method {
     /// The three methods of the paper's table.
     pub const PAPER: [Method; 3] = [Method::QLearning, Method::BayesRl, Method::Scaled];
-    /// The ablations of DESIGN.md §6.
+    /// The ablations (docs/ARCHITECTURE.md §5).
     pub const ABLATIONS: [Method; 5] = [
         Method::BayesRlFactored,
         Method::ScaledAlways,

@@ -1,4 +1,4 @@
-//! The two evaluation protocols (DESIGN.md §6). Every output names the one it ran under.
+//! The two evaluation protocols (docs/ARCHITECTURE.md §5). Every output names the one it ran under.
 //!
 //! * **zero-shot** (the paper's Fig. 8 table, the default of `compare`): every method
 //!   starts every test episode from its trained state; nothing carries over between

@@ -16,7 +16,7 @@
 //! it a [`crate::methods::Method`] lets `batch` report both witnesses from ordinary
 //! units and print the same warnings as `check-map` ([`crate::survivability`]).
 //!
-//! Both decode the observation index `s = ((d*n_v + v)*2 + L)*2 + p` (DESIGN.md §4)
+//! Both decode the observation index `s = ((d*n_v + v)*2 + L)*2 + p` (docs/ARCHITECTURE.md §3)
 //! with the factor sizes they are built with.
 
 use unforeseen_agent::controller::{Controller, Decision};

@@ -1,5 +1,5 @@
 //! Rewards (§VI): the per-tick reward the runner pays out, and the per-state reward
-//! R(s) behind the agent's preferences C = log_softmax(R / tau_c) (§IV, DESIGN.md §5).
+//! R(s) behind the agent's preferences C = log_softmax(R / tau_c) (§IV; docs/ARCHITECTURE.md §4.3).
 
 use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::{Map, StepOutcome};

@@ -1,5 +1,5 @@
 //! The episode runner: map -> world -> discretizer -> controller -> action -> world,
-//! one decision tick at a time (DESIGN.md §1), with the reward and metrics of §VI.
+//! one decision tick at a time (docs/ARCHITECTURE.md §1), with the reward and metrics of §VI.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

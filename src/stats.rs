@@ -1,7 +1,7 @@
 //! Summaries over independently trained agents (training seeds): the mean with a 95%
 //! confidence interval from Student's t distribution with n - 1 degrees of freedom,
-//! plus the smallest and largest value (DESIGN.md §6: "each as a mean with a 95%
-//! interval over independently trained agents").
+//! plus the smallest and largest value, as every figure over training seeds is
+//! reported (docs/ARCHITECTURE.md §5).
 
 use serde::{Deserialize, Serialize};
 

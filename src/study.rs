@@ -155,6 +155,24 @@ fn jobs(setup: &StudySetup<'_>, n_agents: usize) -> Vec<Job> {
 pub fn run_study(setup: &StudySetup<'_>, agents: &[Agent]) -> anyhow::Result<Vec<ProtocolTable>> {
     let jobs = jobs(setup, agents.len());
     let bar = progress::bar(jobs.len() as u64 * setup.episodes, "evaluating", setup.quiet);
+    let names = |xs: Vec<String>| xs.join(", ");
+    progress::phase(
+        setup.quiet,
+        format_args!(
+            "evaluating {} on '{}' (training map) and '{}' (test map), {}: {} runs of {} episodes",
+            names(setup.methods.iter().map(|m| m.name().to_string()).collect()),
+            setup.train_map.name,
+            setup.test_map.name,
+            names(setup.protocols.iter().map(|p| p.to_string()).collect()),
+            jobs.len(),
+            setup.episodes
+        ),
+    );
+    // Runs left per method, for one line as each method finishes (phase lines only).
+    let left: std::sync::Mutex<BTreeMap<Method, usize>> = std::sync::Mutex::new(BTreeMap::new());
+    for job in &jobs {
+        *left.lock().expect("progress counts").entry(job.1).or_default() += 1;
+    }
     let maps = [setup.train_map, setup.test_map];
     let aggregates = jobs
         .par_iter()
@@ -169,6 +187,12 @@ pub fn run_study(setup: &StudySetup<'_>, agents: &[Agent]) -> anyhow::Result<Vec
                 setup.seed,
                 &bar,
             )?;
+            let mut left = left.lock().expect("progress counts");
+            let n = left.entry(method).or_default();
+            *n = n.saturating_sub(1);
+            if *n == 0 {
+                progress::phase(setup.quiet, format_args!("evaluated {method}"));
+            }
             Ok(((agent, method, protocol, map), Aggregate::of(&results)))
         })
         .collect::<anyhow::Result<BTreeMap<Job, Aggregate>>>()?;

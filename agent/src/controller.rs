@@ -1,4 +1,4 @@
-//! The one trait all methods implement (linfa-style shared trait; DESIGN §6), so the
+//! The one trait all methods implement (linfa-style shared trait; docs/ARCHITECTURE.md §1, §5), so the
 //! runner never cares whether it drives Q-learning, Bayesian RL or the scaled agent.
 
 /// What a controller decided on one tick, and what it computed to get there.
@@ -20,7 +20,7 @@ pub struct Decision {
     pub scaling_iters: u32,
 }
 
-/// A method that acts on observations (DESIGN §6).
+/// A method that acts on observations (docs/ARCHITECTURE.md §5).
 pub trait Controller: Send {
     /// Method name, e.g. `"scaled"`.
     fn name(&self) -> &'static str;

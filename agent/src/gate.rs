@@ -1,6 +1,7 @@
 //! The surprise gate on the state (§VI "surprise measured from the state space", Fig. 9a-b;
-//! DESIGN §5): how likely the habit finds the watched factor's value given the factors it
-//! depends on, `P(x | parents)`, e.g. `P(p | L, d)`, a pedestrian given light and distance.
+//! docs/ARCHITECTURE.md §4.4): how likely the habit finds the watched factor's value
+//! given the factors it depends on, `P(x | parents)`, e.g. `P(p | L, d)`, a pedestrian
+//! given light and distance.
 //!
 //! `S_t = -ln Σ_s q_t(s) P(x(s) | parents(s))`, which for a one-hot belief is
 //! `-ln P(x_t | parents_t)`: the paper's Fig. 9a (1.95 -> 0.2 bits) is `-log2` of its

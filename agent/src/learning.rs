@@ -9,7 +9,7 @@
 //!   taken gives the paper's `q(s_{τ-1} = j) 1[a_τ = i]` with its action index shifted by one).
 //!
 //! The base policy is `π_o(u|s) = ν[u,s] / Σ_u ν[u,s]`, and `ν` starts as
-//! `ν0 σ(Q[s,·]/T)` (DESIGN §5).
+//! `ν0 σ(Q[s,·]/T)` (docs/ARCHITECTURE.md §4.8).
 
 use crate::maths::softmax_in_place;
 use crate::model::WorldModel;
@@ -119,7 +119,7 @@ pub fn pi_o_state(nu: &[f64], n_actions: usize, s: usize, out: &mut [f64]) {
     crate::maths::normalize_in_place(out);
 }
 
-/// `π_o(·|q) = Σ_s q[s] π_o(·|s)` (the base policy under a belief, DESIGN §6 "scaled").
+/// `π_o(·|q) = Σ_s q[s] π_o(·|s)` (the base policy under a belief, docs/ARCHITECTURE.md §5).
 pub fn pi_o_belief(nu: &[f64], n_actions: usize, q: &[f64], out: &mut [f64]) {
     out.iter_mut().for_each(|v| *v = 0.0);
     for (s, p) in q.iter().enumerate() {
@@ -133,7 +133,7 @@ pub fn pi_o_belief(nu: &[f64], n_actions: usize, q: &[f64], out: &mut [f64]) {
     }
 }
 
-/// `ν = ν0 σ(Q[s,·]/T)` per state (DESIGN §5, end of training), laid out `[s * n_actions + u]`.
+/// `ν = ν0 σ(Q[s,·]/T)` per state (docs/ARCHITECTURE.md §4.8, end of training), laid out `[s * n_actions + u]`.
 pub fn nu_from_q(q_table: &[f64], n_actions: usize, nu0: f64, temperature: f64) -> Vec<f64> {
     let mut nu: Vec<f64> = q_table.iter().map(|q| q / temperature).collect();
     for row in nu.chunks_mut(n_actions) {

@@ -1,13 +1,13 @@
-//! Numerical primitives shared by every module (DESIGN §5 "Conventions").
+//! Numerical primitives shared by every module (docs/ARCHITECTURE.md §4.1).
 //!
 //! Natural logarithms throughout; `ln x` is computed as `ln(max(x, 1e-16))` so
 //! that zero probabilities give a large finite penalty instead of `-inf`;
 //! softmax is max-subtracted.
 
-/// Floor applied before every logarithm (DESIGN §5): `ln x = ln(max(x, LN_FLOOR))`.
+/// Floor applied before every logarithm (docs/ARCHITECTURE.md §4.1): `ln x = ln(max(x, LN_FLOOR))`.
 pub const LN_FLOOR: f64 = 1e-16;
 
-/// Floored natural logarithm, `ln(max(x, 1e-16))` (DESIGN §5 conventions).
+/// Floored natural logarithm, `ln(max(x, 1e-16))` (docs/ARCHITECTURE.md §4.1).
 #[inline]
 pub fn ln(x: f64) -> f64 {
     x.max(LN_FLOOR).ln()
@@ -59,7 +59,7 @@ pub fn softmax(x: &[f64]) -> Vec<f64> {
 }
 
 /// `log_softmax(x)_i = x_i - ln Σ_j exp(x_j)`, computed stably. Used for the
-/// preferences `C = ln c = log_softmax(R / τ_c)` (DESIGN §5, §IV "EFE_0").
+/// preferences `C = ln c = log_softmax(R / τ_c)` (§IV "EFE_0"; docs/ARCHITECTURE.md §4.3).
 pub fn log_softmax(x: &[f64]) -> Vec<f64> {
     let m = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let lse = m + x.iter().map(|v| (v - m).exp()).sum::<f64>().ln();
@@ -105,7 +105,7 @@ pub fn argmax(x: &[f64]) -> usize {
     best
 }
 
-/// Nats to bits (reporting only: DESIGN §5 says nats inside, bits when reported).
+/// Nats to bits (reporting only: nats inside, bits when reported; docs/ARCHITECTURE.md §4.1).
 pub fn nats_to_bits(x: f64) -> f64 {
     x / std::f64::consts::LN_2
 }

@@ -624,7 +624,7 @@ impl WorldModel {
         &self.gm.d
     }
 
-    /// Set `C = log_softmax(R / τ_c)` from per-observation rewards (DESIGN §5 "Preferences").
+    /// Set `C = log_softmax(R / τ_c)` from per-observation rewards (docs/ARCHITECTURE.md §4.3).
     pub fn set_preferences(&mut self, rewards: &[f64], tau_c: f64) -> Result<(), AgentError> {
         if rewards.len() != self.gm.n_obs() {
             return Err(AgentError::SizeMismatch {

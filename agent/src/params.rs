@@ -117,7 +117,7 @@ pub enum ScalingMode {
     ClosedForm,
 }
 
-/// How the action is drawn from the policy acted upon (DESIGN §5 "Action selection").
+/// How the action is drawn from the policy acted upon (docs/ARCHITECTURE.md §4.9).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum ActionSelection {
     /// The mode (ties: lowest index). Default in evaluation.
@@ -137,7 +137,7 @@ pub enum ReasoningMode {
     Always,
 }
 
-/// What the reasoning trigger measures (§II, §VI; DESIGN §5 "Surprise").
+/// What the reasoning trigger measures (§II, §VI; docs/ARCHITECTURE.md §4.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum GateMode {
     /// Surprise on the state: `-ln P(x_t | parents_t)` of the watched factor (the paper's
@@ -149,8 +149,8 @@ pub enum GateMode {
     OneStep,
 }
 
-/// How the gate's table learns a situation as familiar (§V applied to the gate; DESIGN §5
-/// "Hand-back"). Beyond the paper, whose rule is only `θ <= ε`.
+/// How the gate's table learns a situation as familiar (§V applied to the gate;
+/// docs/ARCHITECTURE.md §4.4). Beyond the paper, whose rule is only `θ <= ε`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum GateLearning {
     /// A reasoning tick counts in the gate's table with weight `π'(a_o) / max_u π'(u)`,
@@ -197,7 +197,7 @@ pub enum GateBaseline {
 /// | `reasoning` | Triggered | | triggered or always (ablation) |
 /// | `learning` | true | | test-time learning §V at episode end |
 /// | `learning_rate` | 1.0 | >= 0 | multiplies the expected counts added in §V |
-/// | `nu0` ν0 | 10.0 | > 0 | prior strength of ν = ν0 σ(Q/T) (DESIGN §5) |
+/// | `nu0` ν0 | 10.0 | > 0 | prior strength of ν = ν0 σ(Q/T) (docs/ARCHITECTURE.md §4.8) |
 /// | `nu_temperature` T | 1.0 | > 0 | temperature of ν's softmax over Q |
 /// | `gate` | State | | §VI surprise on the state, or the one-step joint surprise (ablation) |
 /// | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |

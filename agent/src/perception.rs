@@ -78,7 +78,7 @@ fn message_into(
     }
 }
 
-/// Free energy of a window (Definition "VFE"; DESIGN §5):
+/// Free energy of a window (Definition "VFE"; docs/ARCHITECTURE.md §4.5):
 /// `F = Σ_τ q_τ·(ln q_τ - (ln A)^T o_τ) - q_0·ln ŝ - Σ_{τ>0} q_τ^T (ln B[a_{τ-1}]) q_{τ-1}`.
 /// `F >= -ln p(o_window)` (Lemma 1), with equality at the exact posterior for W = 1.
 pub fn free_energy(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: &[usize], qs: &[Vec<f64>]) -> f64 {

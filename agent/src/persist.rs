@@ -34,7 +34,7 @@ pub struct AgentBundle {
     /// The trained Bayesian-RL posterior.
     pub bayes_rl: BayesRl,
     /// Bayesian RL given the factored world model instead of the flat one (ablation,
-    /// DESIGN.md §6), trained on the same episodes; absent in older files.
+    /// docs/ARCHITECTURE.md §5), trained on the same episodes; absent in older files.
     #[serde(default)]
     pub bayes_rl_factored: Option<BayesRl>,
     /// Free-form metadata (map name, seed, episodes...).

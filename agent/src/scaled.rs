@@ -53,7 +53,7 @@ pub struct ReasoningTrace {
     pub kl_final: f64,
 }
 
-/// The scaled active-inference agent (DESIGN §5–6 "scaled").
+/// The scaled active-inference agent (docs/ARCHITECTURE.md §4, §5).
 #[derive(Debug, Clone)]
 pub struct ScaledAgent {
     model: WorldModel,
@@ -87,7 +87,7 @@ pub struct ScaledAgent {
 }
 
 impl ScaledAgent {
-    /// Build the agent from a trained world model and Q-table: `ν = ν0 σ(Q[s,·]/T)` (DESIGN §5).
+    /// Build the agent from a trained world model and Q-table: `ν = ν0 σ(Q[s,·]/T)` (docs/ARCHITECTURE.md §4.8).
     pub fn new(mut model: WorldModel, q: &QLearning, params: ScaledParams) -> Result<ScaledAgent, AgentError> {
         params.check()?;
         let pooling = (!params.persistence_ignores.is_empty())

@@ -1,5 +1,5 @@
 //! State factors and their parents: the structure of the world model's dynamic
-//! Bayesian network (§II-A world model; DESIGN §5). The structure is data:
+//! Bayesian network (§II-A world model; docs/ARCHITECTURE.md §4.2). The structure is data:
 //! the paper's `v'|v,u; d'|d,v'; L'|L; p'|p,L',d'` is one value, [`Structure::paper_default`].
 //!
 //! Joint indexing: factors in order, first factor most significant. For the

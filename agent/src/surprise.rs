@@ -21,7 +21,7 @@ pub(crate) fn matvec_sparse_x(m: &[f64], rows: usize, x: &[f64], out: &mut [f64]
     }
 }
 
-/// State prediction `ŝ_t = B[a_{t-1}] q_{t-1}`, or `D` when `prev` is `None` (§II, DESIGN §5).
+/// State prediction `ŝ_t = B[a_{t-1}] q_{t-1}`, or `D` when `prev` is `None` (§II; docs/ARCHITECTURE.md §4.4).
 pub fn predict_into(gm: &GenerativeModel, prev: Option<(&[f64], usize)>, out: &mut [f64]) {
     match prev {
         None => out.copy_from_slice(&gm.d),

@@ -1,4 +1,4 @@
-//! Continuous world snapshot -> the paper's discrete state (§VI, DESIGN.md §4).
+//! Continuous world snapshot -> the paper's discrete state (§VI; docs/ARCHITECTURE.md §3).
 //!
 //! The paper's state space is four factors:
 //!
@@ -55,7 +55,7 @@ pub enum DiscretizerError {
     BadNoise(f64),
 }
 
-/// Maps [`Snapshot`]s to discrete states using a map's bin edges (DESIGN.md §4).
+/// Maps [`Snapshot`]s to discrete states using a map's bin edges (docs/ARCHITECTURE.md §3).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Discretizer {
     distance_edges: Vec<f64>,

@@ -1,4 +1,4 @@
-//! Bin edges as a table of (continuous input -> expected discrete state) cases (§VI, DESIGN.md §4).
+//! Bin edges as a table of (continuous input -> expected discrete state) cases (§VI; docs/ARCHITECTURE.md §3).
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

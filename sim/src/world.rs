@@ -310,7 +310,7 @@ impl World {
             self.phys.step_with_events(&(), &events);
             self.substep += 1;
             self.after_substep();
-            // Sensor events arrive one sub-step after the overlap (RAPIER.md §6.4);
+            // Sensor events arrive one sub-step after the overlap (a Rapier pitfall);
             // a collision is therefore detected at most 1/physics_hz late.
             if events.touches(self.car_collider) {
                 collision = true;

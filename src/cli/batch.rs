@@ -159,6 +159,20 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         shard: args.shard,
         agents_identity,
     };
+    crate::progress::phase(
+        args.quiet,
+        format_args!(
+            "running {} scenario(s) x {} method(s) x {} parameter set(s) x {} protocol(s) x {} agent(s) on {} thread(s), {} episodes each, into {}",
+            scenarios.len(),
+            methods.len(),
+            params.len(),
+            protocols.len(),
+            axis.len(),
+            args.jobs,
+            args.episodes,
+            args.out.display()
+        ),
+    );
     let lines = run(&cfg, &args.out, args.resume, args.quiet)?;
     let rows = summarize(&lines);
     print_summary(&rows);

@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 
 use super::table::{cell, print_grid, range_cell, seed_text};
 use super::train_seeds::TrainSeedArgs;
-use super::{AgentArgs, out_dir};
+use super::{AgentArgs, warn_replacing};
 use crate::agents::Agent;
 use crate::maps;
 use crate::methods::{Method, PaperFigures};
-use crate::plots::{BarPanel, BarRow, grouped_bars};
+use crate::plots::{BarPanel, BarRow, bar_key, grouped_bars};
 use crate::protocol::{Protocol, ProtocolChoice};
 use crate::report::{Csv, num, write_json};
 use crate::study::{METRICS, MethodSummary, ProtocolTable, StudySetup, run_study};
@@ -42,9 +42,10 @@ pub struct CompareArgs {
     /// order) or both (zero-shot table first).
     #[arg(long, value_enum, default_value_t = ProtocolChoice::Both)]
     pub protocol: ProtocolChoice,
-    /// Output folder for compare.json, compare.csv, compare_seeds.csv and compare.svg.
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
+    /// Output folder for compare.json, compare.csv, compare_seeds.csv and compare.svg
+    /// (files from an earlier run there are replaced, with a warning).
+    #[arg(long, value_name = "DIR", default_value = "out/compare")]
+    pub out: PathBuf,
     /// Training seeds and the agent cache.
     #[command(flatten)]
     pub seeds: TrainSeedArgs,
@@ -62,7 +63,7 @@ impl Default for CompareArgs {
             episodes: 100,
             ablations: false,
             protocol: ProtocolChoice::Both,
-            out: None,
+            out: PathBuf::from("out/compare"),
             seeds: TrainSeedArgs {
                 train_seeds: None,
                 cache: crate::agents::DEFAULT_CACHE.into(),
@@ -88,7 +89,11 @@ pub struct CompareReport {
     pub protocols: Vec<Protocol>,
     /// One table per protocol.
     pub tables: Vec<ProtocolTable>,
-    /// The paper's values for the same columns (§VI, zero-shot).
+    /// What each column measures and on which map (train reward on the training map,
+    /// every other column on the test map).
+    pub columns: serde_json::Value,
+    /// The paper's values for the same columns (§VI, zero-shot; null where the paper
+    /// gives none, as for the collision rate).
     pub paper: Vec<serde_json::Value>,
     /// Training map name.
     pub train_map: String,
@@ -144,7 +149,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     };
     let tables = run_study(&setup, &agents)?;
     for table in &tables {
-        print_table(table);
+        print_table(table, &train_map.name, &test_map.name);
     }
 
     let report = CompareReport {
@@ -152,8 +157,9 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         protocols,
         paper: Method::PAPER
             .iter()
-            .filter_map(|m| m.paper().map(|p| serde_json::json!({"method": m.name(), "train_reward": p.train_reward, "test_reward": p.test_reward, "success_rate": p.success_rate, "inference_rate_relative_to_bayes_rl": p.inference_rate})))
+            .filter_map(|m| m.paper().map(|p| serde_json::json!({"method": m.name(), "train_reward": p.train_reward, "test_reward": p.test_reward, "success_rate": p.success_rate, "collision_rate": null, "inference_rate_relative_to_bayes_rl": p.inference_rate})))
             .collect(),
+        columns: columns(&train_map.name, &test_map.name, args.episodes),
         train_map: train_map.name.clone(),
         test_map: test_map.name.clone(),
         reward: serde_json::json!({"train_map": train_map.reward, "test_map": test_map.reward}),
@@ -169,16 +175,33 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         scaled_params: serde_json::to_value(&params)?,
         tables,
     };
-    let dir = out_dir(&args.out, "out/compare");
+    let dir = &args.out;
+    let files = ["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"];
+    warn_replacing(dir, &files);
+    crate::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     write_json(&dir.join("compare.json"), &report)?;
-    summary_csv(&report.tables).write(&dir.join("compare.csv"))?;
-    seeds_csv(&report.tables).write(&dir.join("compare_seeds.csv"))?;
+    let maps = (report.train_map.as_str(), report.test_map.as_str());
+    summary_csv(&report.tables, maps).write(&dir.join("compare.csv"))?;
+    seeds_csv(&report.tables, maps).write(&dir.join("compare_seeds.csv"))?;
     plot(&dir.join("compare.svg"), &report.tables)?;
     println!(
         "wrote {}/compare.json, compare.csv, compare_seeds.csv, compare.svg",
         dir.display()
     );
     Ok(())
+}
+
+/// What each column of the table measures, on which map and over how many episodes.
+fn columns(train_map: &str, test_map: &str, episodes: u64) -> serde_json::Value {
+    let on_test = |what: &str| format!("{what} on the test map '{test_map}', {episodes} episodes per method and agent");
+    serde_json::json!({
+        "train_reward": format!("mean return on the training map '{train_map}' after training, {episodes} episodes per method and agent"),
+        "test_reward": on_test("mean return"),
+        "success_rate": on_test("share of episodes reaching the destination without a collision"),
+        "collision_rate": format!("{}; the paper gives no value", on_test("share of episodes that hit a pedestrian")),
+        "inference_rate": on_test("share of decision ticks that ran planning"),
+        "reasoning_us_per_tick": on_test("wall-clock µs per tick inside the controller"),
+    })
 }
 
 /// The paper's figures for a method, if it reports them.
@@ -210,20 +233,25 @@ fn agents_line(m: &MethodSummary) -> String {
 }
 
 /// Prints one protocol's table: the figures (paper's in parentheses), then, over
-/// several agents, their range and the worst seed.
-fn print_table(table: &ProtocolTable) {
+/// several agents, their range and the worst seed. A second header line names the map
+/// each column was measured on.
+fn print_table(table: &ProtocolTable, train_map: &str, test_map: &str) {
     let Some(first) = table.methods.first() else { return };
     let n = first.train_seeds.len();
     println!();
     println!("== {} protocol: {}", table.protocol, table.meaning);
     println!("{}", agents_line(first));
+    println!("train reward: on the training map '{train_map}'; every other column: on the test map '{test_map}'");
     if n > 1 {
         println!(
             "each figure: mean ± half-width of the 95% interval over the {n} agents (Student t, {} df)",
             n - 1
         );
     }
-    let mut rows = vec![header("µs/tick")];
+    let mut rows = vec![
+        header("µs/tick"),
+        maps_row(train_map, test_map, &format!("({test_map})")),
+    ];
     let with_paper = |ours: String, paper: Option<String>| match paper {
         Some(p) if table.protocol == Protocol::ZeroShot => format!("{ours} ({p})"),
         _ => ours,
@@ -239,14 +267,19 @@ fn print_table(table: &ProtocolTable) {
                 cell(&m.success_rate, if n > 1 { 1 } else { 0 }, true),
                 p.map(|p| format!("{:.0}%", 100.0 * p.success_rate)),
             ),
-            cell(&m.collision_rate, if n > 1 { 1 } else { 0 }, true),
+            with_paper(
+                cell(&m.collision_rate, if n > 1 { 1 } else { 0 }, true),
+                p.map(|_| "n/a".to_string()),
+            ),
             cell(&m.inference_rate, 1, true),
             cell(&m.reasoning_us_per_tick, 2, false),
         ]);
     }
     print_grid(&rows);
     if table.protocol == Protocol::ZeroShot {
-        println!("(paper's values in parentheses, §VI)");
+        println!(
+            "(paper's values in parentheses, §VI; n/a: the paper gives no collision rate; its inference rate is relative, below)"
+        );
     }
     let copied: Vec<&str> = table
         .methods
@@ -269,7 +302,7 @@ fn print_table(table: &ProtocolTable) {
         );
     }
     if n > 1 {
-        print_spread(table);
+        print_spread(table, train_map, test_map);
     }
 }
 
@@ -283,10 +316,18 @@ fn header(last: &str) -> Vec<String> {
         .collect()
 }
 
+/// The second header line: the map each figure was measured on, then `last`.
+fn maps_row(train_map: &str, test_map: &str, last: &str) -> Vec<String> {
+    let test = format!("({test_map})");
+    ["", &format!("({train_map})"), &test, &test, &test, &test, last]
+        .map(String::from)
+        .to_vec()
+}
+
 /// The range over agents of each figure and the worst seed (lowest test success).
-fn print_spread(table: &ProtocolTable) {
+fn print_spread(table: &ProtocolTable, train_map: &str, test_map: &str) {
     println!("over the agents: min .. max, and the worst seed (lowest test success; its success and test reward)");
-    let mut rows = vec![header("worst seed")];
+    let mut rows = vec![header("worst seed"), maps_row(train_map, test_map, "")];
     for m in &table.methods {
         let w = &m.worst_seed;
         rows.push(vec![
@@ -320,7 +361,7 @@ fn seeds_cell(seeds: &[Option<u64>]) -> String {
 
 /// `compare.csv`: one row per (protocol, method), every metric as mean, 95% interval,
 /// min and max over agents, and the worst seed.
-fn summary_csv(tables: &[ProtocolTable]) -> Csv {
+fn summary_csv(tables: &[ProtocolTable], (train_map, test_map): (&str, &str)) -> Csv {
     let mut header: Vec<String> = [
         "protocol",
         "method",
@@ -330,6 +371,8 @@ fn summary_csv(tables: &[ProtocolTable]) -> Csv {
         "train_episodes",
         "episodes",
         "seed",
+        "train_map",
+        "test_map",
     ]
     .map(String::from)
     .to_vec();
@@ -350,6 +393,8 @@ fn summary_csv(tables: &[ProtocolTable]) -> Csv {
             m.train_episodes.map(|e| e.to_string()).unwrap_or_default(),
             m.episodes.to_string(),
             m.seed.to_string(),
+            train_map.to_string(),
+            test_map.to_string(),
         ];
         for (name, _) in METRICS {
             let s = m.stat(name);
@@ -372,8 +417,15 @@ fn summary_csv(tables: &[ProtocolTable]) -> Csv {
 }
 
 /// `compare_seeds.csv`: one row per (protocol, method, training seed).
-fn seeds_csv(tables: &[ProtocolTable]) -> Csv {
-    let mut header = vec!["protocol", "method", "computed_under", "train_seed"];
+fn seeds_csv(tables: &[ProtocolTable], (train_map, test_map): (&str, &str)) -> Csv {
+    let mut header = vec![
+        "protocol",
+        "method",
+        "computed_under",
+        "train_seed",
+        "train_map",
+        "test_map",
+    ];
     header.extend(METRICS.iter().map(|(name, _)| *name));
     let mut csv = Csv::new(&header);
     for m in tables.iter().flat_map(|t| &t.methods) {
@@ -383,6 +435,8 @@ fn seeds_csv(tables: &[ProtocolTable]) -> Csv {
                 m.method.clone(),
                 m.computed_under.to_string(),
                 r.train_seed.map(|s| s.to_string()).unwrap_or_default(),
+                train_map.to_string(),
+                test_map.to_string(),
             ];
             row.extend(METRICS.iter().map(|(_, f)| num(f(r), 4)));
             csv.row(row);
@@ -396,10 +450,10 @@ fn seeds_csv(tables: &[ProtocolTable]) -> Csv {
 fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
     type PaperOf = fn(&PaperFigures) -> f64;
     let panels: [(&str, &str, PaperOf); 4] = [
-        ("train reward", "train_reward", |p| p.train_reward),
-        ("test reward (unforeseen)", "test_reward", |p| p.test_reward),
-        ("success rate", "success_rate", |p| p.success_rate),
-        ("inference rate", "inference_rate", |p| p.inference_rate),
+        ("train reward (training map)", "train_reward", |p| p.train_reward),
+        ("test reward (test map)", "test_reward", |p| p.test_reward),
+        ("success rate (test map)", "success_rate", |p| p.success_rate),
+        ("inference rate (test map)", "inference_rate", |p| p.inference_rate),
     ];
     let labels: Vec<Vec<String>> = tables
         .iter()
@@ -410,18 +464,9 @@ fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
         .zip(&labels)
         .map(|(t, labels)| {
             let n = t.methods.first().map_or(0, |m| m.train_seeds.len());
-            let ours = if n > 1 {
-                format!("blue: ours, mean over {n} agents with 95% interval whiskers")
-            } else {
-                "blue: ours".into()
-            };
-            let paper = if t.protocol == Protocol::ZeroShot {
-                "; grey: the paper's (§VI)"
-            } else {
-                ""
-            };
             BarRow {
-                title: format!("{} protocol. {ours}{paper}", t.protocol),
+                title: format!("{} protocol: {}", t.protocol, t.protocol.meaning()),
+                key: bar_key(n, t.protocol == Protocol::ZeroShot),
                 panels: panels
                     .iter()
                     .map(|&(title, metric, paper)| BarPanel {

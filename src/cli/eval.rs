@@ -3,7 +3,7 @@
 use clap::Args;
 use std::path::PathBuf;
 
-use super::{AgentArgs, out_dir};
+use super::{AgentArgs, warn_replacing};
 use crate::experiments::{evaluate_scripted, evaluate_under};
 use crate::maps;
 use crate::methods::Method;
@@ -30,9 +30,10 @@ pub struct EvalArgs {
     /// episodes, in order).
     #[arg(long, value_enum, default_value_t = Protocol::ZeroShot)]
     pub protocol: Protocol,
-    /// Output folder for eval.json.
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
+    /// Output folder for eval.json (an eval.json from an earlier run there is replaced,
+    /// with a warning).
+    #[arg(long, value_name = "DIR", default_value = "out/eval")]
+    pub out: PathBuf,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -47,12 +48,18 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         &format!("{} {}", args.method, map.name),
         args.agent.quiet,
     );
+    let evaluating = format!(
+        "evaluating {} on '{}' ({}, {} episodes)",
+        args.method, map.name, args.protocol, args.episodes
+    );
     // The scripted references need no agent: they decode the map's own observations.
     let (results, train_seed) = if args.method.is_scripted() {
+        crate::progress::phase(args.agent.quiet, &evaluating);
         let results = evaluate_scripted(&map, args.method, args.episodes, args.agent.seed, &bar)?;
         (results, None)
     } else {
         let bundle = args.agent.bundle()?;
+        crate::progress::phase(args.agent.quiet, &evaluating);
         let results = evaluate_under(
             args.protocol,
             &map,
@@ -80,7 +87,12 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         agg.us_per_tick,
         agg.episodes
     );
-    let dir = out_dir(&args.out, "out/eval");
+    let dir = &args.out;
+    warn_replacing(dir, &["eval.json"]);
+    crate::progress::phase(
+        args.agent.quiet,
+        format_args!("writing {}", dir.join("eval.json").display()),
+    );
     write_json(
         &dir.join("eval.json"),
         &serde_json::json!({

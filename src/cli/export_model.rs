@@ -82,6 +82,7 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         }
         .into());
     }
+    super::warn_replacing_file(&args.out);
     write_json(&args.out, &exported)?;
     println!(
         "wrote {} ({} states, {} actions, horizon {}, gamma {})",

@@ -1,10 +1,10 @@
 //! `unforeseen learn`: test-time learning curves over repeated encounters (paper Fig. 9).
 
 use clap::Args;
-use plotters::style::{BLUE, GREEN, RED};
+use plotters::style::{BLUE, RED, RGBColor};
 use std::path::PathBuf;
 
-use super::{AgentArgs, out_dir};
+use super::{AgentArgs, warn_replacing};
 use crate::experiments::learn;
 use crate::maps;
 use crate::plots::{Series, line_panels};
@@ -19,9 +19,10 @@ pub struct LearnArgs {
     /// Episodes of test-time learning.
     #[arg(long, default_value_t = 50, value_parser = super::episodes)]
     pub episodes: u64,
-    /// Output folder for learn.csv, learn.json and learn.svg.
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
+    /// Output folder for learn.csv, learn.json and learn.svg (files from an earlier run
+    /// there are replaced, with a warning).
+    #[arg(long, value_name = "DIR", default_value = "out/learn")]
+    pub out: PathBuf,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -32,6 +33,13 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bundle = args.agent.bundle()?;
+    crate::progress::phase(
+        args.agent.quiet,
+        format_args!(
+            "test-time learning on '{}' over {} episodes (continual)",
+            map.name, args.episodes
+        ),
+    );
     let points = learn(&bundle, &params, &map, args.episodes, args.agent.seed, args.agent.quiet)?;
     let mut csv = Csv::new(&[
         "episode",
@@ -93,7 +101,9 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
             points.len()
         );
     }
-    let dir = out_dir(&args.out, "out/learn");
+    let dir = &args.out;
+    warn_replacing(dir, &["learn.csv", "learn.json", "learn.svg"]);
+    crate::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     csv.write(&dir.join("learn.csv"))?;
     write_json(&dir.join("learn.json"), &points)?;
     let x = |f: &dyn Fn(&crate::experiments::LearnPoint) -> Option<f64>| -> Vec<(f64, f64)> {
@@ -109,7 +119,7 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
             (
                 "(a) surprise at the event (bits)",
                 vec![Series {
-                    label: "gate's surprise, first tick with a pedestrian on green",
+                    label: "gate's surprise at the first pedestrian on green",
                     points: x(&|p| p.event_surprise_bits),
                     color: RED,
                 }],
@@ -125,7 +135,7 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
                     Series {
                         label: "planner: P(p'=1 | p=1, L'=1, d'=2)",
                         points: x(&|p| Some(p.p_stay_green_d2)),
-                        color: GREEN,
+                        color: RGBColor(0, 150, 0),
                     },
                 ],
             ),

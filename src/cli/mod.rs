@@ -24,10 +24,26 @@ pub mod trace;
 pub mod train;
 pub mod train_seeds;
 
+/// What each command writes by default (`--out` changes it), shown under `--help`.
+const OUTPUTS: &str = "\
+Outputs (default places; --out changes them; a rerun replaces them, with a warning,
+except batch, which replaces its results unless --resume completes them):
+  compare       out/compare/: compare.json, compare.csv, compare_seeds.csv, compare.svg
+                (agents trained with --train-seeds are cached in out/agents/)
+  train         agent.ron
+  eval          out/eval/eval.json
+  trace         out/trace/: trace.csv, theta.svg, filmstrip.svg (and --html FILE: a replay page)
+  learn         out/learn/: learn.csv, learn.json, learn.svg
+  batch         results.jsonl and results.summary.json
+  plot-sweep    sweep.svg
+  export-model  out/model.json
+Progress: bars on a terminal; otherwise one line per phase on stderr (-q: none).
+Architecture and equations: docs/ARCHITECTURE.md in the repository.";
+
 /// Active inference as the test-time scaling law for physical AI agents, on a Rapier 2D
 /// intersection. With no command, runs `compare` on the embedded default maps.
 #[derive(Debug, Parser)]
-#[command(name = "unforeseen", version, about, long_about = None)]
+#[command(name = "unforeseen", version, about, long_about = None, after_help = OUTPUTS)]
 pub struct Cli {
     /// What to run (default: `compare` on the embedded maps).
     #[command(subcommand)]
@@ -152,6 +168,10 @@ pub fn load_or_train(
         Some(path) => crate::agent_file::load(path),
         None => {
             let map = crate::maps::load(map)?;
+            crate::progress::phase(
+                quiet,
+                format_args!("training {episodes} episodes on '{}' (seed {seed})", map.name),
+            );
             let cfg = TrainConfig {
                 quiet,
                 ..TrainConfig::new(episodes, seed)
@@ -161,7 +181,26 @@ pub fn load_or_train(
     }
 }
 
-/// `--out` folder handling shared by the commands.
-pub fn out_dir(out: &Option<PathBuf>, default: &str) -> PathBuf {
-    out.clone().unwrap_or_else(|| PathBuf::from(default))
+/// Warns on stderr (whatever `--quiet` says) that this run replaces the file `path` an
+/// earlier run wrote.
+pub fn warn_replacing_file(path: &std::path::Path) {
+    if path.is_file() {
+        eprintln!(
+            "warning: replacing {} from an earlier run (--out FILE writes elsewhere)",
+            path.display()
+        );
+    }
+}
+
+/// Warns on stderr (whatever `--quiet` says) that this run replaces the files `names` in
+/// `dir` that an earlier run wrote; results are replaced, never merged.
+pub fn warn_replacing(dir: &std::path::Path, names: &[&str]) {
+    let existing: Vec<&str> = names.iter().copied().filter(|n| dir.join(n).is_file()).collect();
+    if !existing.is_empty() {
+        eprintln!(
+            "warning: replacing {} in {} from an earlier run (--out DIR writes them elsewhere)",
+            existing.join(", "),
+            dir.display()
+        );
+    }
 }

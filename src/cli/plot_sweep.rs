@@ -2,7 +2,7 @@
 //! and reward against reasoning compute, one panel pair per swept parameter.
 
 use clap::Args;
-use plotters::style::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED, RGBColor};
+use plotters::style::RGBColor;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -21,10 +21,27 @@ pub struct PlotSweepArgs {
     pub out: PathBuf,
 }
 
+/// One series before plotting: key label, colour, points.
+type SeriesData = (String, RGBColor, Vec<(f64, f64)>);
+
 /// Reads an x value off a result line.
 type XOf = Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>>;
 
-const COLORS: [RGBColor; 6] = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
+/// Distinct colours, readable on white (Paul Tol's "bright" and "muted" schemes), in turn.
+const COLORS: [RGBColor; 12] = [
+    RGBColor(68, 119, 170),
+    RGBColor(238, 102, 119),
+    RGBColor(34, 136, 51),
+    RGBColor(204, 187, 68),
+    RGBColor(102, 204, 238),
+    RGBColor(170, 51, 119),
+    RGBColor(0, 0, 0),
+    RGBColor(136, 34, 85),
+    RGBColor(17, 119, 51),
+    RGBColor(221, 204, 119),
+    RGBColor(51, 34, 136),
+    RGBColor(187, 187, 187),
+];
 
 /// Runs `plot-sweep`.
 pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
@@ -53,7 +70,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         .filter(|(_, v)| v.iter().any(|x| *x != v[0]))
         .map(|(k, _)| k)
         .collect();
-    let mut x_axes: Vec<(String, XOf)> = keys
+    let mut x_axes: Vec<(String, Option<String>, XOf)> = keys
         .iter()
         .map(|k| {
             let key = k.clone();
@@ -63,27 +80,43 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
                     .find(|(kk, _)| *kk == key)
                     .and_then(|(_, v)| v.parse().ok())
             });
-            (k.clone(), f)
+            (k.clone(), Some(k.clone()), f)
         })
         .collect();
     x_axes.push((
         "EFE mat-vecs per tick (reasoning compute)".into(),
+        None,
         Box::new(|l| Some(l.efe_matvecs_per_tick)),
     ));
-
-    let mut panels = Vec::new();
-    // One series per (scenario, method, protocol); one point per parameter set, averaged
-    // over its training seeds.
-    let groups: Vec<(String, String, String)> = {
-        let mut g: Vec<_> = lines
+    // Against one swept key, each setting of the other swept keys is its own series (a
+    // line through points that differ in another parameter would zigzag).
+    let others = |l: &crate::batch::ResultLine, x_key: &Option<String>| -> String {
+        let Some(x_key) = x_key else { return String::new() };
+        l.params
             .iter()
-            .map(|l| (l.scenario.clone(), l.method.clone(), l.protocol.to_string()))
-            .collect();
-        g.sort();
-        g.dedup();
-        g
+            .filter(|(k, _)| k != x_key && keys.contains(k))
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
     };
-    for (name, x_of) in &x_axes {
+
+    let mut panels: Vec<(String, Vec<SeriesData>)> = Vec::new();
+    // One series per (scenario, method, protocol[, other swept parameters]); one point
+    // per parameter set, averaged over its training seeds.
+    for (name, x_key, x_of) in &x_axes {
+        let mut groups: Vec<(String, String, String, String)> = lines
+            .iter()
+            .map(|l| {
+                (
+                    l.scenario.clone(),
+                    l.method.clone(),
+                    l.protocol.to_string(),
+                    others(l, x_key),
+                )
+            })
+            .collect();
+        groups.sort();
+        groups.dedup();
         for (figure, y_of) in [
             (
                 "success rate",
@@ -94,25 +127,32 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         ] {
             let series = groups
                 .iter()
-                .enumerate()
-                .map(|(i, (scenario, method, protocol))| {
+                .map(|(scenario, method, protocol, other)| {
                     let points: Vec<(String, f64, f64)> = lines
                         .iter()
-                        .filter(|l| &l.scenario == scenario && &l.method == method && l.protocol.name() == protocol)
+                        .filter(|l| {
+                            &l.scenario == scenario
+                                && &l.method == method
+                                && l.protocol.name() == protocol
+                                && &others(l, x_key) == other
+                        })
                         .filter_map(|l| x_of(l).map(|x| (l.param_set.clone(), x, y_of(l))))
                         .collect();
-                    let points = mean_by_param_set(points);
-                    Series {
-                        label: "",
-                        points,
-                        color: COLORS[i % COLORS.len()],
-                    }
+                    let label = if other.is_empty() {
+                        format!("{scenario} / {method} / {protocol}")
+                    } else {
+                        format!("{scenario} / {method} / {protocol}, {other}")
+                    };
+                    (label, mean_by_param_set(points))
                 })
-                .collect::<Vec<_>>();
+                // A method the swept parameter does not affect ran once, unswept: no series.
+                .filter(|(_, points)| !points.is_empty())
+                .enumerate()
+                .map(|(i, (label, points))| (label, COLORS[i % COLORS.len()], points))
+                .collect();
             panels.push((format!("{figure} vs {name}"), series));
         }
     }
-    let labels: Vec<String> = groups.iter().map(|(s, m, p)| format!("{s} / {m} / {p}")).collect();
     let panels: Vec<(&str, Vec<Series<'_>>)> = panels
         .iter()
         .map(|(title, series)| {
@@ -120,18 +160,16 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
                 title.as_str(),
                 series
                     .iter()
-                    .zip(&labels)
-                    // A method the swept parameter does not affect ran once, unswept: no series.
-                    .filter(|(s, _)| !s.points.is_empty())
-                    .map(|(s, label)| Series {
+                    .map(|(label, color, points)| Series {
                         label,
-                        points: s.points.clone(),
-                        color: s.color,
+                        points: points.clone(),
+                        color: *color,
                     })
                     .collect(),
             )
         })
         .collect();
+    super::warn_replacing_file(&args.out);
     line_panels(
         &args.out,
         "x as named in the panel title (each point: mean over training seeds)",

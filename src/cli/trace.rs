@@ -3,13 +3,14 @@
 use clap::Args;
 use std::path::PathBuf;
 
-use super::{AgentArgs, out_dir};
+use super::{AgentArgs, warn_replacing};
 use crate::experiments::trace;
 use crate::maps;
 use crate::methods::Method;
 use crate::plots::{filmstrip, theta_trace};
 use crate::protocol::Protocol;
-use crate::report::{Csv, num};
+use crate::replay::replay_html;
+use crate::report::{Csv, num, write_atomic};
 
 /// Arguments of `trace`.
 #[derive(Debug, Clone, Args)]
@@ -20,9 +21,15 @@ pub struct TraceArgs {
     /// Method to trace.
     #[arg(long, value_enum, default_value_t = Method::Scaled)]
     pub method: Method,
-    /// Output folder for trace.csv, theta.svg and filmstrip.svg.
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
+    /// Output folder for trace.csv, theta.svg and filmstrip.svg (files from an earlier
+    /// run there are replaced, with a warning).
+    #[arg(long, value_name = "DIR", default_value = "out/trace")]
+    pub out: PathBuf,
+    /// Also write the episode as one self-contained HTML page (no network) that plays
+    /// the car, the pedestrians and the light beside theta and the actions, with a
+    /// slider to scrub, e.g. `--html out/trace/replay.html`.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
     /// Evaluation episode to trace (0 = the first). Under `--protocol continual` the agent
     /// first runs and learns from episodes 0..N, as a continual evaluation does.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
@@ -132,7 +139,9 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         "{outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
         result.ticks, result.ret, result.reasoning_ticks
     );
-    let dir = out_dir(&args.out, "out/trace");
+    let dir = &args.out;
+    warn_replacing(dir, &["trace.csv", "theta.svg", "filmstrip.svg"]);
+    crate::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     csv.write(&dir.join("trace.csv"))?;
     let points: Vec<_> = decided
         .iter()
@@ -144,7 +153,25 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         &points,
         params.epsilon,
     )?;
-    filmstrip(&dir.join("filmstrip.svg"), &map, &ticks)?;
+    filmstrip(
+        &dir.join("filmstrip.svg"),
+        &format!(
+            "{} on {}, seed {}: {outcome} after {} ticks (from above, one strip per decision tick)",
+            args.method, map.name, args.agent.seed, result.ticks
+        ),
+        &map,
+        &ticks,
+    )?;
     println!("wrote {}/trace.csv, theta.svg, filmstrip.svg", dir.display());
+    if let Some(html) = &args.html {
+        let title = format!("{} on {}, seed {}", args.method, map.name, args.agent.seed);
+        let outcome = format!(
+            "{} {outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
+            args.method, result.ticks, result.ret, result.reasoning_ticks
+        );
+        let page = replay_html(&title, &outcome, &map, &ticks, params.epsilon)?;
+        write_atomic(html, page.as_bytes())?;
+        println!("wrote {} (open it in a browser)", html.display());
+    }
     Ok(())
 }

@@ -34,6 +34,13 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         ..TrainConfig::new(args.episodes, args.seed)
     };
     let started = std::time::Instant::now();
+    crate::progress::phase(
+        args.quiet,
+        format_args!(
+            "training {} episodes on '{}' (seed {})",
+            args.episodes, map.name, args.seed
+        ),
+    );
     let (bundle, log) = train(&map, &cfg)?;
     let tail = &log.returns[log.returns.len().saturating_sub(100)..];
     let mean = if tail.is_empty() {
@@ -41,6 +48,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     } else {
         tail.iter().sum::<f64>() / tail.len() as f64
     };
+    crate::progress::phase(args.quiet, format_args!("writing {}", args.out.display()));
+    super::warn_replacing_file(&args.out);
     crate::agent_file::save(&args.out, &bundle)?;
     println!(
         "trained on '{}' for {} episodes in {:.1} s (mean return of the last {} with exploration: {mean:.2}); wrote {}",

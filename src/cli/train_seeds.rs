@@ -37,6 +37,14 @@ impl TrainSeedArgs {
     /// parallel (or loaded from the cache).
     pub fn train(&self, seeds: &[u64], train_map: &str, episodes: u64, quiet: bool) -> anyhow::Result<Vec<Agent>> {
         let map = crate::maps::load(train_map)?;
+        crate::progress::phase(
+            quiet,
+            format_args!(
+                "training {} agent(s) for {episodes} episodes on '{}' (or loading them from the cache), one line each",
+                seeds.len(),
+                map.name
+            ),
+        );
         train_agents(&map, seeds, &TrainConfig::new(episodes, 0), self.cache_dir(), quiet)
     }
 }

@@ -2,7 +2,7 @@
 //! same results zero-shot (fresh controller per episode, in parallel) as continual (one
 //! controller, in order), and zero-shot results do not depend on the number of threads.
 
-mod common;
+use crate::common;
 
 use indicatif::ProgressBar;
 use unforeseen::experiments::{evaluate, evaluate_under};

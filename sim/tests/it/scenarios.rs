@@ -5,9 +5,7 @@
 //! crosswalk (or, for late_fast.ron's runner, slows down until they are gone),
 //! is not hit, and then reaches the destination.
 
-mod common;
-
-use common::{brake_for_pedestrians, run};
+use crate::common::{brake_for_pedestrians, run};
 use unforeseen_sim::{Action, LightPhase, World, embedded};
 
 const SEEDS: u64 = 60;

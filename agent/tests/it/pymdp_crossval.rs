@@ -22,7 +22,7 @@ fn vec_of(v: &serde_json::Value) -> Vec<f64> {
 
 #[test]
 fn inspect_matches_pymdp() {
-    let text = include_str!("data/pymdp_reference.json");
+    let text = include_str!("../data/pymdp_reference.json");
     let r: Reference = serde_json::from_str(text).unwrap();
     assert_eq!(r.pymdp_version, "1.0.4");
     assert!(!r.cases.is_empty());

@@ -2,7 +2,7 @@
 //! `--jobs`; `--resume` completes a truncated file without duplicates; shards
 //! concatenate into the unsharded file.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::sync::OnceLock;

@@ -1,6 +1,6 @@
 //! Spawn triggers, pauses and collision timing, on small inline maps.
 
-mod common;
+use crate::common;
 
 use unforeseen_sim::{Action, LightPhase, Map, World};
 

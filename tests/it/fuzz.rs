@@ -8,7 +8,7 @@
 //!
 //! `UNFORESEEN_FUZZ_CASES=N` sets the number of cases of each kind (default 300).
 
-mod common;
+use crate::common;
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -165,7 +165,7 @@ fn inspect_rejects_bad_models_and_check_map_accepts_the_shipped_maps() {
         .collect();
     assert!(maps.len() >= 4);
     // A few survivability episodes per map keep the check exercised but the test fast
-    // (tests/reference.rs tests the warnings themselves).
+    // (tests/it/reference.rs tests the warnings themselves).
     let mut args = vec!["check-map", "--survivability-episodes", "5"];
     args.extend(maps.iter().map(String::as_str));
     let out = unforeseen(&args);

@@ -9,7 +9,7 @@
 //! is refused as bad input (exit code 2) with a message naming the file, the field and
 //! the fix; a few go through the command line of each command that reads agents.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::Command;

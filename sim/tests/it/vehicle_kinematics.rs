@@ -2,7 +2,7 @@
 //! destination when constant-acceleration kinematics says it should, slow down
 //! stops the car and never reverses it, maintain holds the speed exactly.
 
-mod common;
+use crate::common;
 
 use proptest::prelude::*;
 use unforeseen_sim::{Action, Map, World};

@@ -2,7 +2,7 @@
 //! seed, Q-learning drives on and hits the pedestrian; the scaled agent notices the
 //! surprise, reasons, and avoids it.
 
-mod common;
+use crate::common;
 
 use unforeseen::experiments::{evaluate, learn, trace};
 use unforeseen::methods::Method;

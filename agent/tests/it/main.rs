@@ -1,0 +1,7 @@
+//! The agent's integration tests, one module per subject, in one test binary (one link
+//! instead of one per file keeps `cargo test` builds short).
+
+mod bundle_and_controllers;
+mod hand_worked;
+mod properties;
+mod pymdp_crossval;

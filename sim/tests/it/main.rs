@@ -1,0 +1,9 @@
+//! The simulation's integration tests, one module per subject, in one test binary (one
+//! link instead of one per file keeps `cargo test` builds short).
+
+mod bad_maps;
+mod common;
+mod determinism;
+mod scenarios;
+mod triggers;
+mod vehicle_kinematics;

@@ -1,0 +1,20 @@
+//! The root crate's integration tests, one module per subject, in one test binary (one
+//! link instead of one per file keeps `cargo test` builds short). Modules share one
+//! small trained agent (`common::bundle`).
+
+mod batch;
+mod cli;
+mod common;
+mod compare_determinism;
+mod corrupt_agent_files;
+mod doc_paths;
+mod end_to_end;
+mod figures;
+mod fuzz;
+mod outputs;
+mod protocols;
+mod readme;
+mod reference;
+mod replay;
+mod svg_text;
+mod train_seeds;
