@@ -59,14 +59,7 @@ impl TryFrom<BayesRlRepr> for BayesRl {
     /// planning diverges); a factored model exactly when the parameters ask for one, of
     /// the same sizes.
     fn try_from(r: BayesRlRepr) -> Result<Self, FieldError> {
-        check::size(
-            "n_states",
-            r.n_states,
-            1,
-            MAX_STATES,
-            "the joint states of the map's bins",
-        )?;
-        check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
+        check::state_action_sizes(r.n_states, r.n_actions)?;
         r.params.check().map_err(|e| FieldError::from(e).within("params"))?;
         for (name, x) in [
             ("params.prior_concentration", r.params.prior_concentration),

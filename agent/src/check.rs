@@ -25,6 +25,24 @@ pub(crate) fn size(path: &str, n: usize, lo: usize, hi: usize, why: &str) -> Res
     }
 }
 
+/// `n_states` and `n_actions` of a stored learner within [`crate::limits`].
+pub(crate) fn state_action_sizes(n_states: usize, n_actions: usize) -> Result<(), FieldError> {
+    size(
+        "n_states",
+        n_states,
+        1,
+        crate::limits::MAX_STATES,
+        "the joint states of the map's bins",
+    )?;
+    size(
+        "n_actions",
+        n_actions,
+        1,
+        crate::limits::MAX_ACTIONS,
+        "the car's actions",
+    )
+}
+
 /// `x` is finite and at most [`MAX_VALUE`] in size (false for NaN).
 pub(crate) fn bounded(x: f64) -> bool {
     (-MAX_VALUE..=MAX_VALUE).contains(&x)

@@ -4,7 +4,6 @@
 use crate::check;
 use crate::controller::{Controller, Decision, one_hot};
 use crate::error::{AgentError, FieldError, ParamError};
-use crate::limits::{MAX_ACTIONS, MAX_STATES};
 use crate::maths::argmax;
 use crate::params::QParams;
 use rand::RngExt;
@@ -38,14 +37,7 @@ impl TryFrom<QLearningRepr> for QLearning {
     /// Sizes in range, parameters valid, `epsilon` in [0, 1], a table of exactly
     /// `n_states * n_actions` finite values.
     fn try_from(r: QLearningRepr) -> Result<Self, FieldError> {
-        check::size(
-            "n_states",
-            r.n_states,
-            1,
-            MAX_STATES,
-            "the joint states of the map's bins",
-        )?;
-        check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
+        check::state_action_sizes(r.n_states, r.n_actions)?;
         r.params.check().map_err(|e| FieldError::from(e).within("params"))?;
         if let Some(b) = r.params.bias_action.filter(|b| *b >= r.n_actions) {
             return Err(FieldError::new(
