@@ -24,6 +24,8 @@
 //! * [`study`] runs `compare` over agents and protocols and summarizes over seeds with
 //!   [`stats`] (mean, 95% Student-t interval, range, worst seed);
 //! * [`report`] writes JSON/CSV atomically and [`plots`] draws SVG figures;
+//! * [`replay`] records the scaled agent's reasoning ticks in episodes and replays them
+//!   (the benches' in-loop reasoning tick);
 //! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
 //! * [`cli`] is the command line.
 
@@ -39,6 +41,7 @@ pub mod plots;
 pub mod progress;
 pub mod protocol;
 pub mod reference;
+pub mod replay;
 pub mod report;
 pub mod rewards;
 pub mod runner;

@@ -1,0 +1,102 @@
+//! Records the scaled agent's reasoning ticks on the jaywalk family of maps and replays
+//! them (see `unforeseen::replay`): prints the digest of every replayed decision (equal
+//! digests = bit-identical results) and the distribution of the ticks' wall-clock times.
+//! Built for profiles and instruction counts, which need a short run without criterion:
+//!
+//! ```sh
+//! cargo build --release --example replay_ticks
+//! target/release/unforeseen train --out agent7.ron          # the benches' agent
+//! target/release/examples/replay_ticks --agent agent7.ron --horizon 3 --passes 20
+//! valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*replay_pass*' \
+//!     target/release/examples/replay_ticks --agent agent7.ron --passes 1
+//! ```
+//!
+//! Options: `--agent FILE` (default: train the default agent, 6000 episodes, seed 7),
+//! `--horizon H` (3), `--episodes N` per map (10), `--seed S` (7), `--passes P` (5),
+//! `--set key=value` (any `ScaledParams` key, repeatable).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use unforeseen::agent_file;
+use unforeseen::cli::compare::DEFAULT_TRAIN_EPISODES;
+use unforeseen::replay::{Recording, ReplayOutcome, TickTimes, jaywalk_family, record};
+use unforeseen::training::{TrainConfig, train};
+use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_sim::embedded;
+
+/// One replay of the whole recording (a named function, for callgrind's `--toggle-collect`).
+#[inline(never)]
+fn replay_pass(rec: &Recording, agent: &mut ScaledAgent, times: &mut TickTimes) -> ReplayOutcome {
+    rec.replay(agent, |r, e| times.push(r, e))
+}
+
+fn main() -> anyhow::Result<()> {
+    let mut agent_path: Option<PathBuf> = None;
+    let (mut horizon, mut episodes, mut seed, mut passes) = (3usize, 10u64, 7u64, 5usize);
+    let mut sets: Vec<String> = Vec::new();
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = || args.next().ok_or_else(|| anyhow::anyhow!("{a} needs a value"));
+        match a.as_str() {
+            "--agent" => agent_path = Some(value()?.into()),
+            "--horizon" => horizon = value()?.parse()?,
+            "--episodes" => episodes = value()?.parse()?,
+            "--seed" => seed = value()?.parse()?,
+            "--passes" => passes = value()?.parse()?,
+            "--set" => sets.push(value()?),
+            other => anyhow::bail!("unknown argument {other} (see the example's docs)"),
+        }
+    }
+    let bundle = match &agent_path {
+        Some(p) => agent_file::load(p)?,
+        None => {
+            let map = embedded::load("intersection")?;
+            let cfg = TrainConfig {
+                quiet: true,
+                ..TrainConfig::new(DEFAULT_TRAIN_EPISODES, 7)
+            };
+            train(&map, &cfg)?.0
+        }
+    };
+    let params = unforeseen::cli::params::apply(
+        ScaledParams {
+            horizon,
+            ..ScaledParams::default()
+        },
+        &sets,
+    )?;
+    let maps = jaywalk_family()?;
+    let started = Instant::now();
+    let rec = record(&bundle, &params, &maps, episodes, seed)?;
+    let successes = rec.episodes.iter().filter(|e| e.success).count();
+    println!(
+        "recorded {} episodes on {} maps ({} successful) in {:.2} s: {} ticks, {} reasoning (H = {horizon})",
+        rec.episodes.len(),
+        maps.len(),
+        successes,
+        started.elapsed().as_secs_f64(),
+        rec.ticks(),
+        rec.reasoning_ticks()
+    );
+    let mut agent = ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params)?;
+    let mut times = TickTimes::default();
+    let mut digest = None;
+    for _ in 0..passes {
+        let out = replay_pass(&rec, &mut agent, &mut times);
+        if *digest.get_or_insert(out.digest) != out.digest {
+            anyhow::bail!(
+                "replays disagree: digest {:016x} vs {:016x}",
+                out.digest,
+                digest.unwrap_or(0)
+            );
+        }
+    }
+    if let Some(d) = digest {
+        println!("digest {d:016x}");
+        println!("reasoning ticks:    {}", times.reasoning());
+        println!("feed-forward ticks: {}", times.feedforward());
+    }
+    Ok(())
+}
