@@ -28,6 +28,9 @@ pub struct GenerativeModel {
     pub b: Vec<DMatrix<f64>>,
     /// Elementwise floored `ln B[u]`.
     pub ln_b: Vec<DMatrix<f64>>,
+    /// `(ln B[u])^T`, i.e. `ln B[u]` row by row: VMP's backward messages and `F` read
+    /// `ln B` a row at a time, which this layout makes contiguous.
+    pub ln_b_t: Vec<DMatrix<f64>>,
     /// Log preferences over observations, `C = ln c` (a normalised log distribution).
     pub c: Vec<f64>,
     /// Initial state prior `D`.
@@ -46,7 +49,8 @@ impl GenerativeModel {
             .map(|s| -(0..a.nrows()).map(|o| a[(o, s)] * ln_a[(o, s)]).sum::<f64>())
             .collect();
         let a_identity = a.is_square() && a == DMatrix::identity(a.nrows(), a.ncols());
-        let ln_b = b.iter().map(|m| m.map(ln)).collect();
+        let ln_b: Vec<DMatrix<f64>> = b.iter().map(|m| m.map(ln)).collect();
+        let ln_b_t = ln_b.iter().map(|m| m.transpose()).collect();
         GenerativeModel {
             a,
             ln_a,
@@ -54,6 +58,7 @@ impl GenerativeModel {
             a_identity,
             b,
             ln_b,
+            ln_b_t,
             c,
             d,
             factored: None,

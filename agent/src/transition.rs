@@ -18,17 +18,20 @@
 use crate::structure::{Parent, Structure};
 
 /// One factor's replacement step, a sparse `N x N` matrix with `size` entries per row:
-/// `dst[i] = Σ_t coef[i * size + t] · src[base[i] + t * stride]`, where row `i` holds the
-/// factor's next value and `t` runs over its previous values (§II-A). (Rows measured
-/// faster here than contiguous strided blocks: most strides are 1 or 2.)
+/// `dst[i] = Σ_t coef_t[i] · src[base(i) + t * stride]`, where row `i` holds the
+/// factor's next value, `t` runs over its previous values and `base(i)` is `i` with the
+/// factor's digit set to 0 (§II-A). With the joint index written
+/// `i = (hi · size + k) · stride + lo` (`lo < stride`), the rows of one `(hi, k)` form a
+/// run of `stride` consecutive indices whose sources, for each `t`, are the run
+/// `src[(hi · size + t) · stride + lo]`: each step is a sequence of contiguous
+/// multiply-adds over runs, which the compiler vectorises.
 #[derive(Debug, Clone, PartialEq)]
 struct Step {
     size: usize,
     /// The factor's stride in the joint index.
     stride: usize,
-    /// Per row: the source index of previous value 0.
-    base: Vec<u32>,
-    /// Offset of this step's coefficients in each action's coefficient vector.
+    /// Offset of this step's coefficients in each action's coefficient vector, laid out
+    /// `[t * N + i]` (previous value `t`, row `i`).
     offset: usize,
 }
 
@@ -38,7 +41,7 @@ struct Step {
 pub struct FactoredTransition {
     n: usize,
     steps: Vec<Step>,
-    /// Per action: the coefficients of every step, `N * size` per step, row by row.
+    /// Per action: the coefficients of every step, `N * size` per step (see [`Step`]).
     coef: Vec<Vec<f64>>,
     terminal: Vec<usize>,
 }
@@ -91,7 +94,9 @@ impl FactoredTransition {
             let replaced = &order[..k];
             let offset = coef[0].len();
             let stride = structure.encode(&unit(nf, f));
-            let mut base = Vec::with_capacity(n);
+            for c in coef.iter_mut() {
+                c.resize(offset + n * size, 0.0);
+            }
             for i in 0..n {
                 // Row i: factors replaced so far (and f) hold next values, the rest previous ones.
                 structure.decode_into(i, &mut vals);
@@ -102,22 +107,18 @@ impl FactoredTransition {
                         prev[g] = vals[g];
                     }
                 }
+                // The run layout of `Step` is the mixed-radix joint index's.
                 vals[f] = 0;
-                base.push(structure.encode(&vals) as u32);
+                debug_assert_eq!(structure.encode(&vals), i - (i / stride % size) * stride);
                 for b in 0..size {
                     prev[f] = b;
                     for (u, c) in coef.iter_mut().enumerate() {
                         let cfg = structure.config_index(f, &prev, &next, u, n_actions);
-                        c.push(means[f][cfg * size + next[f]]);
+                        c[offset + b * n + i] = means[f][cfg * size + next[f]];
                     }
                 }
             }
-            steps.push(Step {
-                size,
-                stride,
-                base,
-                offset,
-            });
+            steps.push(Step { size, stride, offset });
         }
         Some(FactoredTransition {
             n,
@@ -154,30 +155,38 @@ impl FactoredTransition {
 
     /// `out = B[u] x`. `scratch` is resized to `N`.
     pub fn apply(&self, u: usize, x: &[f64], out: &mut [f64], scratch: &mut Vec<f64>) {
-        scratch.resize(self.n, 0.0);
-        scratch.copy_from_slice(x);
-        for &t in &self.terminal {
-            scratch[t] = 0.0;
+        let n = self.n;
+        scratch.resize(n, 0.0);
+        // Ping-pong between `out` and `scratch`, starting where the last step lands in `out`.
+        let odd = self.steps.len() % 2 == 1;
+        {
+            let first: &mut [f64] = if odd { scratch.as_mut_slice() } else { &mut *out };
+            first.copy_from_slice(x);
+            for &t in &self.terminal {
+                first[t] = 0.0;
+            }
         }
-        // Ping-pong between `scratch` and `out`; after an odd number of steps the result
-        // sits in `out`, after an even number in `scratch`.
         let coef = &self.coef[u];
         for (k, st) in self.steps.iter().enumerate() {
-            let (src, dst): (&[f64], &mut [f64]) = if k.is_multiple_of(2) {
+            let (src, dst): (&[f64], &mut [f64]) = if (k % 2 == 0) == odd {
                 (scratch.as_slice(), &mut *out)
             } else {
                 (&*out, scratch.as_mut_slice())
             };
-            let c = &coef[st.offset..st.offset + self.n * st.size];
-            match st.size {
-                2 => rows::<2>(c, &st.base, st.stride, src, dst),
-                3 => rows::<3>(c, &st.base, st.stride, src, dst),
-                4 => rows::<4>(c, &st.base, st.stride, src, dst),
-                k => rows_dyn(k, c, &st.base, st.stride, src, dst),
+            let c = &coef[st.offset..st.offset + n * st.size];
+            match (st.size, st.stride) {
+                (2, 1) => runs_kw::<2, 1>(c, n, src, dst),
+                (2, 2) => runs_kw::<2, 2>(c, n, src, dst),
+                (2, 4) => runs_kw::<2, 4>(c, n, src, dst),
+                (2, 8) => runs_kw::<2, 8>(c, n, src, dst),
+                (4, 4) => runs_kw::<4, 4>(c, n, src, dst),
+                (4, 8) => runs_kw::<4, 8>(c, n, src, dst),
+                (4, 16) => runs_kw::<4, 16>(c, n, src, dst),
+                (2, _) => runs::<2>(c, n, st.stride, src, dst),
+                (3, _) => runs::<3>(c, n, st.stride, src, dst),
+                (4, _) => runs::<4>(c, n, st.stride, src, dst),
+                (k, _) => runs_dyn(k, c, n, st.stride, src, dst),
             }
-        }
-        if self.steps.len().is_multiple_of(2) {
-            out.copy_from_slice(scratch);
         }
         for &t in &self.terminal {
             out[t] += x[t];
@@ -185,26 +194,64 @@ impl FactoredTransition {
     }
 }
 
-/// `dst[i] = Σ_t coef[i K + t] · src[base[i] + t w]` with the row length known at compile time.
-fn rows<const K: usize>(coef: &[f64], base: &[u32], w: usize, src: &[f64], dst: &mut [f64]) {
-    for ((d, c), b0) in dst.iter_mut().zip(coef.chunks_exact(K)).zip(base) {
-        let x = &src[*b0 as usize..][..(K - 1) * w + 1];
-        let mut acc = 0.0;
-        for t in 0..K {
-            acc += c[t] * x[t * w];
+/// [`runs`] with the run length `W` (the factor's stride) known at compile time too, so
+/// that each run is a fixed-size array operation the compiler unrolls and vectorises.
+fn runs_kw<const K: usize, const W: usize>(coef: &[f64], n: usize, src: &[f64], dst: &mut [f64]) {
+    let planes: [&[f64]; K] = std::array::from_fn(|t| &coef[t * n..(t + 1) * n]);
+    for (blk, (dblk, sblk)) in dst.chunks_exact_mut(K * W).zip(src.chunks_exact(K * W)).enumerate() {
+        let runs: [&[f64; W]; K] = std::array::from_fn(|t| sblk[t * W..(t + 1) * W].try_into().expect("run"));
+        for (k, d) in dblk.chunks_exact_mut(W).enumerate() {
+            let i = (blk * K + k) * W;
+            let mut acc = [0.0f64; W];
+            for (plane, run) in planes.iter().zip(&runs) {
+                let c: &[f64; W] = plane[i..i + W].try_into().expect("run");
+                for l in 0..W {
+                    acc[l] += c[l] * run[l];
+                }
+            }
+            d.copy_from_slice(&acc);
         }
-        *d = acc;
     }
 }
 
-/// [`rows`] for any row length.
-fn rows_dyn(k: usize, coef: &[f64], base: &[u32], w: usize, src: &[f64], dst: &mut [f64]) {
-    for ((d, c), b0) in dst.iter_mut().zip(coef.chunks_exact(k)).zip(base) {
-        *d = c
-            .iter()
-            .zip(src[*b0 as usize..].iter().step_by(w))
-            .map(|(c, x)| c * x)
-            .sum();
+/// One step (see [`Step`]) with `K` previous values known at compile time:
+/// `dst[i] = ((0 + c_0[i] s_0) + c_1[i] s_1) + ...`, term by term in `t` order.
+fn runs<const K: usize>(coef: &[f64], n: usize, w: usize, src: &[f64], dst: &mut [f64]) {
+    let span = K * w;
+    for (blk, (dblk, sblk)) in dst.chunks_exact_mut(span).zip(src.chunks_exact(span)).enumerate() {
+        let i0 = blk * span;
+        for (k, d) in dblk.chunks_exact_mut(w).enumerate() {
+            let i = i0 + k * w;
+            for ((d, c), s) in d.iter_mut().zip(&coef[i..i + w]).zip(&sblk[..w]) {
+                *d = 0.0 + c * s;
+            }
+            for t in 1..K {
+                let c = &coef[t * n + i..t * n + i + w];
+                for ((d, c), s) in d.iter_mut().zip(c).zip(&sblk[t * w..(t + 1) * w]) {
+                    *d += c * s;
+                }
+            }
+        }
+    }
+}
+
+/// [`runs`] for any number of previous values `k`: `dst[i] = c_0[i] s_0 + c_1[i] s_1 + ...`.
+fn runs_dyn(k_size: usize, coef: &[f64], n: usize, w: usize, src: &[f64], dst: &mut [f64]) {
+    let span = k_size * w;
+    for (blk, (dblk, sblk)) in dst.chunks_exact_mut(span).zip(src.chunks_exact(span)).enumerate() {
+        let i0 = blk * span;
+        for (k, d) in dblk.chunks_exact_mut(w).enumerate() {
+            let i = i0 + k * w;
+            for ((d, c), s) in d.iter_mut().zip(&coef[i..i + w]).zip(&sblk[..w]) {
+                *d = c * s;
+            }
+            for t in 1..k_size {
+                let c = &coef[t * n + i..t * n + i + w];
+                for ((d, c), s) in d.iter_mut().zip(c).zip(&sblk[t * w..(t + 1) * w]) {
+                    *d += c * s;
+                }
+            }
+        }
     }
 }
 
