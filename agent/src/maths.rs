@@ -64,9 +64,9 @@ pub fn axpy_columns(m: &[f64], rows: usize, x: &[f64], out: &mut [f64]) {
     let full = rows - rows % BLOCK;
     for r0 in (0..full).step_by(BLOCK) {
         let mut acc = [0.0f64; BLOCK];
-        for (j, xj) in x.iter().enumerate() {
+        for (col, xj) in m.chunks_exact(rows).zip(x) {
             if *xj != 0.0 {
-                let col: &[f64; BLOCK] = m[j * rows + r0..j * rows + r0 + BLOCK].try_into().expect("block");
+                let col: &[f64; BLOCK] = col[r0..r0 + BLOCK].try_into().expect("block");
                 for l in 0..BLOCK {
                     acc[l] += xj * col[l];
                 }
@@ -76,9 +76,9 @@ pub fn axpy_columns(m: &[f64], rows: usize, x: &[f64], out: &mut [f64]) {
     }
     for r in full..rows {
         let mut acc = 0.0;
-        for (j, xj) in x.iter().enumerate() {
+        for (col, xj) in m.chunks_exact(rows).zip(x) {
             if *xj != 0.0 {
-                acc += xj * m[j * rows + r];
+                acc += xj * col[r];
             }
         }
         out[r] = acc;
@@ -94,25 +94,27 @@ pub fn dot_columns(m_t: &[f64], n: usize, x: &[f64], acc: &mut [f64]) {
     let acc = &mut acc[..n];
     let full = n - n % BLOCK;
     for s0 in (0..full).step_by(BLOCK) {
+        let mut rows = m_t.chunks_exact(n).zip(x);
         let mut a = [0.0f64; BLOCK];
-        for (i, xi) in x.iter().enumerate() {
-            let row: &[f64; BLOCK] = m_t[i * n + s0..i * n + s0 + BLOCK].try_into().expect("block");
-            if i == 0 {
-                for l in 0..BLOCK {
-                    a[l] = row[l] * xi;
-                }
-            } else {
-                for l in 0..BLOCK {
-                    a[l] += row[l] * xi;
-                }
+        if let Some((row, x0)) = rows.next() {
+            let row: &[f64; BLOCK] = row[s0..s0 + BLOCK].try_into().expect("block");
+            for l in 0..BLOCK {
+                a[l] = row[l] * x0;
+            }
+        }
+        for (row, xi) in rows {
+            let row: &[f64; BLOCK] = row[s0..s0 + BLOCK].try_into().expect("block");
+            for l in 0..BLOCK {
+                a[l] += row[l] * xi;
             }
         }
         acc[s0..s0 + BLOCK].copy_from_slice(&a);
     }
     for s in full..n {
-        let mut a = m_t[s] * x[0];
-        for (i, xi) in x.iter().enumerate().skip(1) {
-            a += m_t[i * n + s] * xi;
+        let mut rows = m_t.chunks_exact(n).zip(x);
+        let mut a = rows.next().map_or(0.0, |(row, x0)| row[s] * x0);
+        for (row, xi) in rows {
+            a += row[s] * xi;
         }
         acc[s] = a;
     }

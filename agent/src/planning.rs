@@ -255,3 +255,56 @@ impl EfeTree {
 fn same_bits(a: &[f64], b: &[f64]) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::maths::log_softmax;
+    use nalgebra::DMatrix;
+
+    /// `evaluate_reusing` gives `evaluate`'s bits whether it reuses everything (same
+    /// belief), some subtrees (a belief whose predictions are the same: states 0 and 1 have
+    /// the same columns in every `B[u]`), or nothing; `invalidate` forgets the memo.
+    #[test]
+    fn reusing_subtrees_gives_the_same_bits() {
+        let (ns, nu) = (5, 3);
+        let b: Vec<DMatrix<f64>> = (0..nu)
+            .map(|u| {
+                DMatrix::from_fn(ns, ns, |i, j| {
+                    let j = j.max(1); // columns 0 and 1 are equal
+                    1.0 + ((i * 7 + j * 3 + u * 5) % 11) as f64
+                })
+            })
+            .map(|m| {
+                let z = m.row_sum();
+                DMatrix::from_fn(ns, ns, |i, j| m[(i, j)] / z[j])
+            })
+            .collect();
+        let c = log_softmax(&[0.5, -1.0, 2.0, 0.0, -3.0]);
+        let gm = GenerativeModel::new(DMatrix::identity(ns, ns), b, c, vec![0.2; ns]);
+        let beliefs = [
+            vec![0.25, 0.25, 0.3, 0.1, 0.1],
+            vec![0.25, 0.25, 0.3, 0.1, 0.1],
+            // 0.25 c + 0.25 c and 0.5 c are the same bits: the same predictions.
+            vec![0.5, 0.0, 0.3, 0.1, 0.1],
+            vec![0.5, 0.1, 0.1, 0.2, 0.1],
+        ];
+        let mut plain = EfeTree::new(ns, ns, nu, 3);
+        let mut memo = EfeTree::new(ns, ns, nu, 3);
+        let mut reused = Vec::new();
+        for q in &beliefs {
+            plain.evaluate(&gm, q, 1.5);
+            memo.evaluate_reusing(&gm, q, 1.5);
+            for (a, b) in plain.g.iter().zip(&memo.g).chain(plain.psi.iter().zip(&memo.psi)) {
+                assert_eq!(a.to_bits(), b.to_bits());
+            }
+            assert_eq!(memo.matvecs + memo.reused, plain.matvecs);
+            reused.push(memo.reused);
+        }
+        // Nothing, everything, the subtrees below depth 1, nothing.
+        assert_eq!(reused, vec![0, 39, 36, 0]);
+        memo.invalidate();
+        memo.evaluate_reusing(&gm, &beliefs[3], 1.5);
+        assert_eq!(memo.reused, 0);
+    }
+}

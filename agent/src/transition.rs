@@ -24,14 +24,16 @@ use crate::structure::{Parent, Structure};
 /// `i = (hi · size + k) · stride + lo` (`lo < stride`), the rows of one `(hi, k)` form a
 /// run of `stride` consecutive indices whose sources, for each `t`, are the run
 /// `src[(hi · size + t) · stride + lo]`: each step is a sequence of contiguous
-/// multiply-adds over runs, which the compiler vectorises.
+/// multiply-adds over runs, which the compiler vectorises. The coefficients are stored
+/// run by run, `[((run · size) + t) · stride + lo]` with `run = i / stride`, so that one
+/// block `hi` reads one contiguous tile of `size² · stride` coefficients.
 #[derive(Debug, Clone, PartialEq)]
 struct Step {
     size: usize,
     /// The factor's stride in the joint index.
     stride: usize,
-    /// Offset of this step's coefficients in each action's coefficient vector, laid out
-    /// `[t * N + i]` (previous value `t`, row `i`).
+    /// Offset of this step's coefficients in each action's coefficient vector (laid out
+    /// run by run, see above).
     offset: usize,
 }
 
@@ -114,7 +116,7 @@ impl FactoredTransition {
                     prev[f] = b;
                     for (u, c) in coef.iter_mut().enumerate() {
                         let cfg = structure.config_index(f, &prev, &next, u, n_actions);
-                        c[offset + b * n + i] = means[f][cfg * size + next[f]];
+                        c[offset + ((i / stride) * size + b) * stride + i % stride] = means[f][cfg * size + next[f]];
                     }
                 }
             }
@@ -175,17 +177,17 @@ impl FactoredTransition {
             };
             let c = &coef[st.offset..st.offset + n * st.size];
             match (st.size, st.stride) {
-                (2, 1) => runs_kw::<2, 1>(c, n, src, dst),
-                (2, 2) => runs_kw::<2, 2>(c, n, src, dst),
-                (2, 4) => runs_kw::<2, 4>(c, n, src, dst),
-                (2, 8) => runs_kw::<2, 8>(c, n, src, dst),
-                (4, 4) => runs_kw::<4, 4>(c, n, src, dst),
-                (4, 8) => runs_kw::<4, 8>(c, n, src, dst),
-                (4, 16) => runs_kw::<4, 16>(c, n, src, dst),
-                (2, _) => runs::<2>(c, n, st.stride, src, dst),
-                (3, _) => runs::<3>(c, n, st.stride, src, dst),
-                (4, _) => runs::<4>(c, n, st.stride, src, dst),
-                (k, _) => runs_dyn(k, c, n, st.stride, src, dst),
+                (2, 1) => runs_kw::<2, 1>(c, src, dst),
+                (2, 2) => runs_kw::<2, 2>(c, src, dst),
+                (2, 4) => runs_kw::<2, 4>(c, src, dst),
+                (2, 8) => runs_kw::<2, 8>(c, src, dst),
+                (4, 4) => runs_kw::<4, 4>(c, src, dst),
+                (4, 8) => runs_kw::<4, 8>(c, src, dst),
+                (4, 16) => runs_kw::<4, 16>(c, src, dst),
+                (2, w) => runs::<2>(c, w, src, dst),
+                (3, w) => runs::<3>(c, w, src, dst),
+                (4, w) => runs::<4>(c, w, src, dst),
+                (k, w) => runs_dyn(k, c, w, src, dst),
             }
         }
         for &t in &self.terminal {
@@ -194,40 +196,41 @@ impl FactoredTransition {
     }
 }
 
-/// [`runs`] with the run length `W` (the factor's stride) known at compile time too, so
-/// that each run is a fixed-size array operation the compiler unrolls and vectorises.
-fn runs_kw<const K: usize, const W: usize>(coef: &[f64], n: usize, src: &[f64], dst: &mut [f64]) {
-    let planes: [&[f64]; K] = std::array::from_fn(|t| &coef[t * n..(t + 1) * n]);
-    for (blk, (dblk, sblk)) in dst.chunks_exact_mut(K * W).zip(src.chunks_exact(K * W)).enumerate() {
-        let runs: [&[f64; W]; K] = std::array::from_fn(|t| sblk[t * W..(t + 1) * W].try_into().expect("run"));
-        for (k, d) in dblk.chunks_exact_mut(W).enumerate() {
-            let i = (blk * K + k) * W;
+/// One step (see [`Step`]) with `K` previous values and run length `W` (the factor's
+/// stride) known at compile time: every block is a fixed-size tile the compiler unrolls
+/// and vectorises. `dst[i] = ((0 + c_0 s_0) + c_1 s_1) + ...`, term by term in `t` order.
+fn runs_kw<const K: usize, const W: usize>(coef: &[f64], src: &[f64], dst: &mut [f64]) {
+    for ((dblk, sblk), cblk) in dst
+        .chunks_exact_mut(K * W)
+        .zip(src.chunks_exact(K * W))
+        .zip(coef.chunks_exact(K * K * W))
+    {
+        for k in 0..K {
             let mut acc = [0.0f64; W];
-            for (plane, run) in planes.iter().zip(&runs) {
-                let c: &[f64; W] = plane[i..i + W].try_into().expect("run");
+            for t in 0..K {
                 for l in 0..W {
-                    acc[l] += c[l] * run[l];
+                    acc[l] += cblk[(k * K + t) * W + l] * sblk[t * W + l];
                 }
             }
-            d.copy_from_slice(&acc);
+            dblk[k * W..(k + 1) * W].copy_from_slice(&acc);
         }
     }
 }
 
-/// One step (see [`Step`]) with `K` previous values known at compile time:
-/// `dst[i] = ((0 + c_0[i] s_0) + c_1[i] s_1) + ...`, term by term in `t` order.
-fn runs<const K: usize>(coef: &[f64], n: usize, w: usize, src: &[f64], dst: &mut [f64]) {
-    let span = K * w;
-    for (blk, (dblk, sblk)) in dst.chunks_exact_mut(span).zip(src.chunks_exact(span)).enumerate() {
-        let i0 = blk * span;
+/// [`runs_kw`] with the run length `w` known at run time only.
+fn runs<const K: usize>(coef: &[f64], w: usize, src: &[f64], dst: &mut [f64]) {
+    for ((dblk, sblk), cblk) in dst
+        .chunks_exact_mut(K * w)
+        .zip(src.chunks_exact(K * w))
+        .zip(coef.chunks_exact(K * K * w))
+    {
         for (k, d) in dblk.chunks_exact_mut(w).enumerate() {
-            let i = i0 + k * w;
-            for ((d, c), s) in d.iter_mut().zip(&coef[i..i + w]).zip(&sblk[..w]) {
+            let c = &cblk[k * K * w..(k + 1) * K * w];
+            for ((d, c), s) in d.iter_mut().zip(&c[..w]).zip(&sblk[..w]) {
                 *d = 0.0 + c * s;
             }
             for t in 1..K {
-                let c = &coef[t * n + i..t * n + i + w];
-                for ((d, c), s) in d.iter_mut().zip(c).zip(&sblk[t * w..(t + 1) * w]) {
+                for ((d, c), s) in d.iter_mut().zip(&c[t * w..(t + 1) * w]).zip(&sblk[t * w..(t + 1) * w]) {
                     *d += c * s;
                 }
             }
@@ -235,19 +238,21 @@ fn runs<const K: usize>(coef: &[f64], n: usize, w: usize, src: &[f64], dst: &mut
     }
 }
 
-/// [`runs`] for any number of previous values `k`: `dst[i] = c_0[i] s_0 + c_1[i] s_1 + ...`.
-fn runs_dyn(k_size: usize, coef: &[f64], n: usize, w: usize, src: &[f64], dst: &mut [f64]) {
-    let span = k_size * w;
-    for (blk, (dblk, sblk)) in dst.chunks_exact_mut(span).zip(src.chunks_exact(span)).enumerate() {
-        let i0 = blk * span;
+/// [`runs`] for any number of previous values `k`: `dst[i] = c_0 s_0 + c_1 s_1 + ...`
+/// (the first term alone, as a serial sum from `-0.0` gives it).
+fn runs_dyn(k_size: usize, coef: &[f64], w: usize, src: &[f64], dst: &mut [f64]) {
+    for ((dblk, sblk), cblk) in dst
+        .chunks_exact_mut(k_size * w)
+        .zip(src.chunks_exact(k_size * w))
+        .zip(coef.chunks_exact(k_size * k_size * w))
+    {
         for (k, d) in dblk.chunks_exact_mut(w).enumerate() {
-            let i = i0 + k * w;
-            for ((d, c), s) in d.iter_mut().zip(&coef[i..i + w]).zip(&sblk[..w]) {
+            let c = &cblk[k * k_size * w..(k + 1) * k_size * w];
+            for ((d, c), s) in d.iter_mut().zip(&c[..w]).zip(&sblk[..w]) {
                 *d = c * s;
             }
             for t in 1..k_size {
-                let c = &coef[t * n + i..t * n + i + w];
-                for ((d, c), s) in d.iter_mut().zip(c).zip(&sblk[t * w..(t + 1) * w]) {
+                for ((d, c), s) in d.iter_mut().zip(&c[t * w..(t + 1) * w]).zip(&sblk[t * w..(t + 1) * w]) {
                     *d += c * s;
                 }
             }
@@ -348,8 +353,99 @@ mod tests {
             .collect()
     }
 
+    /// The row-by-row form of the steps (each row's sum in `t` order, from `0.0` for 2 to 4
+    /// previous values and as a serial sum otherwise): what `apply` computed before its
+    /// steps became runs. `apply` must give the same bits.
+    fn apply_by_rows(
+        st: &Structure,
+        means: &[Vec<f64>],
+        na: usize,
+        u: usize,
+        x: &[f64],
+        terminal: &[usize],
+    ) -> Vec<f64> {
+        let factors = st.factors();
+        let nf = factors.len();
+        let n = st.joint_size();
+        let order = elimination_order(st).unwrap();
+        let mut cur = x.to_vec();
+        for &t in terminal {
+            cur[t] = 0.0;
+        }
+        let (mut vals, mut prev, mut next) = (vec![0usize; nf], vec![0usize; nf], vec![0usize; nf]);
+        for (k, &f) in order.iter().enumerate() {
+            let size = factors[f].size;
+            let stride = st.encode(&unit(nf, f));
+            let mut dst = vec![0.0; n];
+            for (i, d) in dst.iter_mut().enumerate() {
+                st.decode_into(i, &mut vals);
+                for g in 0..nf {
+                    if order[..k].contains(&g) || g == f {
+                        next[g] = vals[g];
+                    } else {
+                        prev[g] = vals[g];
+                    }
+                }
+                vals[f] = 0;
+                let base = st.encode(&vals);
+                let terms = (0..size).map(|b| {
+                    prev[f] = b;
+                    means[f][st.config_index(f, &prev, &next, u, na) * size + next[f]] * cur[base + b * stride]
+                });
+                *d = if (2..=4).contains(&size) {
+                    terms.fold(0.0, |acc, t| acc + t)
+                } else {
+                    terms.collect::<Vec<f64>>().into_iter().sum()
+                };
+            }
+            cur = dst;
+        }
+        for &t in terminal {
+            cur[t] += x[t];
+        }
+        cur
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(48))]
+        /// `apply` (runs, tiles, const-generic kernels) equals the row-by-row steps bit for
+        /// bit, for random sizes (1 to 5 per factor, every kernel), CPTs, beliefs and terminals.
+        #[test]
+        fn runs_equal_rows_bit_for_bit(
+            sizes in prop::array::uniform4(1usize..6),
+            seed in 0u64..1000,
+            n_terminal in 0usize..4,
+        ) {
+            let st = Structure::paper_default(sizes).unwrap();
+            let n = st.joint_size();
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let means: Vec<Vec<f64>> = st
+                .factors()
+                .iter()
+                .enumerate()
+                .map(|(f, fac)| {
+                    let rows = st.n_configs(f, 3);
+                    let mut m: Vec<f64> = (0..rows * fac.size).map(|_| rng.random::<f64>()).collect();
+                    for row in m.chunks_mut(fac.size) {
+                        let z: f64 = row.iter().sum();
+                        row.iter_mut().for_each(|v| *v /= z);
+                    }
+                    m
+                })
+                .collect();
+            let terminal: Vec<usize> = (0..n_terminal.min(n)).map(|i| (i * 7 + seed as usize) % n).collect();
+            let ft = FactoredTransition::new(&st, &means, 3).unwrap().with_terminal(&terminal);
+            let x: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
+            let (mut out, mut scratch) = (vec![0.0; n], Vec::new());
+            for u in 0..3 {
+                ft.apply(u, &x, &mut out, &mut scratch);
+                let want = apply_by_rows(&st, &means, 3, u, &x, &terminal);
+                for (a, b) in out.iter().zip(&want) {
+                    prop_assert_eq!(a.to_bits(), b.to_bits());
+                }
+            }
+        }
+
         /// The factor-by-factor product equals the dense joint `B[u] x` (and the planning
         /// model's absorbing `B[u] x`) for random sizes, counts, beliefs and terminal sets.
         #[test]
