@@ -169,31 +169,58 @@ impl Recording {
             reasoning_ticks: 0,
             digest: 0,
         };
-        for e in &self.episodes {
-            agent.begin_episode(e.controller_seed);
-            for (k, &o) in e.obs.iter().enumerate() {
-                let started = Instant::now();
-                let d = agent.act(o);
-                let elapsed = started.elapsed();
-                on_tick(d.reasoned, elapsed);
-                assert!(
-                    d.action == e.actions[k] && d.reasoned == e.reasoned[k],
-                    "replay of {} episode {} tick {k} differs from the recording",
-                    e.map,
-                    e.episode
-                );
+        for e in 0..self.episodes.len() {
+            let (ticks, reasoning) = self.replay_episode(e, agent, Some(&mut digest), &mut on_tick);
+            out.ticks += ticks;
+            out.reasoning_ticks += reasoning;
+        }
+        out.digest = digest.0;
+        out
+    }
+
+    /// Replays episode `e` alone (see [`Recording::replay`]; no digest); returns its
+    /// ticks and reasoning ticks.
+    pub fn replay_one(
+        &self,
+        e: usize,
+        agent: &mut ScaledAgent,
+        mut on_tick: impl FnMut(bool, Duration),
+    ) -> (usize, usize) {
+        self.replay_episode(e, agent, None, &mut on_tick)
+    }
+
+    fn replay_episode(
+        &self,
+        e: usize,
+        agent: &mut ScaledAgent,
+        mut digest: Option<&mut Digest>,
+        on_tick: &mut impl FnMut(bool, Duration),
+    ) -> (usize, usize) {
+        let e = &self.episodes[e];
+        let mut reasoning = 0;
+        agent.begin_episode(e.controller_seed);
+        for (k, &o) in e.obs.iter().enumerate() {
+            let started = Instant::now();
+            let d = agent.act(o);
+            let elapsed = started.elapsed();
+            on_tick(d.reasoned, elapsed);
+            assert!(
+                d.action == e.actions[k] && d.reasoned == e.reasoned[k],
+                "replay of {} episode {} tick {k} differs from the recording",
+                e.map,
+                e.episode
+            );
+            if let Some(digest) = digest.as_deref_mut() {
                 digest.decision(&d);
                 if d.reasoned {
                     let tr = agent.last_reasoning();
                     digest.floats(&tr.g);
                     digest.floats(&tr.q_pi);
-                    out.reasoning_ticks += 1;
                 }
-                out.ticks += 1;
             }
+            reasoning += usize::from(d.reasoned);
         }
-        out.digest = digest.0;
-        out
+        (e.obs.len(), reasoning)
     }
 }
 
