@@ -346,6 +346,18 @@ impl WorldModel {
         }
     }
 
+    /// The joint `B[u]` of the current counts, bit for bit the matrices
+    /// [`WorldModel::materialize`] would put in `generative().b`, without building the rest
+    /// of the generative model (logarithms, `A`, the planning copy): for a caller that
+    /// needs only the transition means (Bayesian RL on the factored model).
+    pub fn transition_matrices(&self) -> Vec<DMatrix<f64>> {
+        let means = self.cpt_means();
+        match FactoredTransition::new(&self.structure, &means, self.n_actions) {
+            Some(ft) => (0..self.n_actions).map(|u| ft.dense(u)).collect(),
+            None => self.dense_b(&means),
+        }
+    }
+
     /// Rebuild the joint `B[u][(s',s)] = Π_f p(s'_f | parents_f, u)` from CPT posterior
     /// means, and `A` from its counts (§II-A; re-run after learning, §V).
     pub fn materialize(&mut self) {

@@ -443,6 +443,17 @@ mod tests {
                 for (a, b) in out.iter().zip(&want) {
                     prop_assert_eq!(a.to_bits(), b.to_bits());
                 }
+                // `dense` is apply's columns, bit for bit.
+                let dense = ft.dense(u);
+                let mut e = vec![0.0; n];
+                for s in 0..n {
+                    e[s] = 1.0;
+                    ft.apply(u, &e, &mut out, &mut scratch);
+                    e[s] = 0.0;
+                    for (a, b) in dense.column(s).iter().zip(&out) {
+                        prop_assert_eq!(a.to_bits(), b.to_bits());
+                    }
+                }
             }
         }
 
