@@ -13,7 +13,11 @@
 //!
 //! Options: `--agent FILE` (default: train the default agent, 6000 episodes, seed 7),
 //! `--horizon H` (3), `--episodes N` per map (10), `--seed S` (7), `--passes P` (5),
-//! `--set key=value` (any `ScaledParams` key, repeatable).
+//! `--set key=value` (any `ScaledParams` key, repeatable), `--evict-kb K` (write K KiB
+//! after every tick, untimed, as the physics of a real episode would), `--json FILE` (the figures as
+//! JSON), `--write-sequence FILE` (every recorded tick as JSON: observation, action,
+//! whether it reasoned, whether it starts an episode; `scripts/pymdp_bench.py` runs
+//! pymdp on the same observations).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -27,15 +31,25 @@ use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_sim::embedded;
 
 /// One replay of the whole recording (a named function, for callgrind's `--toggle-collect`).
+/// With `evict` non-empty, every byte-line of it is written after each tick (untimed), the
+/// way the physics between two ticks of a real episode pushes the agent's data out of
+/// the caches.
 #[inline(never)]
-fn replay_pass(rec: &Recording, agent: &mut ScaledAgent, times: &mut TickTimes) -> ReplayOutcome {
-    rec.replay(agent, |r, e| times.push(r, e))
+fn replay_pass(rec: &Recording, agent: &mut ScaledAgent, times: &mut TickTimes, evict: &mut [u8]) -> ReplayOutcome {
+    rec.replay(agent, |r, e| {
+        times.push(r, e);
+        for b in evict.iter_mut().step_by(64) {
+            *b = b.wrapping_add(1);
+        }
+    })
 }
 
 fn main() -> anyhow::Result<()> {
     let mut agent_path: Option<PathBuf> = None;
     let (mut horizon, mut episodes, mut seed, mut passes) = (3usize, 10u64, 7u64, 5usize);
     let mut sets: Vec<String> = Vec::new();
+    let (mut json, mut sequence): (Option<PathBuf>, Option<PathBuf>) = (None, None);
+    let mut evict_kb = 0usize;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = || args.next().ok_or_else(|| anyhow::anyhow!("{a} needs a value"));
@@ -46,6 +60,9 @@ fn main() -> anyhow::Result<()> {
             "--seed" => seed = value()?.parse()?,
             "--passes" => passes = value()?.parse()?,
             "--set" => sets.push(value()?),
+            "--json" => json = Some(value()?.into()),
+            "--evict-kb" => evict_kb = value()?.parse()?,
+            "--write-sequence" => sequence = Some(value()?.into()),
             other => anyhow::bail!("unknown argument {other} (see the example's docs)"),
         }
     }
@@ -80,14 +97,27 @@ fn main() -> anyhow::Result<()> {
         rec.ticks(),
         rec.reasoning_ticks()
     );
+    if let Some(path) = &sequence {
+        let (mut obs, mut actions): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
+        let (mut reasoned, mut starts): (Vec<bool>, Vec<bool>) = (Vec::new(), Vec::new());
+        for e in &rec.episodes {
+            obs.extend(&e.obs);
+            actions.extend(&e.actions);
+            reasoned.extend(&e.reasoned);
+            starts.extend((0..e.obs.len()).map(|k| k == 0));
+        }
+        let v = serde_json::json!({"horizon": horizon, "obs": obs, "actions": actions, "reasoned": reasoned, "episode_start": starts});
+        std::fs::write(path, serde_json::to_string(&v)?)?;
+    }
     let mut agent = ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params)?;
     let mut times = TickTimes::default();
+    let mut evict = vec![0u8; evict_kb * 1024];
     let mut digest = None;
     // Per tick, the fastest of the passes: robust to other processes on a loaded machine.
     let mut fastest = TickTimes::default();
     for pass in 0..passes {
         let mut this = TickTimes::default();
-        let out = replay_pass(&rec, &mut agent, &mut this);
+        let out = replay_pass(&rec, &mut agent, &mut this, &mut evict);
         if pass == 0 {
             fastest = this.clone();
         } else {
@@ -120,6 +150,21 @@ fn main() -> anyhow::Result<()> {
             "feed-forward ticks, each the fastest of {passes} passes: {}",
             fastest.feedforward()
         );
+        if let Some(path) = &json {
+            let summary = |t: unforeseen::replay::TimeSummary| serde_json::json!({"n": t.n, "mean_us": t.mean, "p10_us": t.p10, "median_us": t.p50, "p90_us": t.p90});
+            let v = serde_json::json!({
+                "horizon": horizon,
+                "passes": passes,
+                "episodes": rec.episodes.len(),
+                "ticks": rec.ticks(),
+                "reasoning_ticks": rec.reasoning_ticks(),
+                "digest": format!("{d:016x}"),
+                "reasoning": summary(times.reasoning()),
+                "reasoning_fastest_of_passes": summary(fastest.reasoning()),
+                "feedforward": summary(times.feedforward()),
+            });
+            std::fs::write(path, serde_json::to_string_pretty(&v)?)?;
+        }
     }
     Ok(())
 }
