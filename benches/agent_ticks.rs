@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use unforeseen::replay::{TickTimes, jaywalk_family, record};
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::model::WorldModel;
-use unforeseen_agent::params::{ModelPriors, QParams, ReasoningMode, ScaledParams};
+use unforeseen_agent::params::{GateMode, ModelPriors, QParams, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::q_learning::QLearning;
 use unforeseen_agent::scaled::ScaledAgent;
@@ -289,9 +289,20 @@ fn reasoning_tick_states(c: &mut Criterion) {
             let m = synthetic_model(structure, &mut rng);
             assert_eq!(m.generative().factored.is_some(), kind == "factored");
             let q = QLearning::new(n, 3, QParams::default());
-            let params = ScaledParams {
-                reasoning: ReasoningMode::Always,
-                ..ScaledParams::default()
+            // The flat model has no pedestrian factor to gate on or to pool (reasoning is
+            // forced anyway): one-step gate, no persistence pooling.
+            let params = if kind == "dense" {
+                ScaledParams {
+                    reasoning: ReasoningMode::Always,
+                    gate: GateMode::OneStep,
+                    persistence_ignores: String::new(),
+                    ..ScaledParams::default()
+                }
+            } else {
+                ScaledParams {
+                    reasoning: ReasoningMode::Always,
+                    ..ScaledParams::default()
+                }
             };
             let mut a = ScaledAgent::new(m, &q, params).expect("agent");
             let obs = n / 2 + 1;
