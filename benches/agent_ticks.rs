@@ -1,6 +1,7 @@
 //! Micro-benchmarks of the scaled agent's ticks (issue 5): one reasoning tick per
-//! horizon `H`, a feed-forward tick, the end-of-episode test-time learning update, and
-//! the reasoning tick as the joint state space grows.
+//! horizon `H`, the reasoning ticks of real episodes replayed (issue 13), a feed-forward
+//! tick, the end-of-episode test-time learning update, and the reasoning tick as the
+//! joint state space grows.
 //!
 //! Run with `cargo bench --features bench --bench agent_ticks`. See BENCHMARKS.md for the figures.
 
@@ -9,9 +10,10 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
+use unforeseen::tick_replay::{TickTimes, jaywalk_family, record};
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::model::WorldModel;
-use unforeseen_agent::params::{ModelPriors, QParams, ReasoningMode, ScaledParams};
+use unforeseen_agent::params::{GateMode, ModelPriors, QParams, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::q_learning::QLearning;
 use unforeseen_agent::scaled::ScaledAgent;
@@ -60,6 +62,72 @@ fn reasoning_tick(c: &mut Criterion, bundle: &AgentBundle) {
         }
         g.finish();
     }
+}
+
+/// Evaluation episodes per map recorded for `reasoning_tick_replay` (seed 7, zero-shot).
+const REPLAY_EPISODES: u64 = 10;
+
+/// `reasoning_tick_replay/H`: the reasoning ticks the scaled agent (default parameters,
+/// horizon H) really meets in zero-shot evaluation episodes on the jaywalk family of
+/// maps (`unforeseen::tick_replay`: 10 episodes per map, `eval`'s seeds for seed 7), replayed
+/// one episode after the other on one agent; only the reasoning ticks are timed, each
+/// alone (VMP over its real window, the EFE tree with the reuse of the previous tick's
+/// subtrees, scaling). One iteration is one reasoning tick; criterion's figure is the
+/// mean over the ticks of a sample. The setup also prints the distribution over ticks
+/// (median, p10-p90), each tick the fastest of 5 replays.
+fn reasoning_tick_replay(c: &mut Criterion, bundle: &AgentBundle) {
+    let maps = jaywalk_family().expect("jaywalk family");
+    let mut g = c.benchmark_group("reasoning_tick_replay");
+    for h in 1..=5 {
+        let params = ScaledParams {
+            horizon: h,
+            ..ScaledParams::default()
+        };
+        let rec = record(bundle, &params, &maps, REPLAY_EPISODES, 7).expect("recording");
+        let mut a = agent(bundle, params);
+        let mut fastest: Option<TickTimes> = None;
+        let mut digest = 0;
+        for _ in 0..5 {
+            let mut t = TickTimes::default();
+            digest = rec.replay(&mut a, |r, e| t.push(r, e)).digest;
+            match &mut fastest {
+                None => fastest = Some(t),
+                Some(f) => f
+                    .reasoning_ns
+                    .iter_mut()
+                    .zip(&t.reasoning_ns)
+                    .for_each(|(f, t)| *f = (*f).min(*t)),
+            }
+        }
+        let fastest = fastest.unwrap_or_default();
+        eprintln!(
+            "reasoning_tick_replay/{h}: {} episodes on {} maps ({} successful), {} ticks, {} reasoning, digest {digest:016x}; per reasoning tick (fastest of 5 replays): {}",
+            rec.episodes.len(),
+            maps.len(),
+            rec.episodes.iter().filter(|e| e.success).count(),
+            rec.ticks(),
+            rec.reasoning_ticks(),
+            fastest.reasoning()
+        );
+        g.bench_with_input(BenchmarkId::from_parameter(h), &h, |b, _| {
+            let mut episode = 0;
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                let mut done = 0u64;
+                while done < iters {
+                    rec.replay_one(episode, &mut a, |reasoned, elapsed| {
+                        if reasoned && done < iters {
+                            total += elapsed;
+                            done += 1;
+                        }
+                    });
+                    episode = (episode + 1) % rec.episodes.len();
+                }
+                total
+            })
+        });
+    }
+    g.finish();
 }
 
 /// `feedforward_tick`: `act` on the feed-forward path (`θ <= ε`: prediction by one
@@ -221,9 +289,20 @@ fn reasoning_tick_states(c: &mut Criterion) {
             let m = synthetic_model(structure, &mut rng);
             assert_eq!(m.generative().factored.is_some(), kind == "factored");
             let q = QLearning::new(n, 3, QParams::default());
-            let params = ScaledParams {
-                reasoning: ReasoningMode::Always,
-                ..ScaledParams::default()
+            // The flat model has no pedestrian factor to gate on or to pool (reasoning is
+            // forced anyway): one-step gate, no persistence pooling.
+            let params = if kind == "dense" {
+                ScaledParams {
+                    reasoning: ReasoningMode::Always,
+                    gate: GateMode::OneStep,
+                    persistence_ignores: String::new(),
+                    ..ScaledParams::default()
+                }
+            } else {
+                ScaledParams {
+                    reasoning: ReasoningMode::Always,
+                    ..ScaledParams::default()
+                }
             };
             let mut a = ScaledAgent::new(m, &q, params).expect("agent");
             let obs = n / 2 + 1;
@@ -248,6 +327,7 @@ fn reasoning_tick_states(c: &mut Criterion) {
 fn benches(c: &mut Criterion) {
     let bundle = bundle();
     reasoning_tick(c, &bundle);
+    reasoning_tick_replay(c, &bundle);
     feedforward_tick(c, &bundle);
     learning_update(c, &bundle);
     reasoning_tick_states(c);

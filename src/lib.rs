@@ -25,6 +25,8 @@
 //!   [`stats`] (mean, 95% Student-t interval, range, worst seed);
 //! * [`report`] writes JSON/CSV atomically, [`plots`] draws SVG figures and [`replay`]
 //!   writes an episode as a self-contained HTML page that plays it;
+//! * [`tick_replay`] records the scaled agent's reasoning ticks in episodes and replays
+//!   them (the benches' in-loop reasoning tick);
 //! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
 //! * [`error`] is the library's typed error (what the user can fix);
 //! * [`cli`] is the command line, and alone decides messages and exit codes.
@@ -54,4 +56,5 @@ pub mod seeds;
 pub mod stats;
 pub mod study;
 pub mod survivability;
+pub mod tick_replay;
 pub mod training;

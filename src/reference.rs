@@ -19,17 +19,17 @@
 //! Both decode the observation index `s = ((d*n_v + v)*2 + L)*2 + p` (docs/ARCHITECTURE.md §3)
 //! with the factor sizes they are built with.
 
-use unforeseen_agent::controller::{Controller, Decision};
+use unforeseen_agent::controller::{Controller, Decision, Dist};
 use unforeseen_sim::Action;
 
 use crate::error::Error;
 
 /// A one-hot distribution over the three actions at `action` (the policy a scripted
 /// controller acts from).
-fn one_hot(action: Action) -> Vec<f64> {
-    let mut policy = vec![0.0; Action::ALL.len()];
+fn one_hot(action: Action) -> Dist {
+    let mut policy = [0.0; Action::ALL.len()];
     policy[action.index()] = 1.0;
-    policy
+    Dist::from_slice(&policy)
 }
 
 /// A decision of a scripted controller: never reasoned, no surprise.

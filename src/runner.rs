@@ -119,8 +119,8 @@ pub fn run_episode(
                 reasoned: decision.reasoned,
                 surprise: decision.surprise,
                 theta: decision.theta,
-                policy: decision.policy,
-                psi: decision.psi,
+                policy: decision.policy.to_vec(),
+                psi: decision.psi.as_deref().map(<[f64]>::to_vec),
                 reward,
                 snapshot: snap,
             });

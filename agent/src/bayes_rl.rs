@@ -239,9 +239,9 @@ impl BayesRl {
     fn rebuild(&mut self) {
         let (n, na) = (self.n_states, self.n_actions);
         let prior = self.params.prior_concentration;
-        if let Some(m) = self.factored.as_mut() {
-            m.materialize();
-        }
+        // The factored model's transition means only (not the active-inference agent's
+        // whole generative model, whose logarithms cost four times as much).
+        let factored_b = self.factored.as_ref().map(WorldModel::transition_matrices);
         let cache = self.cache.get_or_insert_with(|| Cache {
             p: vec![0.0; n * na * n],
             r: vec![0.0; n * na],
@@ -256,9 +256,9 @@ impl BayesRl {
                 let row = &mut cache.p[i * n..(i + 1) * n];
                 if total <= 0.0 {
                     row.iter_mut().for_each(|x| *x = 1.0 / n as f64);
-                } else if let Some(m) = self.factored.as_ref() {
+                } else if let Some(b) = &factored_b {
                     let keep = (total - self.terminal[i]) / total;
-                    let col = &m.b(a).as_slice()[s * n..(s + 1) * n];
+                    let col = &b[a].as_slice()[s * n..(s + 1) * n];
                     for (x, b) in row.iter_mut().zip(col) {
                         *x = keep * b;
                     }
@@ -288,15 +288,15 @@ impl BayesRl {
         let Some(c) = self.cache.as_mut() else {
             unreachable!("cache built above")
         };
-        let sweep = |c: &mut Cache| -> f64 {
+        let mut ev = vec![0.0; na];
+        let mut sweep = |c: &mut Cache| -> f64 {
             let mut delta: f64 = 0.0;
             for s in 0..n {
+                expected_values(&c.p[s * na * n..(s + 1) * na * n], n, &c.v, &mut ev);
                 let mut best = f64::NEG_INFINITY;
-                for a in 0..na {
+                for (a, e) in ev.iter().enumerate() {
                     let i = s * na + a;
-                    let row = &c.p[i * n..(i + 1) * n];
-                    let ev: f64 = row.iter().zip(&c.v).map(|(p, v)| p * v).sum();
-                    let q = c.r[i] + gamma * ev;
+                    let q = c.r[i] + gamma * e;
                     c.qv[i] = q;
                     best = best.max(q);
                 }
@@ -319,12 +319,11 @@ impl BayesRl {
                     // Synchronous backward induction: compute from a snapshot of V.
                     let v_old = c.v.clone();
                     for s in 0..n {
+                        expected_values(&c.p[s * na * n..(s + 1) * na * n], n, &v_old, &mut ev);
                         let mut best = f64::NEG_INFINITY;
-                        for a in 0..na {
+                        for (a, e) in ev.iter().enumerate() {
                             let i = s * na + a;
-                            let row = &c.p[i * n..(i + 1) * n];
-                            let ev: f64 = row.iter().zip(&v_old).map(|(p, v)| p * v).sum();
-                            c.qv[i] = c.r[i] + gamma * ev;
+                            c.qv[i] = c.r[i] + gamma * e;
                             best = best.max(c.qv[i]);
                         }
                         c.v[s] = best;
@@ -333,6 +332,26 @@ impl BayesRl {
             }
         }
         &c.qv[s * na..(s + 1) * na]
+    }
+}
+
+/// `ev[a] = Σ_{s'} rows[a * n + s'] v[s']` for every action's row of one state: each sum
+/// runs in `s'` order exactly as a serial sum would (from `-0.0`), but the actions' sums
+/// advance together, so they do not wait on each other.
+fn expected_values(rows: &[f64], n: usize, v: &[f64], ev: &mut [f64]) {
+    ev.iter_mut().for_each(|e| *e = -0.0);
+    if let [e0, e1, e2] = ev {
+        let (r0, rest) = rows.split_at(n);
+        let (r1, r2) = rest.split_at(n);
+        for (((p0, p1), p2), x) in r0.iter().zip(r1).zip(r2).zip(v) {
+            *e0 += p0 * x;
+            *e1 += p1 * x;
+            *e2 += p2 * x;
+        }
+    } else {
+        for (e, row) in ev.iter_mut().zip(rows.chunks_exact(n)) {
+            *e = row.iter().zip(v).map(|(p, x)| p * x).sum();
+        }
     }
 }
 

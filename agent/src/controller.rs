@@ -13,9 +13,9 @@ pub struct Decision {
     /// Normalised surprise `θ_t` (§IV), if measured.
     pub theta: Option<f64>,
     /// The distribution the action was taken from (π_o, π', or a one-hot greedy policy).
-    pub policy: Vec<f64>,
+    pub policy: Dist,
     /// `ψ(u)` from planning (§IV), if planning ran and produces it.
-    pub psi: Option<Vec<f64>>,
+    pub psi: Option<Dist>,
     /// Scaling iterations (eq. "gradient_descent_equations"); 0 if none.
     pub scaling_iters: u32,
 }
@@ -34,11 +34,127 @@ pub trait Controller: Send {
     fn end_episode(&mut self) {}
 }
 
-/// One-hot distribution of length `n` at `i`.
-pub(crate) fn one_hot(n: usize, i: usize) -> Vec<f64> {
-    let mut v = vec![0.0; n];
-    if i < n {
-        v[i] = 1.0;
+/// A distribution over actions, as a [`Decision`] carries it: stored inline (no heap
+/// allocation) up to [`Dist::INLINE`] actions, on the heap beyond. It reads as a slice
+/// (`Deref<Target = [f64]>`), so `d.policy[u]`, `d.policy.iter()` and `&d.policy[..]` work.
+#[derive(Clone)]
+pub struct Dist(DistRepr);
+
+#[derive(Clone)]
+enum DistRepr {
+    Inline { len: u8, p: [f64; Dist::INLINE] },
+    Heap(Vec<f64>),
+}
+
+impl Dist {
+    /// Actions stored without allocating.
+    pub const INLINE: usize = 8;
+
+    /// A copy of `p`; allocates only beyond [`Dist::INLINE`] entries.
+    pub fn from_slice(p: &[f64]) -> Self {
+        if p.len() <= Self::INLINE {
+            let mut a = [0.0; Self::INLINE];
+            a[..p.len()].copy_from_slice(p);
+            Dist(DistRepr::Inline {
+                len: p.len() as u8,
+                p: a,
+            })
+        } else {
+            Dist(DistRepr::Heap(p.to_vec()))
+        }
     }
-    v
+
+    /// `n` zeros; allocates only beyond [`Dist::INLINE`] entries.
+    pub fn zeros(n: usize) -> Self {
+        if n <= Self::INLINE {
+            Dist(DistRepr::Inline {
+                len: n as u8,
+                p: [0.0; Self::INLINE],
+            })
+        } else {
+            Dist(DistRepr::Heap(vec![0.0; n]))
+        }
+    }
+
+    /// The entries, mutable.
+    pub fn as_mut_slice(&mut self) -> &mut [f64] {
+        match &mut self.0 {
+            DistRepr::Inline { len, p } => &mut p[..*len as usize],
+            DistRepr::Heap(v) => v,
+        }
+    }
+
+    /// The entries as a new vector.
+    pub fn to_vec(&self) -> Vec<f64> {
+        self[..].to_vec()
+    }
+}
+
+impl Default for Dist {
+    /// The empty distribution.
+    fn default() -> Self {
+        Dist::from_slice(&[])
+    }
+}
+
+impl std::ops::Deref for Dist {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        match &self.0 {
+            DistRepr::Inline { len, p } => &p[..*len as usize],
+            DistRepr::Heap(v) => v,
+        }
+    }
+}
+
+impl From<Vec<f64>> for Dist {
+    fn from(v: Vec<f64>) -> Self {
+        Dist::from_slice(&v)
+    }
+}
+
+impl From<&[f64]> for Dist {
+    fn from(v: &[f64]) -> Self {
+        Dist::from_slice(v)
+    }
+}
+
+impl PartialEq for Dist {
+    fn eq(&self, other: &Self) -> bool {
+        self[..] == other[..]
+    }
+}
+
+impl std::fmt::Debug for Dist {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self[..].fmt(f)
+    }
+}
+
+/// One-hot distribution of length `n` at `i`.
+pub(crate) fn one_hot(n: usize, i: usize) -> Dist {
+    let mut d = Dist::zeros(n);
+    if let Some(p) = d.as_mut_slice().get_mut(i) {
+        *p = 1.0;
+    }
+    d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dist_reads_as_its_slice_inline_or_not() {
+        let small = Dist::from_slice(&[0.25, 0.75]);
+        assert_eq!(&small[..], &[0.25, 0.75]);
+        assert_eq!(small, Dist::from(vec![0.25, 0.75]));
+        assert_ne!(small, Dist::from_slice(&[0.25, 0.75, 0.0]));
+        let big: Vec<f64> = (0..11).map(|i| i as f64).collect();
+        assert_eq!(Dist::from_slice(&big).to_vec(), big);
+        assert_eq!(&one_hot(3, 1)[..], &[0.0, 1.0, 0.0]);
+        assert_eq!(&one_hot(12, 11)[11..], &[1.0]);
+        assert!(Dist::default().is_empty());
+        assert_eq!(format!("{:?}", small), "[0.25, 0.75]");
+    }
 }

@@ -30,6 +30,9 @@ pub struct GenerativeModel {
     pub b: Vec<DMatrix<f64>>,
     /// Elementwise floored `ln B[u]`.
     pub ln_b: Vec<DMatrix<f64>>,
+    /// `(ln B[u])^T`, i.e. `ln B[u]` row by row: VMP's backward messages and `F` read
+    /// `ln B` a row at a time, which this layout makes contiguous.
+    pub ln_b_t: Vec<DMatrix<f64>>,
     /// Log preferences over observations, `C = ln c` (a normalised log distribution).
     pub c: Vec<f64>,
     /// Initial state prior `D`.
@@ -48,7 +51,8 @@ impl GenerativeModel {
             .map(|s| -(0..a.nrows()).map(|o| a[(o, s)] * ln_a[(o, s)]).sum::<f64>())
             .collect();
         let a_identity = a.is_square() && a == DMatrix::identity(a.nrows(), a.ncols());
-        let ln_b = b.iter().map(|m| m.map(ln)).collect();
+        let ln_b: Vec<DMatrix<f64>> = b.iter().map(|m| m.map(ln)).collect();
+        let ln_b_t = ln_b.iter().map(|m| m.transpose()).collect();
         GenerativeModel {
             a,
             ln_a,
@@ -56,6 +60,7 @@ impl GenerativeModel {
             a_identity,
             b,
             ln_b,
+            ln_b_t,
             c,
             d,
             factored: None,
@@ -425,6 +430,18 @@ impl WorldModel {
             let size = self.structure.factors()[f].size;
             let cfg = self.structure.config_index(f, &prev, &next, a, self.n_actions);
             self.cpt[f][cfg * size + next[f]] += 1.0;
+        }
+    }
+
+    /// The joint `B[u]` of the current counts, bit for bit the matrices
+    /// [`WorldModel::materialize`] would put in `generative().b`, without building the rest
+    /// of the generative model (logarithms, `A`, the planning copy): for a caller that
+    /// needs only the transition means (Bayesian RL on the factored model).
+    pub fn transition_matrices(&self) -> Vec<DMatrix<f64>> {
+        let means = self.cpt_means();
+        match FactoredTransition::new(&self.structure, &means, self.n_actions) {
+            Some(ft) => (0..self.n_actions).map(|u| ft.dense(u)).collect(),
+            None => self.dense_b(&means),
         }
     }
 

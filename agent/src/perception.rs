@@ -15,7 +15,7 @@
 //! geodesic toward that minimiser, along which `KL[q || q*]` (hence `F`) is
 //! non-increasing too — both are property-tested.
 
-use crate::maths::{ln, softmax_in_place};
+use crate::maths::{axpy_columns, dot_columns, ln, softmax_in_place};
 use crate::model::GenerativeModel;
 
 /// Result of a VMP run.
@@ -33,42 +33,37 @@ pub struct VmpOutcome {
 #[derive(Debug, Clone, Default)]
 pub struct VmpWorkspace {
     v: Vec<f64>,
+    /// `(ln B)^T q` of one message.
+    acc: Vec<f64>,
+    /// `ln ŝ`, shared by slot 0's message and `F`.
+    ln_s_hat: Vec<f64>,
 }
 
+/// The message `v_τ` of slot `tau` (eq. "message passing") into `v`; `acc` is scratch.
+#[allow(clippy::too_many_arguments)]
 fn message_into(
     gm: &GenerativeModel,
-    s_hat: &[f64],
+    ln_s_hat: &[f64],
     obs: &[usize],
     actions: &[usize],
     qs: &[Vec<f64>],
     tau: usize,
     v: &mut [f64],
+    acc: &mut [f64],
 ) {
     let n = gm.n_states();
     let last = obs.len() - 1;
     // Message 1: forward.
     if tau == 0 {
-        for (vi, p) in v.iter_mut().zip(s_hat) {
-            *vi = ln(*p);
-        }
+        v.copy_from_slice(ln_s_hat);
     } else {
-        let lb = gm.ln_b[actions[tau - 1]].as_slice();
-        v.iter_mut().for_each(|x| *x = 0.0);
-        for (j, qj) in qs[tau - 1].iter().enumerate() {
-            if *qj != 0.0 {
-                for (vi, l) in v.iter_mut().zip(&lb[j * n..(j + 1) * n]) {
-                    *vi += qj * l;
-                }
-            }
-        }
+        axpy_columns(gm.ln_b[actions[tau - 1]].as_slice(), n, &qs[tau - 1], v);
     }
     // Message 2: backward, (ln B[a_τ])^T q_{τ+1}.
     if tau < last {
-        let lb = gm.ln_b[actions[tau]].as_slice();
-        let qn = &qs[tau + 1];
-        for (s, vi) in v.iter_mut().enumerate() {
-            let col = &lb[s * n..(s + 1) * n];
-            *vi += col.iter().zip(qn).map(|(l, q)| l * q).sum::<f64>();
+        dot_columns(gm.ln_b_t[actions[tau]].as_slice(), n, &qs[tau + 1], acc);
+        for (vi, a) in v.iter_mut().zip(acc.iter()) {
+            *vi += a;
         }
     }
     // Message 3: observation, (ln A)^T o_τ = row o_τ of ln A.
@@ -82,6 +77,20 @@ fn message_into(
 /// `F = Σ_τ q_τ·(ln q_τ - (ln A)^T o_τ) - q_0·ln ŝ - Σ_{τ>0} q_τ^T (ln B[a_{τ-1}]) q_{τ-1}`.
 /// `F >= -ln p(o_window)` (Lemma 1), with equality at the exact posterior for W = 1.
 pub fn free_energy(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: &[usize], qs: &[Vec<f64>]) -> f64 {
+    let ln_s_hat: Vec<f64> = s_hat.iter().map(|p| ln(*p)).collect();
+    let mut acc = vec![0.0; gm.n_states()];
+    free_energy_with(gm, &ln_s_hat, obs, actions, qs, &mut acc)
+}
+
+/// [`free_energy`] given `ln ŝ`, with scratch `acc` (length n_states).
+fn free_energy_with(
+    gm: &GenerativeModel,
+    ln_s_hat: &[f64],
+    obs: &[usize],
+    actions: &[usize],
+    qs: &[Vec<f64>],
+    acc: &mut [f64],
+) -> f64 {
     let n = gm.n_states();
     let mut f = 0.0;
     for (tau, q) in qs.iter().enumerate().take(obs.len()) {
@@ -94,15 +103,15 @@ pub fn free_energy(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: 
         if tau == 0 {
             f -= q
                 .iter()
-                .zip(s_hat)
-                .map(|(p, sh)| if *p > 0.0 { p * ln(*sh) } else { 0.0 })
+                .zip(ln_s_hat)
+                .map(|(p, l)| if *p > 0.0 { p * l } else { 0.0 })
                 .sum::<f64>();
         } else {
-            let lb = gm.ln_b[actions[tau - 1]].as_slice();
-            for (j, qj) in qs[tau - 1].iter().enumerate() {
+            // acc[j] = (column j of ln B[a_{τ-1}]) · q_τ.
+            dot_columns(gm.ln_b_t[actions[tau - 1]].as_slice(), n, q, acc);
+            for (qj, a) in qs[tau - 1].iter().zip(acc.iter()) {
                 if *qj != 0.0 {
-                    let col = &lb[j * n..(j + 1) * n];
-                    f -= qj * col.iter().zip(q).map(|(l, p)| l * p).sum::<f64>();
+                    f -= qj * a;
                 }
             }
         }
@@ -129,6 +138,9 @@ pub fn vmp(
 ) -> VmpOutcome {
     let n = gm.n_states();
     ws.v.resize(n, 0.0);
+    ws.acc.resize(n, 0.0);
+    ws.ln_s_hat.clear();
+    ws.ln_s_hat.extend(s_hat.iter().map(|p| ln(*p)));
     let w = obs.len();
     let mut iterations = 0;
     let mut converged = false;
@@ -136,7 +148,7 @@ pub fn vmp(
         iterations += 1;
         let mut change: f64 = 0.0;
         for tau in 0..w {
-            message_into(gm, s_hat, obs, actions, qs, tau, &mut ws.v);
+            message_into(gm, &ws.ln_s_hat, obs, actions, qs, tau, &mut ws.v, &mut ws.acc);
             let q = &mut qs[tau];
             // ε = v - ln q ; ln q <- ln q + κ ε ; q = σ(ln q). Store the new logits in v.
             for (vi, qi) in ws.v.iter_mut().zip(q.iter()) {
@@ -150,7 +162,7 @@ pub fn vmp(
             }
         }
         if let Some(cb) = on_sweep.as_deref_mut() {
-            cb(free_energy(gm, s_hat, obs, actions, qs));
+            cb(free_energy_with(gm, &ws.ln_s_hat, obs, actions, qs, &mut ws.acc));
         }
         if change < tol {
             converged = true;
@@ -159,7 +171,7 @@ pub fn vmp(
     }
     VmpOutcome {
         iterations,
-        free_energy: free_energy(gm, s_hat, obs, actions, qs),
+        free_energy: free_energy_with(gm, &ws.ln_s_hat, obs, actions, qs, &mut ws.acc),
         converged,
     }
 }

@@ -100,26 +100,52 @@ pub fn psi_into(q_pi: &[f64], n_actions: usize, out: &mut [f64]) {
 
 /// `Q_S(u) = -(1/γ) ln ψ(u)` (Theorem 1: ψ approximates `exp(-γ Q_S)`), floored log.
 pub fn q_s(psi: &[f64], gamma: f64) -> Vec<f64> {
-    psi.iter().map(|p| -ln(*p) / gamma).collect()
+    let mut out = vec![0.0; psi.len()];
+    q_s_into(psi, gamma, &mut out);
+    out
+}
+
+/// [`q_s`] into `out`.
+pub fn q_s_into(psi: &[f64], gamma: f64, out: &mut [f64]) {
+    for (o, p) in out.iter_mut().zip(psi) {
+        *o = -ln(*p) / gamma;
+    }
 }
 
 /// Preallocated EFE tree evaluator for a fixed (n_states, n_obs, n_actions, H).
+///
+/// [`EfeTree::evaluate`] computes every node. [`EfeTree::evaluate_reusing`] also keeps,
+/// for every internal node, the predicted belief and accumulated `G` it was computed
+/// with, and skips a node's subtree when both are bit for bit those of the previous
+/// evaluation (its leaves' `G` are then still in [`EfeTree::g`]): exact reuse of work
+/// between ticks whose belief has not changed, or whose predictions meet again.
 #[derive(Debug, Clone)]
 pub struct EfeTree {
+    n_states: usize,
     n_actions: usize,
     horizon: usize,
     /// `bufs[k]` is the predicted state belief at depth k (bufs[0] = q_t).
     bufs: Vec<Vec<f64>>,
     obuf: Vec<f64>,
     scratch: Vec<f64>,
+    /// `q_t` of the last evaluation (the root), for [`EfeTree::evaluate_reusing`].
+    memo_root: Vec<f64>,
+    /// Per internal node (depths 1..H-1, breadth-first): its predicted belief...
+    memo_s: Vec<f64>,
+    /// ...and its accumulated `G`.
+    memo_g: Vec<f64>,
+    /// Whether the memo describes the last evaluation.
+    memo_valid: bool,
     /// `G(π)` per policy, lexicographic.
     pub g: Vec<f64>,
     /// `q(π)`.
     pub q_pi: Vec<f64>,
     /// `ψ(u)`.
     pub psi: Vec<f64>,
-    /// Mat-vecs performed by the last evaluation (U + ... + U^H).
+    /// Predictions `B[u] s` computed by the last evaluation (`U + ... + U^H` unless reused).
     pub matvecs: usize,
+    /// Predictions the last [`EfeTree::evaluate_reusing`] did not need to compute.
+    pub reused: usize,
 }
 
 impl EfeTree {
@@ -127,16 +153,23 @@ impl EfeTree {
     pub fn new(n_states: usize, n_obs: usize, n_actions: usize, horizon: usize) -> Self {
         let horizon = horizon.max(1);
         let np = n_actions.pow(horizon as u32);
+        let internal: usize = (1..horizon).map(|k| n_actions.pow(k as u32)).sum();
         EfeTree {
+            n_states,
             n_actions,
             horizon,
             bufs: vec![vec![0.0; n_states]; horizon + 1],
             obuf: vec![0.0; n_obs],
             scratch: vec![0.0; n_states],
+            memo_root: vec![0.0; n_states],
+            memo_s: vec![0.0; internal * n_states],
+            memo_g: vec![0.0; internal],
+            memo_valid: false,
             g: vec![0.0; np],
             q_pi: vec![0.0; np],
             psi: vec![0.0; n_actions],
             matvecs: 0,
+            reused: 0,
         }
     }
 
@@ -147,14 +180,48 @@ impl EfeTree {
 
     /// Evaluate `G`, `q(π)` and `ψ` from `q_t` with precision `γ` (§IV, Prop. 1, Cor. 1).
     pub fn evaluate(&mut self, gm: &GenerativeModel, q_t: &[f64], gamma: f64) {
-        self.bufs[0].copy_from_slice(q_t);
+        self.memo_valid = false;
+        self.run(gm, q_t, gamma, false);
+    }
+
+    /// [`EfeTree::evaluate`], reusing the subtrees of the previous call whose root belief
+    /// and accumulated `G` are bit for bit the same (the results are those of
+    /// [`EfeTree::evaluate`], bit for bit). The caller promises that `gm` is the model of
+    /// the previous call, unchanged, unless it called [`EfeTree::invalidate`] since.
+    pub fn evaluate_reusing(&mut self, gm: &GenerativeModel, q_t: &[f64], gamma: f64) {
+        self.run(gm, q_t, gamma, true);
+    }
+
+    /// Forget the previous evaluation (call when the model changes).
+    pub fn invalidate(&mut self) {
+        self.memo_valid = false;
+    }
+
+    fn run(&mut self, gm: &GenerativeModel, q_t: &[f64], gamma: f64, reuse: bool) {
         self.matvecs = 0;
-        self.recurse(gm, 0, 0.0, 0);
+        self.reused = 0;
+        let unchanged = reuse && self.memo_valid && same_bits(&self.memo_root, q_t);
+        if unchanged {
+            self.reused = self.below(0);
+        } else {
+            self.bufs[0].copy_from_slice(q_t);
+            self.recurse(gm, 0, 0.0, 0, reuse);
+            if reuse {
+                self.memo_root.copy_from_slice(q_t);
+                self.memo_valid = true;
+            }
+        }
         q_pi_into(&self.g, gamma, &mut self.q_pi);
         psi_into(&self.q_pi, self.n_actions, &mut self.psi);
     }
 
-    fn recurse(&mut self, gm: &GenerativeModel, depth: usize, g_acc: f64, idx: usize) {
+    /// Nodes in a subtree whose root sits at `depth` (the root itself not counted).
+    fn below(&self, depth: usize) -> usize {
+        (1..=self.horizon - depth).map(|k| self.n_actions.pow(k as u32)).sum()
+    }
+
+    fn recurse(&mut self, gm: &GenerativeModel, depth: usize, g_acc: f64, idx: usize, reuse: bool) {
+        let n = self.n_states;
         for u in 0..self.n_actions {
             {
                 let (lo, hi) = self.bufs.split_at_mut(depth + 1);
@@ -166,9 +233,78 @@ impl EfeTree {
             let child = idx * self.n_actions + u;
             if depth + 1 == self.horizon {
                 self.g[child] = g;
-            } else {
-                self.recurse(gm, depth + 1, g, child);
+                continue;
             }
+            if reuse {
+                // Internal nodes are numbered breadth-first: depth d starts after U + ... + U^(d-1).
+                let node = (1..depth + 1).map(|k| self.n_actions.pow(k as u32)).sum::<usize>() + child;
+                let (ms, mg) = (&mut self.memo_s[node * n..(node + 1) * n], &mut self.memo_g[node]);
+                if self.memo_valid && mg.to_bits() == g.to_bits() && same_bits(ms, &self.bufs[depth + 1]) {
+                    self.reused += self.below(depth + 1);
+                    continue;
+                }
+                ms.copy_from_slice(&self.bufs[depth + 1]);
+                *mg = g;
+            }
+            self.recurse(gm, depth + 1, g, child, reuse);
         }
+    }
+}
+
+/// Whether two slices hold the same bits.
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::maths::log_softmax;
+    use nalgebra::DMatrix;
+
+    /// `evaluate_reusing` gives `evaluate`'s bits whether it reuses everything (same
+    /// belief), some subtrees (a belief whose predictions are the same: states 0 and 1 have
+    /// the same columns in every `B[u]`), or nothing; `invalidate` forgets the memo.
+    #[test]
+    fn reusing_subtrees_gives_the_same_bits() {
+        let (ns, nu) = (5, 3);
+        let b: Vec<DMatrix<f64>> = (0..nu)
+            .map(|u| {
+                DMatrix::from_fn(ns, ns, |i, j| {
+                    let j = j.max(1); // columns 0 and 1 are equal
+                    1.0 + ((i * 7 + j * 3 + u * 5) % 11) as f64
+                })
+            })
+            .map(|m| {
+                let z = m.row_sum();
+                DMatrix::from_fn(ns, ns, |i, j| m[(i, j)] / z[j])
+            })
+            .collect();
+        let c = log_softmax(&[0.5, -1.0, 2.0, 0.0, -3.0]);
+        let gm = GenerativeModel::new(DMatrix::identity(ns, ns), b, c, vec![0.2; ns]);
+        let beliefs = [
+            vec![0.25, 0.25, 0.3, 0.1, 0.1],
+            vec![0.25, 0.25, 0.3, 0.1, 0.1],
+            // 0.25 c + 0.25 c and 0.5 c are the same bits: the same predictions.
+            vec![0.5, 0.0, 0.3, 0.1, 0.1],
+            vec![0.5, 0.1, 0.1, 0.2, 0.1],
+        ];
+        let mut plain = EfeTree::new(ns, ns, nu, 3);
+        let mut memo = EfeTree::new(ns, ns, nu, 3);
+        let mut reused = Vec::new();
+        for q in &beliefs {
+            plain.evaluate(&gm, q, 1.5);
+            memo.evaluate_reusing(&gm, q, 1.5);
+            for (a, b) in plain.g.iter().zip(&memo.g).chain(plain.psi.iter().zip(&memo.psi)) {
+                assert_eq!(a.to_bits(), b.to_bits());
+            }
+            assert_eq!(memo.matvecs + memo.reused, plain.matvecs);
+            reused.push(memo.reused);
+        }
+        // Nothing, everything, the subtrees below depth 1, nothing.
+        assert_eq!(reused, vec![0, 39, 36, 0]);
+        memo.invalidate();
+        memo.evaluate_reusing(&gm, &beliefs[3], 1.5);
+        assert_eq!(memo.reused, 0);
     }
 }

@@ -13,7 +13,7 @@
 //! the surprise itself, `Decision::theta` what the trigger compared with `ε`. Planning always
 //! predicts with the full transition model, which keeps the pedestrian's persistence.
 
-use crate::controller::{Controller, Decision};
+use crate::controller::{Controller, Decision, Dist};
 use crate::error::AgentError;
 use crate::gate::StateGate;
 use crate::learning;
@@ -21,7 +21,7 @@ use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{ActionSelection, GateBaseline, GateLearning, GateMode, ReasoningMode, ScaledParams, ScalingMode};
 use crate::perception::{VmpWorkspace, vmp};
-use crate::planning::{EfeTree, q_s};
+use crate::planning::{EfeTree, q_s_into};
 use crate::q_learning::QLearning;
 use crate::scaling::{scale_closed_form, scale_iterative};
 use crate::surprise::{bayes_step, predict_into, surprise, theta};
@@ -241,8 +241,10 @@ impl ScaledAgent {
         }
         self.q_cur.copy_from_slice(&self.window_q[w - 1]);
         // Planning (§IV).
+        // The planning model changes only at the end of an episode (`begin_episode`
+        // invalidates the tree), so the tree may reuse the previous tick's subtrees.
         self.tree
-            .evaluate(self.model.planning_generative(), &self.q_cur, self.params.gamma);
+            .evaluate_reusing(self.model.planning_generative(), &self.q_cur, self.params.gamma);
         learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
         let tr = &mut self.last;
         tr.free_energy = out.free_energy;
@@ -250,7 +252,8 @@ impl ScaledAgent {
         tr.g.clone_from(&self.tree.g);
         tr.q_pi.clone_from(&self.tree.q_pi);
         tr.psi.clone_from(&self.tree.psi);
-        tr.q_s = q_s(&self.tree.psi, self.params.gamma);
+        tr.q_s.resize(self.n_actions, 0.0);
+        q_s_into(&self.tree.psi, self.params.gamma, &mut tr.q_s);
         tr.pi_o.clone_from(&self.pi);
         tr.pi_scaled.resize(self.n_actions, 0.0);
         // Scaling (Theorem 1).
@@ -297,6 +300,7 @@ impl Controller for ScaledAgent {
         self.hist_reasoned.clear();
         self.final_obs = None;
         self.prev_one_hot = None;
+        self.tree.invalidate();
     }
 
     fn act(&mut self, obs: usize) -> Decision {
@@ -358,8 +362,8 @@ impl Controller for ScaledAgent {
             reasoned,
             surprise: Some(s),
             theta: Some(th),
-            policy: self.pi.clone(),
-            psi: reasoned.then(|| self.tree.psi.clone()),
+            policy: Dist::from_slice(&self.pi),
+            psi: reasoned.then(|| Dist::from_slice(&self.tree.psi)),
             scaling_iters,
         }
     }

@@ -10,15 +10,7 @@ use crate::model::GenerativeModel;
 /// column-major in `m` (`rows` rows), skipping zero entries of `x` (exact; exploits one-hot beliefs).
 #[inline]
 pub(crate) fn matvec_sparse_x(m: &[f64], rows: usize, x: &[f64], out: &mut [f64]) {
-    out.iter_mut().for_each(|v| *v = 0.0);
-    for (j, xj) in x.iter().enumerate() {
-        if *xj != 0.0 {
-            let col = &m[j * rows..(j + 1) * rows];
-            for (o, c) in out.iter_mut().zip(col) {
-                *o += xj * c;
-            }
-        }
-    }
+    crate::maths::axpy_columns(m, rows, x, out);
 }
 
 /// State prediction `ŝ_t = B[a_{t-1}] q_{t-1}`, or `D` when `prev` is `None` (§II; docs/ARCHITECTURE.md §4.4).

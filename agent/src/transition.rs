@@ -18,17 +18,22 @@
 use crate::structure::{Parent, Structure};
 
 /// One factor's replacement step, a sparse `N x N` matrix with `size` entries per row:
-/// `dst[i] = Σ_t coef[i * size + t] · src[base[i] + t * stride]`, where row `i` holds the
-/// factor's next value and `t` runs over its previous values (§II-A). (Rows measured
-/// faster here than contiguous strided blocks: most strides are 1 or 2.)
+/// `dst[i] = Σ_t coef_t[i] · src[base(i) + t * stride]`, where row `i` holds the
+/// factor's next value, `t` runs over its previous values and `base(i)` is `i` with the
+/// factor's digit set to 0 (§II-A). With the joint index written
+/// `i = (hi · size + k) · stride + lo` (`lo < stride`), the rows of one `(hi, k)` form a
+/// run of `stride` consecutive indices whose sources, for each `t`, are the run
+/// `src[(hi · size + t) · stride + lo]`: each step is a sequence of contiguous
+/// multiply-adds over runs, which the compiler vectorises. The coefficients are stored
+/// run by run, `[((run · size) + t) · stride + lo]` with `run = i / stride`, so that one
+/// block `hi` reads one contiguous tile of `size² · stride` coefficients.
 #[derive(Debug, Clone, PartialEq)]
 struct Step {
     size: usize,
     /// The factor's stride in the joint index.
     stride: usize,
-    /// Per row: the source index of previous value 0.
-    base: Vec<u32>,
-    /// Offset of this step's coefficients in each action's coefficient vector.
+    /// Offset of this step's coefficients in each action's coefficient vector (laid out
+    /// run by run, see above).
     offset: usize,
 }
 
@@ -38,7 +43,7 @@ struct Step {
 pub struct FactoredTransition {
     n: usize,
     steps: Vec<Step>,
-    /// Per action: the coefficients of every step, `N * size` per step, row by row.
+    /// Per action: the coefficients of every step, `N * size` per step (see [`Step`]).
     coef: Vec<Vec<f64>>,
     terminal: Vec<usize>,
 }
@@ -91,7 +96,9 @@ impl FactoredTransition {
             let replaced = &order[..k];
             let offset = coef[0].len();
             let stride = structure.encode(&unit(nf, f));
-            let mut base = Vec::with_capacity(n);
+            for c in coef.iter_mut() {
+                c.resize(offset + n * size, 0.0);
+            }
             for i in 0..n {
                 // Row i: factors replaced so far (and f) hold next values, the rest previous ones.
                 structure.decode_into(i, &mut vals);
@@ -102,22 +109,18 @@ impl FactoredTransition {
                         prev[g] = vals[g];
                     }
                 }
+                // The run layout of `Step` is the mixed-radix joint index's.
                 vals[f] = 0;
-                base.push(structure.encode(&vals) as u32);
+                debug_assert_eq!(structure.encode(&vals), i - (i / stride % size) * stride);
                 for b in 0..size {
                     prev[f] = b;
                     for (u, c) in coef.iter_mut().enumerate() {
                         let cfg = structure.config_index(f, &prev, &next, u, n_actions);
-                        c.push(means[f][cfg * size + next[f]]);
+                        c[offset + ((i / stride) * size + b) * stride + i % stride] = means[f][cfg * size + next[f]];
                     }
                 }
             }
-            steps.push(Step {
-                size,
-                stride,
-                base,
-                offset,
-            });
+            steps.push(Step { size, stride, offset });
         }
         Some(FactoredTransition {
             n,
@@ -154,30 +157,38 @@ impl FactoredTransition {
 
     /// `out = B[u] x`. `scratch` is resized to `N`.
     pub fn apply(&self, u: usize, x: &[f64], out: &mut [f64], scratch: &mut Vec<f64>) {
-        scratch.resize(self.n, 0.0);
-        scratch.copy_from_slice(x);
-        for &t in &self.terminal {
-            scratch[t] = 0.0;
+        let n = self.n;
+        scratch.resize(n, 0.0);
+        // Ping-pong between `out` and `scratch`, starting where the last step lands in `out`.
+        let odd = self.steps.len() % 2 == 1;
+        {
+            let first: &mut [f64] = if odd { scratch.as_mut_slice() } else { &mut *out };
+            first.copy_from_slice(x);
+            for &t in &self.terminal {
+                first[t] = 0.0;
+            }
         }
-        // Ping-pong between `scratch` and `out`; after an odd number of steps the result
-        // sits in `out`, after an even number in `scratch`.
         let coef = &self.coef[u];
         for (k, st) in self.steps.iter().enumerate() {
-            let (src, dst): (&[f64], &mut [f64]) = if k.is_multiple_of(2) {
+            let (src, dst): (&[f64], &mut [f64]) = if (k % 2 == 0) == odd {
                 (scratch.as_slice(), &mut *out)
             } else {
                 (&*out, scratch.as_mut_slice())
             };
-            let c = &coef[st.offset..st.offset + self.n * st.size];
-            match st.size {
-                2 => rows::<2>(c, &st.base, st.stride, src, dst),
-                3 => rows::<3>(c, &st.base, st.stride, src, dst),
-                4 => rows::<4>(c, &st.base, st.stride, src, dst),
-                k => rows_dyn(k, c, &st.base, st.stride, src, dst),
+            let c = &coef[st.offset..st.offset + n * st.size];
+            match (st.size, st.stride) {
+                (2, 1) => runs_kw::<2, 1>(c, src, dst),
+                (2, 2) => runs_kw::<2, 2>(c, src, dst),
+                (2, 4) => runs_kw::<2, 4>(c, src, dst),
+                (2, 8) => runs_kw::<2, 8>(c, src, dst),
+                (4, 4) => runs_kw::<4, 4>(c, src, dst),
+                (4, 8) => runs_kw::<4, 8>(c, src, dst),
+                (4, 16) => runs_kw::<4, 16>(c, src, dst),
+                (2, w) => runs::<2>(c, w, src, dst),
+                (3, w) => runs::<3>(c, w, src, dst),
+                (4, w) => runs::<4>(c, w, src, dst),
+                (k, w) => runs_dyn(k, c, w, src, dst),
             }
-        }
-        if self.steps.len().is_multiple_of(2) {
-            out.copy_from_slice(scratch);
         }
         for &t in &self.terminal {
             out[t] += x[t];
@@ -185,26 +196,67 @@ impl FactoredTransition {
     }
 }
 
-/// `dst[i] = Σ_t coef[i K + t] · src[base[i] + t w]` with the row length known at compile time.
-fn rows<const K: usize>(coef: &[f64], base: &[u32], w: usize, src: &[f64], dst: &mut [f64]) {
-    for ((d, c), b0) in dst.iter_mut().zip(coef.chunks_exact(K)).zip(base) {
-        let x = &src[*b0 as usize..][..(K - 1) * w + 1];
-        let mut acc = 0.0;
-        for t in 0..K {
-            acc += c[t] * x[t * w];
+/// One step (see [`Step`]) with `K` previous values and run length `W` (the factor's
+/// stride) known at compile time: every block is a fixed-size tile the compiler unrolls
+/// and vectorises. `dst[i] = ((0 + c_0 s_0) + c_1 s_1) + ...`, term by term in `t` order.
+fn runs_kw<const K: usize, const W: usize>(coef: &[f64], src: &[f64], dst: &mut [f64]) {
+    for ((dblk, sblk), cblk) in dst
+        .chunks_exact_mut(K * W)
+        .zip(src.chunks_exact(K * W))
+        .zip(coef.chunks_exact(K * K * W))
+    {
+        for k in 0..K {
+            let mut acc = [0.0f64; W];
+            for t in 0..K {
+                for l in 0..W {
+                    acc[l] += cblk[(k * K + t) * W + l] * sblk[t * W + l];
+                }
+            }
+            dblk[k * W..(k + 1) * W].copy_from_slice(&acc);
         }
-        *d = acc;
     }
 }
 
-/// [`rows`] for any row length.
-fn rows_dyn(k: usize, coef: &[f64], base: &[u32], w: usize, src: &[f64], dst: &mut [f64]) {
-    for ((d, c), b0) in dst.iter_mut().zip(coef.chunks_exact(k)).zip(base) {
-        *d = c
-            .iter()
-            .zip(src[*b0 as usize..].iter().step_by(w))
-            .map(|(c, x)| c * x)
-            .sum();
+/// [`runs_kw`] with the run length `w` known at run time only.
+fn runs<const K: usize>(coef: &[f64], w: usize, src: &[f64], dst: &mut [f64]) {
+    for ((dblk, sblk), cblk) in dst
+        .chunks_exact_mut(K * w)
+        .zip(src.chunks_exact(K * w))
+        .zip(coef.chunks_exact(K * K * w))
+    {
+        for (k, d) in dblk.chunks_exact_mut(w).enumerate() {
+            let c = &cblk[k * K * w..(k + 1) * K * w];
+            for ((d, c), s) in d.iter_mut().zip(&c[..w]).zip(&sblk[..w]) {
+                *d = 0.0 + c * s;
+            }
+            for t in 1..K {
+                for ((d, c), s) in d.iter_mut().zip(&c[t * w..(t + 1) * w]).zip(&sblk[t * w..(t + 1) * w]) {
+                    *d += c * s;
+                }
+            }
+        }
+    }
+}
+
+/// [`runs`] for any number of previous values `k`: `dst[i] = c_0 s_0 + c_1 s_1 + ...`
+/// (the first term alone, as a serial sum from `-0.0` gives it).
+fn runs_dyn(k_size: usize, coef: &[f64], w: usize, src: &[f64], dst: &mut [f64]) {
+    for ((dblk, sblk), cblk) in dst
+        .chunks_exact_mut(k_size * w)
+        .zip(src.chunks_exact(k_size * w))
+        .zip(coef.chunks_exact(k_size * k_size * w))
+    {
+        for (k, d) in dblk.chunks_exact_mut(w).enumerate() {
+            let c = &cblk[k * k_size * w..(k + 1) * k_size * w];
+            for ((d, c), s) in d.iter_mut().zip(&c[..w]).zip(&sblk[..w]) {
+                *d = c * s;
+            }
+            for t in 1..k_size {
+                for ((d, c), s) in d.iter_mut().zip(&c[t * w..(t + 1) * w]).zip(&sblk[t * w..(t + 1) * w]) {
+                    *d += c * s;
+                }
+            }
+        }
     }
 }
 
@@ -301,8 +353,110 @@ mod tests {
             .collect()
     }
 
+    /// The row-by-row form of the steps (each row's sum in `t` order, from `0.0` for 2 to 4
+    /// previous values and as a serial sum otherwise): what `apply` computed before its
+    /// steps became runs. `apply` must give the same bits.
+    fn apply_by_rows(
+        st: &Structure,
+        means: &[Vec<f64>],
+        na: usize,
+        u: usize,
+        x: &[f64],
+        terminal: &[usize],
+    ) -> Vec<f64> {
+        let factors = st.factors();
+        let nf = factors.len();
+        let n = st.joint_size();
+        let order = elimination_order(st).unwrap();
+        let mut cur = x.to_vec();
+        for &t in terminal {
+            cur[t] = 0.0;
+        }
+        let (mut vals, mut prev, mut next) = (vec![0usize; nf], vec![0usize; nf], vec![0usize; nf]);
+        for (k, &f) in order.iter().enumerate() {
+            let size = factors[f].size;
+            let stride = st.encode(&unit(nf, f));
+            let mut dst = vec![0.0; n];
+            for (i, d) in dst.iter_mut().enumerate() {
+                st.decode_into(i, &mut vals);
+                for g in 0..nf {
+                    if order[..k].contains(&g) || g == f {
+                        next[g] = vals[g];
+                    } else {
+                        prev[g] = vals[g];
+                    }
+                }
+                vals[f] = 0;
+                let base = st.encode(&vals);
+                let terms = (0..size).map(|b| {
+                    prev[f] = b;
+                    means[f][st.config_index(f, &prev, &next, u, na) * size + next[f]] * cur[base + b * stride]
+                });
+                *d = if (2..=4).contains(&size) {
+                    terms.fold(0.0, |acc, t| acc + t)
+                } else {
+                    terms.collect::<Vec<f64>>().into_iter().sum()
+                };
+            }
+            cur = dst;
+        }
+        for &t in terminal {
+            cur[t] += x[t];
+        }
+        cur
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(48))]
+        /// `apply` (runs, tiles, const-generic kernels) equals the row-by-row steps bit for
+        /// bit, for random sizes (1 to 5 per factor, every kernel), CPTs, beliefs and terminals.
+        #[test]
+        fn runs_equal_rows_bit_for_bit(
+            sizes in prop::array::uniform4(1usize..6),
+            seed in 0u64..1000,
+            n_terminal in 0usize..4,
+        ) {
+            let st = Structure::paper_default(sizes).unwrap();
+            let n = st.joint_size();
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let means: Vec<Vec<f64>> = st
+                .factors()
+                .iter()
+                .enumerate()
+                .map(|(f, fac)| {
+                    let rows = st.n_configs(f, 3);
+                    let mut m: Vec<f64> = (0..rows * fac.size).map(|_| rng.random::<f64>()).collect();
+                    for row in m.chunks_mut(fac.size) {
+                        let z: f64 = row.iter().sum();
+                        row.iter_mut().for_each(|v| *v /= z);
+                    }
+                    m
+                })
+                .collect();
+            let terminal: Vec<usize> = (0..n_terminal.min(n)).map(|i| (i * 7 + seed as usize) % n).collect();
+            let ft = FactoredTransition::new(&st, &means, 3).unwrap().with_terminal(&terminal);
+            let x: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
+            let (mut out, mut scratch) = (vec![0.0; n], Vec::new());
+            for u in 0..3 {
+                ft.apply(u, &x, &mut out, &mut scratch);
+                let want = apply_by_rows(&st, &means, 3, u, &x, &terminal);
+                for (a, b) in out.iter().zip(&want) {
+                    prop_assert_eq!(a.to_bits(), b.to_bits());
+                }
+                // `dense` is apply's columns, bit for bit.
+                let dense = ft.dense(u);
+                let mut e = vec![0.0; n];
+                for s in 0..n {
+                    e[s] = 1.0;
+                    ft.apply(u, &e, &mut out, &mut scratch);
+                    e[s] = 0.0;
+                    for (a, b) in dense.column(s).iter().zip(&out) {
+                        prop_assert_eq!(a.to_bits(), b.to_bits());
+                    }
+                }
+            }
+        }
+
         /// The factor-by-factor product equals the dense joint `B[u] x` (and the planning
         /// model's absorbing `B[u] x`) for random sizes, counts, beliefs and terminal sets.
         #[test]
