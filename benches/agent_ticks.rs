@@ -31,7 +31,10 @@ const JAYWALK_OBS: usize = ((2 * 4 + 3) * 2 + 1) * 2 + 1;
 /// observation, with reasoning forced on every tick. This is the first tick of an
 /// episode (VMP window of one observation) followed by the full EFE tree of depth H and
 /// the scaling loop. `reasoning_tick_mid/H` times the 4th tick of an episode instead
-/// (full VMP window of 4) after three untimed ticks on the same observation.
+/// (full VMP window of 4) after three untimed ticks on the same observation; its belief
+/// is then bit for bit the 3rd tick's, so the EFE tree reuses the previous tick's whole
+/// tree (`EfeTree::evaluate_reusing`) and this measures VMP and scaling. For what
+/// reasoning ticks cost in episodes, see `reasoning_tick_replay/H`.
 fn reasoning_tick(c: &mut Criterion, bundle: &AgentBundle) {
     for (group, untimed_ticks) in [("reasoning_tick", 0), ("reasoning_tick_mid", 3)] {
         let mut g = c.benchmark_group(group);
