@@ -367,11 +367,19 @@ fn the_shipped_maps_are_within_the_limits() {
     for name in unforeseen_sim::embedded::names() {
         unforeseen_sim::embedded::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
     }
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../maps");
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|x| x == "ron") {
-            Map::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    // maps/ and its subfolders (maps/rapid/: the rapid-approach reward).
+    let mut dirs = vec![Path::new(env!("CARGO_MANIFEST_DIR")).join("../maps")];
+    let mut loaded = 0;
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.extension().is_some_and(|x| x == "ron") {
+                Map::load(&path).unwrap_or_else(|e| panic!("{e}"));
+                loaded += 1;
+            }
         }
     }
+    assert!(loaded >= 13, "only {loaded} map files found under maps/");
 }
