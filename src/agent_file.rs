@@ -108,13 +108,7 @@ fn check_intersection(bundle: &AgentBundle) -> Result<(), (String, String)> {
 /// map's bins give (the same joint state space, factor by factor).
 pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> anyhow::Result<()> {
     let disc = Discretizer::new(&map.bins)?;
-    let agent: Vec<usize> = bundle
-        .world_model
-        .structure()
-        .factors()
-        .iter()
-        .map(|f| f.size)
-        .collect();
+    let agent = bundle.world_model.structure().sizes();
     let map_sizes = disc.factor_sizes();
     if agent != map_sizes {
         return Err(Error::Agent {

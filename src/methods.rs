@@ -174,13 +174,7 @@ impl Method {
                 ..params.clone()
             })?,
             Method::BrakeOnPedestrian | Method::NeverBrake => {
-                let sizes: Vec<usize> = bundle
-                    .world_model
-                    .structure()
-                    .factors()
-                    .iter()
-                    .map(|f| f.size)
-                    .collect();
+                let sizes = bundle.world_model.structure().sizes();
                 self.scripted_controller(&sizes)?
                     .expect("scripted_controller builds every scripted method")
             }

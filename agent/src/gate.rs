@@ -83,13 +83,7 @@ impl StateGate {
 
         // Sum the CPT's data counts over every parent configuration: mixed radix over the
         // parents (in parent order), then the action if it is a parent.
-        let parent_sizes: Vec<usize> = fac
-            .parents
-            .iter()
-            .map(|p| match p {
-                Parent::Prev(g) | Parent::Next(g) => factors[*g].size,
-            })
-            .collect();
+        let parent_sizes = st.parent_sizes(factor);
         let n_actions = model.n_actions();
         let actions = if fac.action_parent { n_actions } else { 1 };
         let b0 = model.priors().transition_concentration;

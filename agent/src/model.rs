@@ -312,12 +312,7 @@ impl Pooling {
                 "persistence pooling: `{over}` is not a next-time parent of factor `{factor}`"
             ))
         })?;
-        let sizes: Vec<usize> = parents
-            .iter()
-            .map(|p| match p {
-                Parent::Prev(j) | Parent::Next(j) => factors[*j].size,
-            })
-            .collect();
+        let sizes = structure.parent_sizes(f);
         // Mixed radix in parent order; an action parent, if any, is the least significant digit.
         let mut strides = vec![0; sizes.len()];
         let mut stride = if factors[f].action_parent { n_actions } else { 1 };

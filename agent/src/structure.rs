@@ -207,18 +207,31 @@ impl Structure {
         }
     }
 
-    /// Number of parent configurations of factor `f` (product of parent sizes, times
-    /// the number of actions if the action is a parent).
-    pub fn n_configs(&self, f: usize, n_actions: usize) -> usize {
-        let fac = &self.factors[f];
-        let p: usize = fac
+    /// Number of values of every factor, in factor order.
+    pub fn sizes(&self) -> Vec<usize> {
+        self.factors.iter().map(|f| f.size).collect()
+    }
+
+    /// Number of values of each parent of factor `f`, in parent order.
+    pub fn parent_sizes(&self, f: usize) -> Vec<usize> {
+        self.factors[f]
             .parents
             .iter()
             .map(|p| match p {
                 Parent::Prev(j) | Parent::Next(j) => self.factors[*j].size,
             })
-            .product();
-        if fac.action_parent { p * n_actions } else { p }
+            .collect()
+    }
+
+    /// Number of parent configurations of factor `f` (product of parent sizes, times
+    /// the number of actions if the action is a parent).
+    pub fn n_configs(&self, f: usize, n_actions: usize) -> usize {
+        let p: usize = self.parent_sizes(f).iter().product();
+        if self.factors[f].action_parent {
+            p * n_actions
+        } else {
+            p
+        }
     }
 
     /// Parent-configuration index of factor `f` given previous values `prev`, next
