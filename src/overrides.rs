@@ -2,7 +2,7 @@
 //! and by sweeps ([`crate::batch::sweep`]). A bad key or value is an [`Error::Flag`]
 //! naming the flag and, for a value out of range, the range and its reason.
 
-use unforeseen_agent::params::{ActionSelection, GateBaseline, GateLearning, GateMode, ScaledParams};
+use unforeseen_agent::params::{ActionSelection, GateBaseline, GateLearning, GateMode, RootStep, ScaledParams};
 
 use crate::error::Error;
 
@@ -26,6 +26,7 @@ pub const KEYS: &[&str] = &[
     "gate_learning",
     "gate_baseline",
     "persistence_ignores",
+    "root_step",
 ];
 
 /// Applies `KEY=VALUE` overrides in order, then checks the result (ranges and bounds
@@ -101,6 +102,13 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), Error
                 "endorsed" => GateBaseline::Endorsed,
                 "none" => GateBaseline::None,
                 _ => return Err(Error::flag(&flag, "expected endorsed or none")),
+            }
+        }
+        "root_step" => {
+            p.root_step = match value {
+                "learned" => RootStep::Learned,
+                "absorbing" => RootStep::Absorbing,
+                _ => return Err(Error::flag(&flag, "expected learned or absorbing")),
             }
         }
         "persistence_ignores" => {

@@ -4,6 +4,23 @@
 use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::{Map, StepOutcome};
 
+/// One line naming a map's reward, for tables: its four numbers, and whether it pays
+/// rapid approach (a tick at the car's top speed nets at most 0, so every slower tick
+/// costs, §VI) or progress per metre (a tick at top speed earns, so waiting costs little).
+pub fn describe(map: &Map) -> String {
+    let r = &map.reward;
+    let full_speed_tick = r.progress_per_metre * map.vehicle.max_speed * map.episode.decision_dt - r.step_cost;
+    let kind = if full_speed_tick <= 1e-9 {
+        "rapid approach"
+    } else {
+        "per metre"
+    };
+    format!(
+        "{kind}: {}/m of progress, -{} per tick, goal {:+}, crash {:+}",
+        r.progress_per_metre, r.step_cost, r.goal, r.crash
+    )
+}
+
 /// The reward of one decision tick: progress toward the goal, minus the step cost,
 /// plus the goal bonus or the crash penalty when the tick ends the episode that way.
 pub fn tick_reward(map: &Map, outcome: &StepOutcome) -> f64 {

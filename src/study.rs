@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_sim::Map;
+use unforeseen_sim::{Map, Reward};
 
 use crate::agents::Agent;
 use crate::experiments::{MethodRow, evaluate_under, method_row};
@@ -69,6 +69,8 @@ pub struct MethodSummary {
     pub train_episodes: Option<u64>,
     /// Evaluation episodes per agent on each of the two maps.
     pub episodes: u64,
+    /// The reward the returns are paid in, on each map.
+    pub reward: RewardPair,
     /// Mean return on the training map, over agents.
     pub train_reward: Stat,
     /// Mean return on the test map, over agents.
@@ -85,6 +87,15 @@ pub struct MethodSummary {
     pub worst_seed: WorstSeed,
     /// One row per agent, in seed order.
     pub per_seed: Vec<MethodRow>,
+}
+
+/// The reward settings of the training and the test map.
+#[derive(Debug, Clone, Serialize)]
+pub struct RewardPair {
+    /// The training map's reward (train reward column).
+    pub train_map: Reward,
+    /// The test map's reward (every other column).
+    pub test_map: Reward,
 }
 
 /// The table of one protocol.
@@ -253,6 +264,10 @@ fn summarize(
         train_seeds: agents.iter().map(|a| a.train_seed).collect(),
         train_episodes: agents.first().and_then(|a| a.train_episodes),
         episodes: setup.episodes,
+        reward: RewardPair {
+            train_map: setup.train_map.reward.clone(),
+            test_map: setup.test_map.reward.clone(),
+        },
         train_reward: stat(METRICS[0].1),
         test_reward: stat(METRICS[1].1),
         success_rate: stat(METRICS[2].1),

@@ -207,7 +207,7 @@ pub fn inspect(m: &InspectModel) -> Result<InspectReport, InspectError> {
     let f = free_energy(&gm, &s_hat, &[last], &[], std::slice::from_ref(&q));
     let s = surprise(&gm, last, &s_hat);
     let mut tree = EfeTree::new(ns, gm.n_obs(), gm.n_actions(), m.policy_len);
-    tree.evaluate(&gm, &q, m.gamma);
+    tree.evaluate(&gm, &gm, &q, m.gamma);
     Ok(InspectReport {
         qs: q,
         F: f,
@@ -262,7 +262,7 @@ mod tests {
         }
         let report = inspect(&back).unwrap();
         let mut tree = EfeTree::new(64, 64, 3, 3);
-        tree.evaluate(gm, &report.qs, 2.0);
+        tree.evaluate(gm, gm, &report.qs, 2.0);
         assert!(gm.factored.is_some());
         for (a, b) in report.G.iter().zip(&tree.g) {
             assert!((a - b).abs() < 1e-10, "G {a} vs {b}");

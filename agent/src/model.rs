@@ -282,8 +282,8 @@ struct Pooling {
     factor: usize,
     /// Position of the factor's own previous value among its parents.
     own: usize,
-    /// Position of the pooled parent.
-    over: usize,
+    /// Positions of the pooled parents.
+    over: Vec<usize>,
     /// Per parent position: its size and its stride in the configuration index.
     sizes: Vec<usize>,
     strides: Vec<usize>,
@@ -300,18 +300,29 @@ impl Pooling {
                 ))
             })
         };
-        let (f, g) = (index(factor)?, index(over)?);
+        let f = index(factor)?;
+        let names: Vec<&str> = over.split('+').collect();
+        let gs = names
+            .iter()
+            .map(|n| index(n))
+            .collect::<Result<Vec<usize>, AgentError>>()?;
         let parents = &factors[f].parents;
         let own = parents.iter().position(|p| *p == Parent::Prev(f)).ok_or_else(|| {
             AgentError::Structure(format!(
                 "persistence pooling: factor `{factor}` does not depend on its own previous value"
             ))
         })?;
-        let over = parents.iter().position(|p| *p == Parent::Next(g)).ok_or_else(|| {
-            AgentError::Structure(format!(
-                "persistence pooling: `{over}` is not a next-time parent of factor `{factor}`"
-            ))
-        })?;
+        let over = names
+            .iter()
+            .zip(gs)
+            .map(|(name, g)| {
+                parents.iter().position(|p| *p == Parent::Next(g)).ok_or_else(|| {
+                    AgentError::Structure(format!(
+                        "persistence pooling: `{name}` is not a next-time parent of factor `{factor}`"
+                    ))
+                })
+            })
+            .collect::<Result<Vec<usize>, AgentError>>()?;
         let sizes = structure.parent_sizes(f);
         // Mixed radix in parent order; an action parent, if any, is the least significant digit.
         let mut strides = vec![0; sizes.len()];
@@ -491,8 +502,8 @@ impl WorldModel {
             .collect()
     }
 
-    /// Pool the persistence of factor `factor` over its next-time parent `over` (both by
-    /// name): in every CPT row where the factor's own previous value is not 0 (it was
+    /// Pool the persistence of factor `factor` over its next-time parents `over` (by
+    /// name; several joined by `+`, e.g. `"d+L"`): in every CPT row where the factor's own previous value is not 0 (it was
     /// present), the data counts of the rows that differ only in `over` are summed and
     /// shared, so that those rows predict alike; rows with previous value 0 (appearance)
     /// keep their own counts. The counts themselves are unchanged (the state gate and
@@ -500,9 +511,12 @@ impl WorldModel {
     ///
     /// This is a context-specific independence the paper's CPT `p' | p, L', d'` does not
     /// have: a pedestrian who is on the crosswalk stays or leaves whatever the car's
-    /// distance. Without it, one episode in which a pedestrian left just as the car
-    /// reached the crosswalk teaches the planner that driving on makes pedestrians leave
-    /// (measured on `late_fast`, EXPERIMENTS.md). `None` restores the paper's CPT.
+    /// distance and whatever the light. Without `d`, one episode in which a pedestrian
+    /// left just as the car reached the crosswalk teaches the planner that driving on
+    /// makes pedestrians leave (measured on `late_fast`, EXPERIMENTS.md). Without `L`,
+    /// a pedestrian on the crosswalk under green, never seen in training, keeps the
+    /// prior's even odds of leaving every tick, so the planner bets on them vanishing
+    /// (measured on `slow_walker`, EXPERIMENTS.md). `None` restores the paper's CPT.
     pub fn set_persistence_pooling(&mut self, pooling: Option<(&str, &str)>) -> Result<(), AgentError> {
         self.pooling = match pooling {
             None => None,
@@ -520,9 +534,15 @@ impl WorldModel {
         let counts = &self.cpt[f];
         let b0 = self.priors.transition_concentration;
         let n_cfg = counts.len() / size;
-        // Key of a row: its configuration with the pooled parent's value set to 0.
+        // Key of a row: its configuration with the pooled parents' values set to 0.
         let value = |cfg: usize, k: usize| (cfg / pool.strides[k]) % pool.sizes[k];
-        let key = |cfg: usize| cfg - value(cfg, pool.over) * pool.strides[pool.over];
+        let key = |cfg: usize| {
+            cfg - pool
+                .over
+                .iter()
+                .map(|&k| value(cfg, k) * pool.strides[k])
+                .sum::<usize>()
+        };
         let mut sums = vec![0.0; counts.len()];
         for cfg in (0..n_cfg).filter(|&c| value(c, pool.own) != 0) {
             for x in 0..size {
@@ -779,15 +799,39 @@ mod tests {
             }
         }
         assert_eq!(w.cpt_counts(3), &counts[..]);
+        // Pooled over d' and L': a pedestrian on red stays three more times at d' = 3, so
+        // every persistence row shares 5 stays and 1 leave: (1 + 5) / (2 + 6) = 3/4 under
+        // either light at every distance; appearance rows still keep their own counts.
+        let red = |d, p| st.encode(&[d, 1, 0, p]);
+        for _ in 0..3 {
+            w.observe_transition(red(3, 1), 0, red(3, 1));
+        }
+        w.set_persistence_pooling(Some(("p", "d+L"))).unwrap();
+        for (l, d) in (0..2).flat_map(|l| (0..4).map(move |d| (l, d))) {
+            assert!(
+                (stay(&w, l, d) - 0.75).abs() < 1e-12,
+                "L = {l}, d = {d}: {}",
+                stay(&w, l, d)
+            );
+            assert!((w.cpt_prob(3, 1, &[0, l, d], None) - 0.5).abs() < 1e-12);
+        }
         w.set_persistence_pooling(None).unwrap();
         assert!((stay(&w, 1, 1) - 1.0 / 3.0).abs() < 1e-12);
+        assert!((stay(&w, 0, 3) - 4.0 / 5.0).abs() < 1e-12);
     }
 
     #[test]
     fn persistence_pooling_names_are_checked() {
         let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
         let mut w = WorldModel::new(st, 3, &ModelPriors::default()).unwrap();
-        for (factor, over) in [("q", "d"), ("p", "x"), ("p", "p"), ("L", "d")] {
+        for (factor, over) in [
+            ("q", "d"),
+            ("p", "x"),
+            ("p", "p"),
+            ("L", "d"),
+            ("p", "d+x"),
+            ("p", "d+"),
+        ] {
             let e = w.set_persistence_pooling(Some((factor, over))).unwrap_err();
             assert!(matches!(e, AgentError::Structure(_)), "{factor}/{over}: {e}");
         }

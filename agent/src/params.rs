@@ -177,6 +177,19 @@ pub enum GateBaseline {
     None,
 }
 
+/// Which model the EFE tree's first step from `q_t` goes through
+/// ([`crate::planning::EfeTree::evaluate`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum RootStep {
+    /// The learned `B`: the car observes `q_t` while the episode goes on, so from a
+    /// crash-risk state braking out of it counts; later steps absorb.
+    #[default]
+    Learned,
+    /// Ablation (sessions 1-4): the planning model's, where episode-ending states are
+    /// absorbing from the root on, so every action from a crash-risk state ends alike.
+    Absorbing,
+}
+
 /// Hyperparameters of the paper's agent ([`crate::scaled::ScaledAgent`]).
 ///
 /// | field | default | range | paper |
@@ -204,7 +217,8 @@ pub enum GateBaseline {
 /// | `gate_memory` | 20.0 | > 0 (inf allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
 /// | `gate_learning` | Endorsed | | reasoning ticks count in the gate's table as far as the planner endorses the habit |
 /// | `gate_baseline` | Endorsed | | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `None` is the paper's trigger) |
-/// | `persistence_ignores` | `"d"` | a next-time parent's name, or `""` | the watched factor's persistence (rows where it was present) is pooled over this parent in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
+/// | `persistence_ignores` | `"d+L"` | next-time parents' names joined by `+`, or `""` | the watched factor's persistence (rows where it was present) is pooled over these parents in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
+/// | `root_step` | Learned | | the EFE tree's first step uses the learned `B`, later steps the absorbing planning model ([`RootStep`]; `Absorbing` is sessions 1-4's planner) |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ScaledParams {
@@ -254,8 +268,11 @@ pub struct ScaledParams {
     pub gate_learning: GateLearning,
     /// What the trigger subtracts from the gate's surprise.
     pub gate_baseline: GateBaseline,
-    /// The next-time parent the watched factor's persistence does not depend on (`""`: none).
+    /// The next-time parents the watched factor's persistence does not depend on, joined
+    /// by `+` (`""`: none).
     pub persistence_ignores: String,
+    /// The model of the EFE tree's first step.
+    pub root_step: RootStep,
 }
 
 impl Default for ScaledParams {
@@ -284,7 +301,8 @@ impl Default for ScaledParams {
             gate_memory: 20.0,
             gate_learning: GateLearning::Endorsed,
             gate_baseline: GateBaseline::Endorsed,
-            persistence_ignores: "d".into(),
+            persistence_ignores: "d+L".into(),
+            root_step: RootStep::Learned,
         }
     }
 }

@@ -6,7 +6,14 @@
 //! factor for dense beliefs, §II-A); the brute-force oracle uses the dense `B`.
 //!
 //! All policies start from `q_t`: `s_1 = B[π_1] q_t`, `s_k = B[π_k] s_{k-1}`, `o_k = A s_k`,
-//! `G(π) = Σ_k [ o_k·(ln o_k - C) + s_k·H_A ]` (risk + ambiguity). The tree shares
+//! `G(π) = Σ_k [ o_k·(ln o_k - C) + s_k·H_A ]` (risk + ambiguity).
+//!
+//! The tree takes two models: the first step from `q_t` goes through the *root* model's
+//! `B` and every later step through the planning model's. In the agent the planning
+//! model has the episode-ending states absorbing (`WorldModel::set_terminal_states`) and
+//! the root model is the learned one: the car observes `q_t` while the episode goes on,
+//! so even in a crash-risk state (a pedestrian on the crosswalk while the car moves in a
+//! crosswalk bin) its next step follows its dynamics, and braking out of it counts. The tree shares
 //! prefixes: `U + U^2 + ... + U^H` mat-vecs instead of `H U^H`. Policies are ordered
 //! lexicographically (first action most significant): `[0,0], [0,1], ...`.
 
@@ -178,18 +185,20 @@ impl EfeTree {
         self.horizon
     }
 
-    /// Evaluate `G`, `q(π)` and `ψ` from `q_t` with precision `γ` (§IV, Prop. 1, Cor. 1).
-    pub fn evaluate(&mut self, gm: &GenerativeModel, q_t: &[f64], gamma: f64) {
+    /// Evaluate `G`, `q(π)` and `ψ` from `q_t` with precision `γ` (§IV, Prop. 1, Cor. 1):
+    /// the first step through `root`'s `B`, the later ones through `gm`'s (module docs).
+    /// Pass the same model twice for one model throughout.
+    pub fn evaluate(&mut self, gm: &GenerativeModel, root: &GenerativeModel, q_t: &[f64], gamma: f64) {
         self.memo_valid = false;
-        self.run(gm, q_t, gamma, false);
+        self.run(gm, root, q_t, gamma, false);
     }
 
     /// [`EfeTree::evaluate`], reusing the subtrees of the previous call whose root belief
     /// and accumulated `G` are bit for bit the same (the results are those of
     /// [`EfeTree::evaluate`], bit for bit). The caller promises that `gm` is the model of
     /// the previous call, unchanged, unless it called [`EfeTree::invalidate`] since.
-    pub fn evaluate_reusing(&mut self, gm: &GenerativeModel, q_t: &[f64], gamma: f64) {
-        self.run(gm, q_t, gamma, true);
+    pub fn evaluate_reusing(&mut self, gm: &GenerativeModel, root: &GenerativeModel, q_t: &[f64], gamma: f64) {
+        self.run(gm, root, q_t, gamma, true);
     }
 
     /// Forget the previous evaluation (call when the model changes).
@@ -197,7 +206,7 @@ impl EfeTree {
         self.memo_valid = false;
     }
 
-    fn run(&mut self, gm: &GenerativeModel, q_t: &[f64], gamma: f64, reuse: bool) {
+    fn run(&mut self, gm: &GenerativeModel, root: &GenerativeModel, q_t: &[f64], gamma: f64, reuse: bool) {
         self.matvecs = 0;
         self.reused = 0;
         let unchanged = reuse && self.memo_valid && same_bits(&self.memo_root, q_t);
@@ -205,7 +214,7 @@ impl EfeTree {
             self.reused = self.below(0);
         } else {
             self.bufs[0].copy_from_slice(q_t);
-            self.recurse(gm, 0, 0.0, 0, reuse);
+            self.recurse(gm, root, 0, 0.0, 0, reuse);
             if reuse {
                 self.memo_root.copy_from_slice(q_t);
                 self.memo_valid = true;
@@ -220,12 +229,21 @@ impl EfeTree {
         (1..=self.horizon - depth).map(|k| self.n_actions.pow(k as u32)).sum()
     }
 
-    fn recurse(&mut self, gm: &GenerativeModel, depth: usize, g_acc: f64, idx: usize, reuse: bool) {
+    fn recurse(
+        &mut self,
+        gm: &GenerativeModel,
+        root: &GenerativeModel,
+        depth: usize,
+        g_acc: f64,
+        idx: usize,
+        reuse: bool,
+    ) {
         let n = self.n_states;
+        let step_model = if depth == 0 { root } else { gm };
         for u in 0..self.n_actions {
             {
                 let (lo, hi) = self.bufs.split_at_mut(depth + 1);
-                gm.transition_into(u, &lo[depth], &mut hi[0], &mut self.scratch);
+                step_model.transition_into(u, &lo[depth], &mut hi[0], &mut self.scratch);
             }
             self.matvecs += 1;
             let (r, a) = step_efe(gm, &self.bufs[depth + 1], &mut self.obuf);
@@ -246,7 +264,7 @@ impl EfeTree {
                 ms.copy_from_slice(&self.bufs[depth + 1]);
                 *mg = g;
             }
-            self.recurse(gm, depth + 1, g, child, reuse);
+            self.recurse(gm, root, depth + 1, g, child, reuse);
         }
     }
 }
@@ -293,8 +311,8 @@ mod tests {
         let mut memo = EfeTree::new(ns, ns, nu, 3);
         let mut reused = Vec::new();
         for q in &beliefs {
-            plain.evaluate(&gm, q, 1.5);
-            memo.evaluate_reusing(&gm, q, 1.5);
+            plain.evaluate(&gm, &gm, q, 1.5);
+            memo.evaluate_reusing(&gm, &gm, q, 1.5);
             for (a, b) in plain.g.iter().zip(&memo.g).chain(plain.psi.iter().zip(&memo.psi)) {
                 assert_eq!(a.to_bits(), b.to_bits());
             }
@@ -304,7 +322,7 @@ mod tests {
         // Nothing, everything, the subtrees below depth 1, nothing.
         assert_eq!(reused, vec![0, 39, 36, 0]);
         memo.invalidate();
-        memo.evaluate_reusing(&gm, &beliefs[3], 1.5);
+        memo.evaluate_reusing(&gm, &gm, &beliefs[3], 1.5);
         assert_eq!(memo.reused, 0);
     }
 }

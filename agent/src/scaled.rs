@@ -19,7 +19,9 @@ use crate::gate::StateGate;
 use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
-use crate::params::{ActionSelection, GateBaseline, GateLearning, GateMode, ReasoningMode, ScaledParams, ScalingMode};
+use crate::params::{
+    ActionSelection, GateBaseline, GateLearning, GateMode, ReasoningMode, RootStep, ScaledParams, ScalingMode,
+};
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s_into};
 use crate::q_learning::QLearning;
@@ -240,11 +242,18 @@ impl ScaledAgent {
             self.hist_q[(first + k) * n..(first + k + 1) * n].copy_from_slice(&self.window_q[k]);
         }
         self.q_cur.copy_from_slice(&self.window_q[w - 1]);
-        // Planning (§IV).
-        // The planning model changes only at the end of an episode (`begin_episode`
-        // invalidates the tree), so the tree may reuse the previous tick's subtrees.
+        // Planning (§IV). The first step goes through the learned B, the later ones
+        // through the planning model's (episode-ending states absorbing): the car is
+        // observed while the episode goes on, so braking out of a crash-risk state counts
+        // (module docs of `planning`).
+        // The models change only at the end of an episode (`begin_episode` invalidates
+        // the tree), so the tree may reuse the previous tick's subtrees.
+        let root = match self.params.root_step {
+            RootStep::Learned => self.model.generative(),
+            RootStep::Absorbing => self.model.planning_generative(),
+        };
         self.tree
-            .evaluate_reusing(self.model.planning_generative(), &self.q_cur, self.params.gamma);
+            .evaluate_reusing(self.model.planning_generative(), root, &self.q_cur, self.params.gamma);
         learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
         let tr = &mut self.last;
         tr.free_energy = out.free_energy;

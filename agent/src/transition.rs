@@ -510,7 +510,7 @@ mod tests {
             q.iter_mut().for_each(|v| *v /= z);
             let gm = w.planning_generative();
             let mut tree = crate::planning::EfeTree::new(64, 64, 3, h);
-            tree.evaluate(gm, &q, 1.0);
+            tree.evaluate(gm, gm, &q, 1.0);
             for (i, p) in crate::planning::policies(3, h).iter().enumerate() {
                 let bf = crate::planning::efe_brute_force(gm, &q, p);
                 prop_assert!((bf - tree.g[i]).abs() < 1e-10, "{:?}: {bf} vs {}", p, tree.g[i]);

@@ -5,8 +5,9 @@
 //! red phases). The car is a dynamic rigid body; the three actions of the
 //! paper ([`Action`]: maintain, speed up, slow down) act on it through
 //! longitudinal velocity control (Rapier integrates it and finds contacts). Pedestrians are kinematic bodies with sensor colliders
-//! that cross the crosswalk when the map's spawn rules say so. Collisions come
-//! from Rapier's collision events.
+//! that cross the crosswalk when the map's spawn rules say so. A collision is the
+//! car's collider intersecting a pedestrian's (parry's intersection test, the one
+//! Rapier's narrow phase runs on sensors) after any physics sub-step.
 //!
 //! Everything about a scenario is in a [`Map`] (RON; see `maps/README.md`):
 //!

@@ -2,8 +2,6 @@
 //! longitudinal velocity control), pedestrians (kinematic bodies with sensor colliders),
 //! the traffic light, spawn rules, and the episode's end.
 
-use std::sync::Mutex;
-
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier2d::prelude::*;
@@ -95,7 +93,7 @@ impl Snapshot {
 pub struct StepOutcome {
     /// Decision ticks done (after this one).
     pub step: u32,
-    /// The car touched a pedestrian (reported by Rapier's collision events).
+    /// The car touched a pedestrian (their colliders intersect after a sub-step).
     pub collision: bool,
     /// The car's front reached the destination (and there was no collision).
     pub goal: bool,
@@ -109,51 +107,6 @@ impl StepOutcome {
     /// Whether the episode is over.
     pub fn done(&self) -> bool {
         self.collision || self.goal || self.timeout
-    }
-}
-
-/// Collects Rapier's collision-start events during a step.
-#[derive(Default)]
-struct Events(Mutex<Vec<(ColliderHandle, ColliderHandle)>>);
-
-impl EventHandler for Events {
-    fn handle_collision_event(
-        &self,
-        _bodies: &RigidBodySet,
-        _colliders: &ColliderSet,
-        event: CollisionEvent,
-        _contact_pair: Option<&ContactPair>,
-    ) {
-        if let CollisionEvent::Started(a, b, _) = event
-            && let Ok(mut v) = self.0.lock()
-        {
-            v.push((a, b));
-        }
-    }
-
-    fn handle_contact_force_event(
-        &self,
-        _dt: Real,
-        _bodies: &RigidBodySet,
-        _colliders: &ColliderSet,
-        _contact_pair: &ContactPair,
-        _total_force_magnitude: Real,
-    ) {
-    }
-
-    fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
-}
-
-impl Events {
-    fn touches(&self, c: ColliderHandle) -> bool {
-        match self.0.lock() {
-            Ok(mut v) => {
-                let hit = v.iter().any(|&(a, b)| a == c || b == c);
-                v.clear();
-                hit
-            }
-            Err(_) => false,
-        }
     }
 }
 
@@ -230,11 +183,15 @@ impl World {
         // What the scene does not need (issue 13): no CCD (a 4.5 m car at 60 Hz would
         // tunnel only above ~290 m/s), and no position-stabilisation
         // passes (they correct penetrations of solid contacts and joints; the scene has
-        // neither: pedestrians are sensors). Neither changes a bit of the trajectories.
-        // The solver's iteration count stays: it sets the sub-steps positions are
-        // integrated in, so changing it would change every position's last bits.
+        // neither: pedestrians are sensors), and one solver iteration instead of 4: the
+        // car is the only dynamic body and has no contact or joint to solve, so more
+        // iterations only split the same free motion into smaller integration sub-steps.
+        // One iteration saves 19% of the training's instructions (BENCHMARKS.md); it
+        // moves positions in their last bits, which decides the distance bin where the
+        // car stops exactly on a bin edge (EXPERIMENTS.md, slow_walker).
         phys.integration_parameters.max_ccd_substeps = 0;
         phys.integration_parameters.num_internal_stabilization_iterations = 0;
+        phys.integration_parameters.num_solver_iterations = 1;
 
         let v = &map.vehicle;
         let body = RigidBodyBuilder::dynamic()
@@ -251,8 +208,7 @@ impl World {
             .can_sleep(false);
         let collider = ColliderBuilder::cuboid((v.length / 2.0) as Real, (v.width / 2.0) as Real)
             .mass(v.mass as Real)
-            .friction(0.0)
-            .active_events(ActiveEvents::COLLISION_EVENTS);
+            .friction(0.0);
         let (car, car_collider) = phys.insert(body, collider);
         let prev_phase = light_at(&map.light, light_offset, 0.0).0;
         World {
@@ -308,7 +264,6 @@ impl World {
             return t;
         }
         let start_x = self.car_front();
-        let events = Events::default();
         let mut collision = false;
         let mut goal = false;
         let v0 = self.car_speed();
@@ -316,12 +271,10 @@ impl World {
             self.spawn_due();
             self.move_pedestrians();
             self.control_car(action, v0, k);
-            self.phys.step_with_events(&(), &events);
+            self.phys.step();
             self.substep += 1;
             self.after_substep();
-            // Sensor events arrive one sub-step after the overlap (a Rapier pitfall);
-            // a collision is therefore detected at most 1/physics_hz late.
-            if events.touches(self.car_collider) {
+            if self.car_touches_pedestrian() {
                 collision = true;
                 break;
             }
@@ -329,13 +282,6 @@ impl World {
                 goal = true;
                 break;
             }
-        }
-        if !collision && self.car_touches_pedestrian() {
-            // The late sensor event of the last sub-step (they arrive one sub-step late), read with one
-            // query on the final poses instead of another collision-detection pass: a
-            // collision is never reported a whole tick late.
-            collision = true;
-            goal = false;
         }
         self.step += 1;
         let timeout = !collision && !goal && self.step >= self.map.episode.max_steps;
@@ -354,7 +300,10 @@ impl World {
 
     /// Whether the car's collider overlaps a pedestrian's on the current poses: the
     /// test Rapier's narrow phase runs on a sensor pair (parry's `intersection_test`),
-    /// so it says what the next collision-detection pass would report.
+    /// run after every sub-step, so a collision is reported on the sub-step the shapes
+    /// first overlap. (Rapier's own sensor events arrive one sub-step late with four
+    /// solver iterations and two with one, measured in session 5 on the scene of the
+    /// test `collision_is_reported_when_the_shapes_touch`.)
     fn car_touches_pedestrian(&self) -> bool {
         let car = &self.phys.colliders[self.car_collider];
         self.peds.iter().any(|p| {

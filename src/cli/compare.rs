@@ -4,17 +4,18 @@
 
 use clap::Args;
 use std::path::{Path, PathBuf};
+use unforeseen_sim::Map;
 
 use super::table::{cell, print_grid, range_cell, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
 use crate::agents::Agent;
-use crate::maps;
 use crate::methods::{Method, PaperFigures};
 use crate::plots::{BarPanel, BarRow, bar_key, grouped_bars};
 use crate::protocol::{Protocol, ProtocolChoice};
 use crate::report::{Csv, num, write_json};
 use crate::study::{METRICS, MethodSummary, ProtocolTable, StudySetup, run_study};
+use crate::{maps, rewards};
 
 /// Training episodes by default (the paper's 6000).
 pub const DEFAULT_TRAIN_EPISODES: u64 = 6000;
@@ -149,7 +150,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     };
     let tables = run_study(&setup, &agents)?;
     for table in &tables {
-        print_table(table, &train_map.name, &test_map.name);
+        print_table(table, &train_map, &test_map);
     }
 
     let report = CompareReport {
@@ -235,13 +236,22 @@ fn agents_line(m: &MethodSummary) -> String {
 /// Prints one protocol's table: the figures (paper's in parentheses), then, over
 /// several agents, their range and the worst seed. A second header line names the map
 /// each column was measured on.
-fn print_table(table: &ProtocolTable, train_map: &str, test_map: &str) {
+fn print_table(table: &ProtocolTable, train_map: &Map, test_map: &Map) {
     let Some(first) = table.methods.first() else { return };
     let n = first.train_seeds.len();
     println!();
     println!("== {} protocol: {}", table.protocol, table.meaning);
     println!("{}", agents_line(first));
-    println!("train reward: on the training map '{train_map}'; every other column: on the test map '{test_map}'");
+    println!(
+        "train reward: on the training map '{}'; every other column: on the test map '{}'",
+        train_map.name, test_map.name
+    );
+    let (train_reward, test_reward) = (rewards::describe(train_map), rewards::describe(test_map));
+    if train_reward == test_reward {
+        println!("reward on both maps: {train_reward}");
+    } else {
+        println!("reward: training map {train_reward}; test map {test_reward}");
+    }
     if n > 1 {
         println!(
             "each figure: mean ± half-width of the 95% interval over the {n} agents (Student t, {} df)",
@@ -250,7 +260,7 @@ fn print_table(table: &ProtocolTable, train_map: &str, test_map: &str) {
     }
     let mut rows = vec![
         header("µs/tick"),
-        maps_row(train_map, test_map, &format!("({test_map})")),
+        maps_row(&train_map.name, &test_map.name, &format!("({})", test_map.name)),
     ];
     let with_paper = |ours: String, paper: Option<String>| match paper {
         Some(p) if table.protocol == Protocol::ZeroShot => format!("{ours} ({p})"),
@@ -302,7 +312,7 @@ fn print_table(table: &ProtocolTable, train_map: &str, test_map: &str) {
         );
     }
     if n > 1 {
-        print_spread(table, train_map, test_map);
+        print_spread(table, &train_map.name, &test_map.name);
     }
 }
 

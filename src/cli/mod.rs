@@ -111,7 +111,7 @@ pub struct AgentArgs {
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
     /// Scaled-agent parameter overrides, e.g. `--set omega=0.3 --set horizon=2`
-    /// (keys: omega, epsilon, gamma, varsigma, horizon, kappa_pi, vmp_window, max_scaling_iters, nu0, nu_temperature, learning_rate, sample, gate, gate_factor, gate_memory, gate_learning, gate_baseline, persistence_ignores).
+    /// (keys: omega, epsilon, gamma, varsigma, horizon, kappa_pi, vmp_window, max_scaling_iters, nu0, nu_temperature, learning_rate, sample, gate, gate_factor, gate_memory, gate_learning, gate_baseline, persistence_ignores, root_step).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// Run seed: the evaluation episodes and, without `--agent`, the training run derive from it.

@@ -56,7 +56,7 @@ fn efe_q_pi_and_psi() {
     let gm = model();
     let q = [9.0 / 11.0, 2.0 / 11.0];
     let mut tree = EfeTree::new(2, 2, 2, 1);
-    tree.evaluate(&gm, &q, 0.5);
+    tree.evaluate(&gm, &gm, &q, 0.5);
     close(tree.g[0], 0.358366, 1e-5);
     close(tree.g[1], 0.863053, 1e-5);
     close(tree.q_pi[0], 0.562759, 1e-5);

@@ -3,5 +3,6 @@
 
 mod bundle_and_controllers;
 mod hand_worked;
+mod planning_root;
 mod properties;
 mod pymdp_crossval;

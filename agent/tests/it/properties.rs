@@ -96,7 +96,7 @@ proptest! {
         let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(1));
         let q = dist(&mut rng, gm.n_states());
         let mut tree = EfeTree::new(gm.n_states(), gm.n_obs(), gm.n_actions(), h);
-        tree.evaluate(&gm, &q, gamma);
+        tree.evaluate(&gm, &gm, &q, gamma);
         let pols = policies(gm.n_actions(), h);
         prop_assert_eq!(pols.len(), tree.g.len());
         let expected_matvecs: usize = (1..=h).map(|k| gm.n_actions().pow(k as u32)).sum();

@@ -367,7 +367,7 @@ fn the_shipped_maps_are_within_the_limits() {
     for name in unforeseen_sim::embedded::names() {
         unforeseen_sim::embedded::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
     }
-    // maps/ and its subfolders (maps/rapid/: the rapid-approach reward).
+    // maps/ and its subfolders (maps/per_metre/: the per-metre reward).
     let mut dirs = vec![Path::new(env!("CARGO_MANIFEST_DIR")).join("../maps")];
     let mut loaded = 0;
     while let Some(dir) = dirs.pop() {
