@@ -72,3 +72,19 @@ pub fn state_rewards(map: &Map, disc: &Discretizer) -> Vec<f64> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod describe_tests {
+    use super::describe;
+
+    #[test]
+    fn the_default_reward_is_named_rapid_approach_and_a_cheap_tick_per_metre() {
+        let mut map = crate::maps::load("intersection").unwrap();
+        assert_eq!(
+            describe(&map),
+            "rapid approach: 0.5/m of progress, -4.5 per tick, goal +50, crash -25"
+        );
+        map.reward.step_cost = 1.0;
+        assert!(describe(&map).starts_with("per metre: "), "{}", describe(&map));
+    }
+}

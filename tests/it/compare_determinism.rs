@@ -57,6 +57,12 @@ fn compare_json_is_identical_across_runs_with_the_same_seed() {
         for m in t["methods"].as_array().unwrap() {
             assert_eq!(m["protocol"], t["protocol"]);
             assert_eq!(m["train_seeds"], serde_json::json!([3]));
+            // Every row names the reward its returns are paid in: the maps' default,
+            // rapid approach (a tick costs what a full-speed tick earns).
+            for map in ["train_map", "test_map"] {
+                assert_eq!(m["reward"][map]["step_cost"], serde_json::json!(4.5), "{m}");
+                assert_eq!(m["reward"][map]["crash"], serde_json::json!(-25.0), "{m}");
+            }
             for k in [
                 "train_reward",
                 "test_reward",
