@@ -51,6 +51,125 @@ pub fn lane_sum(n: usize, f: impl Fn(usize) -> f64) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3])
 }
 
+/// `ln 2` split so that `k · LN2_HI` is exact for `|k| < 2^11`: `LN2_HI` holds the
+/// leading 32 bits of `ln 2`, `LN2_LO = ln 2 - LN2_HI` the rest.
+const LN2_HI: f64 = f64::from_bits(0x3FE6_2E42_FEE0_0000);
+const LN2_LO: f64 = 1.9082149292705877e-10;
+/// `2^52 + 1023`: subtracting it from the float whose bits are `0x433 << 52 | e` gives
+/// the unbiased exponent `e - 1023` exactly (no integer-to-float conversion needed, so
+/// the compiler keeps the loop in SSE2 registers).
+const EXP_MAGIC: f64 = 4_503_599_627_370_496.0 + 1023.0;
+
+/// Natural logarithm of a positive normal `x`, branch-free, so that loops over slices
+/// vectorise (docs/ARCHITECTURE.md §4.1; used through [`ln_into`] and [`risk_sum`]).
+///
+/// `x = 2^k m` with `m` in `[√2/2, √2)`; with `f = m - 1` and `s = f / (2 + f)`,
+/// `ln m = 2 atanh s = 2s + 2s (s²/3 + s⁴/5 + … + s¹⁸/19)` (the Taylor series of
+/// `atanh`, `|s| <= 0.1716`, truncated where the next term is below 1e-17 of the result),
+/// written `f - s (f - 2 s² Q(s²))` since `2s = f - s f`. `k ln 2` is added in two
+/// parts. Plain IEEE operations (no FMA, no table, no run-time dispatch): every x86-64
+/// machine computes the same bits, scalar or vectorised. Max error against `std`'s `ln`
+/// ~1 ulp of `max(|ln x|, 1)` (test `fast_ln_and_exp_match_std`). Not for zero,
+/// subnormal, negative or non-finite `x`: callers floor first.
+#[inline(always)]
+pub fn ln_fast(x: f64) -> f64 {
+    let bits = x.to_bits();
+    let mut k = f64::from_bits((bits >> 52) | 0x4330_0000_0000_0000) - EXP_MAGIC;
+    let mut m = f64::from_bits((bits & 0x000F_FFFF_FFFF_FFFF) | 0x3FF0_0000_0000_0000);
+    let big = m > std::f64::consts::SQRT_2;
+    m = if big { m * 0.5 } else { m };
+    k = if big { k + 1.0 } else { k };
+    let f = m - 1.0;
+    let s = f / (2.0 + f);
+    let z = s * s;
+    let q = 1.0 / 3.0
+        + z * (1.0 / 5.0
+            + z * (1.0 / 7.0
+                + z * (1.0 / 9.0
+                    + z * (1.0 / 11.0 + z * (1.0 / 13.0 + z * (1.0 / 15.0 + z * (1.0 / 17.0 + z * (1.0 / 19.0))))))));
+    let ln_m = f - s * (f - 2.0 * z * q);
+    k * LN2_HI + (k * LN2_LO + ln_m)
+}
+
+/// `e^x`, branch-free (for vectorised loops, see [`ln_fast`]): `x = k ln 2 + r` with
+/// `k = round(x / ln 2)` (`|r| <= 0.35`), `e^r` by its Taylor series to `r^13/13!`
+/// (the next term is below 1e-17 of the result), times `2^k` built from its bits.
+/// Results below the smallest normal (`x < -708.39`) flush to 0; `x` must be `<= 709`.
+/// Max error against `std`'s `exp` ~2 ulp (test `fast_ln_and_exp_match_std`).
+#[inline(always)]
+pub fn exp_fast(x: f64) -> f64 {
+    const ROUND: f64 = 6_755_399_441_055_744.0; // 1.5 · 2^52: x + ROUND - ROUND rounds x
+    const MIN_X: f64 = -708.39;
+    let xc = if x < MIN_X { MIN_X } else { x };
+    let k = (xc * std::f64::consts::LOG2_E + ROUND) - ROUND;
+    let r = (xc - k * LN2_HI) - k * LN2_LO;
+    let mut p = 1.0 / 6_227_020_800.0; // 1/13!
+    for c in [
+        1.0 / 479_001_600.0,
+        1.0 / 39_916_800.0,
+        1.0 / 3_628_800.0,
+        1.0 / 362_880.0,
+        1.0 / 40_320.0,
+        1.0 / 5_040.0,
+        1.0 / 720.0,
+        1.0 / 120.0,
+        1.0 / 24.0,
+        1.0 / 6.0,
+        0.5,
+        1.0,
+        1.0,
+    ] {
+        p = p * r + c;
+    }
+    // 2^k from its bits: k + 1023 in the exponent field (k >= -1022 by the clamp).
+    let two_k = f64::from_bits(((k + EXP_MAGIC).to_bits() & 0x7FF) << 52);
+    if x < MIN_X { 0.0 } else { p * two_k }
+}
+
+/// `out[i] = ln(max(x[i], 1e-16))` with [`ln_fast`] (docs/ARCHITECTURE.md §4.1); the
+/// loop vectorises.
+pub fn ln_into(x: &[f64], out: &mut [f64]) {
+    for (o, v) in out[..x.len()].iter_mut().zip(x) {
+        *o = ln_fast(v.max(LN_FLOOR));
+    }
+}
+
+/// Softmax as [`softmax_in_place`], with [`exp_fast`] and the normaliser summed in four
+/// lanes by [`lane_sum`]. For VMP's beliefs (§III eq. "iterative").
+pub fn softmax_fast_in_place(x: &mut [f64]) {
+    let m = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !m.is_finite() {
+        let n = x.len() as f64;
+        x.iter_mut().for_each(|v| *v = 1.0 / n);
+        return;
+    }
+    for v in x.iter_mut() {
+        *v = exp_fast(*v - m);
+    }
+    let z = lane_sum(x.len(), |i| x[i]);
+    for v in x.iter_mut() {
+        *v /= z;
+    }
+}
+
+/// `Σ_i p_i (ln p_i - c_i)` with the floored [`ln_fast`], summed by [`lane_sum`]; zero
+/// entries add exactly 0. The risk of one step of the EFE (Prop. 1, `KL[A s || c]`).
+pub fn risk_sum(p: &[f64], c: &[f64]) -> f64 {
+    const CHUNK: usize = 64;
+    let c = &c[..p.len()];
+    let mut buf = [0.0f64; CHUNK];
+    let mut acc = [0.0f64; 4];
+    // The logarithms of a chunk first (a loop that vectorises), then its terms, added
+    // to four lanes by index modulo 4 as `lane_sum` does.
+    for (k, (pc, cc)) in p.chunks(CHUNK).zip(c.chunks(CHUNK)).enumerate() {
+        ln_into(pc, &mut buf);
+        for (i, ((pi, li), ci)) in pc.iter().zip(&buf).zip(cc).enumerate() {
+            acc[(k * CHUNK + i) % 4] += pi * (li - ci);
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3])
+}
+
 /// Rows of `out` computed together by [`axpy_columns`] and [`dot_columns`], held in
 /// registers while the columns stream past.
 const BLOCK: usize = 8;
@@ -225,6 +344,71 @@ mod tests {
                 let want: f64 = (0..n).map(|i| m[i * n + s] * x[i]).sum();
                 assert_eq!(g.to_bits(), want.to_bits());
             }
+        }
+    }
+
+    /// Maximum error of the vectorised `ln` and `exp` against `std` over the ranges the
+    /// agent uses: `ln` on `[1e-16, 1]` (probabilities, floored) and beyond up to 1e6,
+    /// `exp` on `[-745, 0]` (softmax arguments after max-subtraction). Errors are measured
+    /// in units of `f64::EPSILON` relative to `max(|std|, 1)` (absolute near `ln 1 = 0`).
+    #[test]
+    fn fast_ln_and_exp_match_std() {
+        let n = 200_000;
+        let xs: Vec<f64> = (0..=n)
+            .map(|i| 10f64.powf(-16.0 + 22.0 * i as f64 / n as f64))
+            .collect();
+        let mut got = vec![0.0; xs.len()];
+        ln_into(&xs, &mut got);
+        let mut worst: f64 = 0.0;
+        for (x, g) in xs.iter().zip(&got) {
+            let want = x.ln();
+            worst = worst.max((g - want).abs() / want.abs().max(1.0) / f64::EPSILON);
+        }
+        eprintln!("ln: worst {worst} eps");
+        assert!(worst <= 2.0, "ln: {worst} eps");
+        // The floor, zero and values just around 1.
+        ln_into(&[0.0, 1e-300, 1.0, 1.0 - 1e-12, 1.0 + 1e-12], &mut got);
+        assert_eq!(got[0], LN_FLOOR.ln());
+        assert_eq!(got[1], LN_FLOOR.ln());
+        assert_eq!(got[2], 0.0);
+        assert!((got[3] - (1.0f64 - 1e-12).ln()).abs() < 1e-27);
+        assert!((got[4] - (1.0f64 + 1e-12).ln()).abs() < 1e-27);
+        // exp through softmax over [x, 0]: entry 0 is exp(x) / (exp(x) + 1).
+        let mut worst: f64 = 0.0;
+        for i in 0..=n {
+            let x = -745.0 * i as f64 / n as f64;
+            let mut v = [x, 0.0];
+            softmax_fast_in_place(&mut v);
+            let e = x.exp();
+            let want = e / (e + 1.0);
+            // Relative error down to 1e-300; below (`exp_fast` flushes to 0 near the
+            // subnormal range), absolute.
+            let err = if want >= 1e-300 {
+                (v[0] - want).abs() / want / f64::EPSILON
+            } else {
+                (v[0] - want).abs() / 1e-300
+            };
+            worst = worst.max(err);
+        }
+        eprintln!("exp (through softmax): worst {worst} eps");
+        assert!(worst <= 4.0, "exp: {worst} eps");
+    }
+
+    /// The vector softmax and risk agree with the scalar forms to rounding, for lengths
+    /// that are and are not multiples of four.
+    #[test]
+    fn vector_softmax_and_risk_match_scalar_forms() {
+        for n in [1usize, 3, 4, 7, 64] {
+            let x: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 40.0 * (i % 3) as f64).collect();
+            let (mut a, mut b) = (x.clone(), x.clone());
+            softmax_in_place(&mut a);
+            softmax_fast_in_place(&mut b);
+            for (p, q) in a.iter().zip(&b) {
+                assert!((p - q).abs() <= 4.0 * f64::EPSILON * p.max(1e-300), "{p} vs {q}");
+            }
+            let c: Vec<f64> = (0..n).map(|i| -(i as f64) * 0.3).collect();
+            let want: f64 = a.iter().zip(&c).map(|(p, ci)| p * (ln(*p) - ci)).sum();
+            assert!((risk_sum(&a, &c) - want).abs() < 1e-14, "{n}");
         }
     }
 

@@ -15,7 +15,7 @@
 //! geodesic toward that minimiser, along which `KL[q || q*]` (hence `F`) is
 //! non-increasing too — both are property-tested.
 
-use crate::maths::{axpy_columns, dot_columns, ln, softmax_in_place};
+use crate::maths::{axpy_columns, dot_columns, lane_sum, ln_into, softmax_fast_in_place};
 use crate::model::GenerativeModel;
 
 /// Result of a VMP run.
@@ -77,7 +77,8 @@ fn message_into(
 /// `F = Σ_τ q_τ·(ln q_τ - (ln A)^T o_τ) - q_0·ln ŝ - Σ_{τ>0} q_τ^T (ln B[a_{τ-1}]) q_{τ-1}`.
 /// `F >= -ln p(o_window)` (Lemma 1), with equality at the exact posterior for W = 1.
 pub fn free_energy(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: &[usize], qs: &[Vec<f64>]) -> f64 {
-    let ln_s_hat: Vec<f64> = s_hat.iter().map(|p| ln(*p)).collect();
+    let mut ln_s_hat = vec![0.0; s_hat.len()];
+    ln_into(s_hat, &mut ln_s_hat);
     let mut acc = vec![0.0; gm.n_states()];
     free_energy_with(gm, &ln_s_hat, obs, actions, qs, &mut acc)
 }
@@ -95,11 +96,10 @@ fn free_energy_with(
     let mut f = 0.0;
     for (tau, q) in qs.iter().enumerate().take(obs.len()) {
         let o = obs[tau];
-        for (s, p) in q.iter().enumerate() {
-            if *p > 0.0 {
-                f += p * (ln(*p) - gm.ln_a[(o, s)]);
-            }
-        }
+        // Σ_s q (ln q - ln A[o, s]); zero entries add exactly 0 (the floored logs are finite).
+        ln_into(q, acc);
+        let ln_a = gm.ln_a.row(o);
+        f += lane_sum(n, |s| q[s] * (acc[s] - ln_a[s]));
         if tau == 0 {
             f -= q
                 .iter()
@@ -139,8 +139,8 @@ pub fn vmp(
     let n = gm.n_states();
     ws.v.resize(n, 0.0);
     ws.acc.resize(n, 0.0);
-    ws.ln_s_hat.clear();
-    ws.ln_s_hat.extend(s_hat.iter().map(|p| ln(*p)));
+    ws.ln_s_hat.resize(n, 0.0);
+    ln_into(s_hat, &mut ws.ln_s_hat);
     let w = obs.len();
     let mut iterations = 0;
     let mut converged = false;
@@ -151,11 +151,12 @@ pub fn vmp(
             message_into(gm, &ws.ln_s_hat, obs, actions, qs, tau, &mut ws.v, &mut ws.acc);
             let q = &mut qs[tau];
             // ε = v - ln q ; ln q <- ln q + κ ε ; q = σ(ln q). Store the new logits in v.
-            for (vi, qi) in ws.v.iter_mut().zip(q.iter()) {
-                let lq = ln(*qi);
+            // Branch-free logarithms and exponentials that vectorise (`maths::ln_fast`, `exp_fast`).
+            ln_into(q, &mut ws.acc);
+            for (vi, lq) in ws.v.iter_mut().zip(ws.acc.iter()) {
                 *vi = lq + kappa * (*vi - lq);
             }
-            softmax_in_place(&mut ws.v);
+            softmax_fast_in_place(&mut ws.v);
             for (qi, vi) in q.iter_mut().zip(&ws.v) {
                 change = change.max((*qi - *vi).abs());
                 *qi = *vi;
