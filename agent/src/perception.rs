@@ -37,9 +37,12 @@ pub struct VmpWorkspace {
     acc: Vec<f64>,
     /// `ln ŝ`, shared by slot 0's message and `F`.
     ln_s_hat: Vec<f64>,
+    /// Marginals and partial messages of the factored `ln B`.
+    scratch: Vec<f64>,
 }
 
-/// The message `v_τ` of slot `tau` (eq. "message passing") into `v`; `acc` is scratch.
+/// The message `v_τ` of slot `tau` (eq. "message passing") into `v`; `acc` and `scratch`
+/// are scratch. Through the factored `ln B` when the model has it (`FactoredLogB`).
 #[allow(clippy::too_many_arguments)]
 fn message_into(
     gm: &GenerativeModel,
@@ -50,6 +53,7 @@ fn message_into(
     tau: usize,
     v: &mut [f64],
     acc: &mut [f64],
+    scratch: &mut Vec<f64>,
 ) {
     let n = gm.n_states();
     let last = obs.len() - 1;
@@ -57,11 +61,17 @@ fn message_into(
     if tau == 0 {
         v.copy_from_slice(ln_s_hat);
     } else {
-        axpy_columns(gm.ln_b[actions[tau - 1]].as_slice(), n, &qs[tau - 1], v);
+        match &gm.log_factored {
+            Some(lb) => lb.forward(actions[tau - 1], &qs[tau - 1], v, scratch),
+            None => axpy_columns(gm.ln_b[actions[tau - 1]].as_slice(), n, &qs[tau - 1], v),
+        }
     }
     // Message 2: backward, (ln B[a_τ])^T q_{τ+1}.
     if tau < last {
-        dot_columns(gm.ln_b_t[actions[tau]].as_slice(), n, &qs[tau + 1], acc);
+        match &gm.log_factored {
+            Some(lb) => lb.backward(actions[tau], &qs[tau + 1], acc, scratch),
+            None => dot_columns(gm.ln_b_t[actions[tau]].as_slice(), n, &qs[tau + 1], acc),
+        }
         for (vi, a) in v.iter_mut().zip(acc.iter()) {
             *vi += a;
         }
@@ -80,10 +90,10 @@ pub fn free_energy(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: 
     let mut ln_s_hat = vec![0.0; s_hat.len()];
     ln_into(s_hat, &mut ln_s_hat);
     let mut acc = vec![0.0; gm.n_states()];
-    free_energy_with(gm, &ln_s_hat, obs, actions, qs, &mut acc)
+    free_energy_with(gm, &ln_s_hat, obs, actions, qs, &mut acc, &mut Vec::new())
 }
 
-/// [`free_energy`] given `ln ŝ`, with scratch `acc` (length n_states).
+/// [`free_energy`] given `ln ŝ`, with scratch `acc` (length n_states) and `scratch`.
 fn free_energy_with(
     gm: &GenerativeModel,
     ln_s_hat: &[f64],
@@ -91,6 +101,7 @@ fn free_energy_with(
     actions: &[usize],
     qs: &[Vec<f64>],
     acc: &mut [f64],
+    scratch: &mut Vec<f64>,
 ) -> f64 {
     let n = gm.n_states();
     let mut f = 0.0;
@@ -106,6 +117,8 @@ fn free_energy_with(
                 .zip(ln_s_hat)
                 .map(|(p, l)| if *p > 0.0 { p * l } else { 0.0 })
                 .sum::<f64>();
+        } else if let Some(lb) = &gm.log_factored {
+            f -= lb.quadratic(actions[tau - 1], q, &qs[tau - 1], scratch);
         } else {
             // acc[j] = (column j of ln B[a_{τ-1}]) · q_τ.
             dot_columns(gm.ln_b_t[actions[tau - 1]].as_slice(), n, q, acc);
@@ -148,7 +161,17 @@ pub fn vmp(
         iterations += 1;
         let mut change: f64 = 0.0;
         for tau in 0..w {
-            message_into(gm, &ws.ln_s_hat, obs, actions, qs, tau, &mut ws.v, &mut ws.acc);
+            message_into(
+                gm,
+                &ws.ln_s_hat,
+                obs,
+                actions,
+                qs,
+                tau,
+                &mut ws.v,
+                &mut ws.acc,
+                &mut ws.scratch,
+            );
             let q = &mut qs[tau];
             // ε = v - ln q ; ln q <- ln q + κ ε ; q = σ(ln q). Store the new logits in v.
             // Branch-free logarithms and exponentials that vectorise (`maths::ln_fast`, `exp_fast`).
@@ -163,7 +186,15 @@ pub fn vmp(
             }
         }
         if let Some(cb) = on_sweep.as_deref_mut() {
-            cb(free_energy_with(gm, &ws.ln_s_hat, obs, actions, qs, &mut ws.acc));
+            cb(free_energy_with(
+                gm,
+                &ws.ln_s_hat,
+                obs,
+                actions,
+                qs,
+                &mut ws.acc,
+                &mut ws.scratch,
+            ));
         }
         if change < tol {
             converged = true;
@@ -172,7 +203,7 @@ pub fn vmp(
     }
     VmpOutcome {
         iterations,
-        free_energy: free_energy_with(gm, &ws.ln_s_hat, obs, actions, qs, &mut ws.acc),
+        free_energy: free_energy_with(gm, &ws.ln_s_hat, obs, actions, qs, &mut ws.acc, &mut ws.scratch),
         converged,
     }
 }
