@@ -60,25 +60,22 @@ const LN2_LO: f64 = 1.9082149292705877e-10;
 /// the compiler keeps the loop in SSE2 registers).
 const EXP_MAGIC: f64 = 4_503_599_627_370_496.0 + 1023.0;
 
-/// Natural logarithm of a positive normal `x`, branch-free, so that loops over slices
-/// vectorise (docs/ARCHITECTURE.md §4.1; used through [`ln_into`] and [`risk_sum`]).
+/// Natural logarithm of a positive normal `x` by a series (no table): builds the table
+/// of [`ln_fast`] at compile time, and is its reference in the tests.
 ///
 /// `x = 2^k m` with `m` in `[√2/2, √2)`; with `f = m - 1` and `s = f / (2 + f)`,
 /// `ln m = 2 atanh s = 2s + 2s (s²/3 + s⁴/5 + … + s¹⁸/19)` (the Taylor series of
 /// `atanh`, `|s| <= 0.1716`, truncated where the next term is below 1e-17 of the result),
-/// written `f - s (f - 2 s² Q(s²))` since `2s = f - s f`. `k ln 2` is added in two
-/// parts. Plain IEEE operations (no FMA, no table, no run-time dispatch): every x86-64
-/// machine computes the same bits, scalar or vectorised. Max error against `std`'s `ln`
-/// ~1 ulp of `max(|ln x|, 1)` (test `fast_ln_and_exp_match_std`). Not for zero,
-/// subnormal, negative or non-finite `x`: callers floor first.
-#[inline(always)]
-pub fn ln_fast(x: f64) -> f64 {
+/// written `f - s (f - 2 s² Q(s²))` since `2s = f - s f`; `k ln 2` is added in two parts.
+/// Max error against `std`'s `ln` ~1 ulp of `max(|ln x|, 1)`.
+const fn ln_series(x: f64) -> f64 {
     let bits = x.to_bits();
     let mut k = f64::from_bits((bits >> 52) | 0x4330_0000_0000_0000) - EXP_MAGIC;
     let mut m = f64::from_bits((bits & 0x000F_FFFF_FFFF_FFFF) | 0x3FF0_0000_0000_0000);
-    let big = m > std::f64::consts::SQRT_2;
-    m = if big { m * 0.5 } else { m };
-    k = if big { k + 1.0 } else { k };
+    if m > std::f64::consts::SQRT_2 {
+        m *= 0.5;
+        k += 1.0;
+    }
     let f = m - 1.0;
     let s = f / (2.0 + f);
     let z = s * s;
@@ -89,6 +86,49 @@ pub fn ln_fast(x: f64) -> f64 {
                     + z * (1.0 / 11.0 + z * (1.0 / 13.0 + z * (1.0 / 15.0 + z * (1.0 / 17.0 + z * (1.0 / 19.0))))))));
     let ln_m = f - s * (f - 2.0 * z * q);
     k * LN2_HI + (k * LN2_LO + ln_m)
+}
+
+/// The table of [`ln_fast`] has an entry per `1/128` of the mantissa, ends included.
+const LN_TABLE_STEPS: usize = 128;
+
+/// Per point `c_i = 1 + i/128` (`i = 0..=128`): `[1/c_i rounded, -ln(that), 0]`,
+/// computed at compile time by [`ln_series`]. Entry 0 is `[1, 0, 0]`, so that `ln 1 = 0`
+/// exactly; the last (`c = 2`) is `[1/2, 0, 1]`: the mantissa is halved and the exponent
+/// raised by one, so that `ln x` just below 1 is `ln(1 + r)` with an exact `r`.
+const LN_TABLE: [[f64; 3]; LN_TABLE_STEPS + 1] = {
+    let mut t = [[0.0; 3]; LN_TABLE_STEPS + 1];
+    let mut i = 0;
+    while i < LN_TABLE_STEPS {
+        let inv = 1.0 / (1.0 + i as f64 / LN_TABLE_STEPS as f64);
+        t[i] = [inv, -ln_series(inv), 0.0];
+        i += 1;
+    }
+    t[LN_TABLE_STEPS] = [0.5, 0.0, 1.0];
+    t
+};
+
+/// Natural logarithm of a positive normal `x`, branch-free, so that loops over slices
+/// vectorise (docs/ARCHITECTURE.md §4.1; used through [`ln_into`] and [`risk_sum`]).
+///
+/// `x = 2^k m`, `m` in `[1, 2)`; the top 8 bits of `m`, rounded to 7, pick the nearest
+/// `c = 1 + i/128 ≈ 1/inv` from a 129-entry table, `r = m · inv - 1` (`|r| <= 2^-8`), and
+/// `ln x = k ln 2 - ln inv + ln(1 + r)` (for `c = 2`: `(k + 1) ln 2 + ln(1 + r)`, with
+/// `r = m/2 - 1`) with `ln(1 + r)` by its Taylor series to `r^6/6`
+/// (the next term is below 3e-18). Plain IEEE operations and a constant table (no FMA,
+/// no run-time dispatch): every x86-64 machine computes the same bits, scalar or
+/// vectorised. Max error against `std`'s `ln` ~2 ulp of `max(|ln x|, 1)` (test
+/// `fast_ln_and_exp_match_std`). Not for zero, subnormal, negative or non-finite `x`:
+/// callers floor first.
+#[inline(always)]
+pub fn ln_fast(x: f64) -> f64 {
+    let bits = x.to_bits();
+    let k = f64::from_bits((bits >> 52) | 0x4330_0000_0000_0000) - EXP_MAGIC;
+    let m = f64::from_bits((bits & 0x000F_FFFF_FFFF_FFFF) | 0x3FF0_0000_0000_0000);
+    let [inv, ln_c, k_add] = LN_TABLE[((((bits >> 44) & 0xFF) + 1) >> 1) as usize];
+    let k = k + k_add;
+    let r = m * inv - 1.0;
+    let p = r * r * (-0.5 + r * (1.0 / 3.0 + r * (-0.25 + r * (0.2 - r * (1.0 / 6.0)))));
+    k * LN2_HI + (ln_c + (k * LN2_LO + (r + p)))
 }
 
 /// `e^x`, branch-free (for vectorised loops, see [`ln_fast`]): `x = k ln 2 + r` with
@@ -366,6 +406,12 @@ mod tests {
         }
         eprintln!("ln: worst {worst} eps");
         assert!(worst <= 2.0, "ln: {worst} eps");
+        let worst = xs
+            .iter()
+            .map(|x| (ln_series(*x) - x.ln()).abs() / x.ln().abs().max(1.0) / f64::EPSILON)
+            .fold(0.0, f64::max);
+        eprintln!("ln_series: worst {worst} eps");
+        assert!(worst <= 1.5, "ln_series: {worst} eps");
         // The floor, zero and values just around 1.
         ln_into(&[0.0, 1e-300, 1.0, 1.0 - 1e-12, 1.0 + 1e-12], &mut got);
         assert_eq!(got[0], LN_FLOOR.ln());
