@@ -15,7 +15,7 @@
 //! geodesic toward that minimiser, along which `KL[q || q*]` (hence `F`) is
 //! non-increasing too — both are property-tested.
 
-use crate::maths::{axpy_columns, dot_columns, lane_sum, ln_into, softmax_fast_in_place};
+use crate::maths::{axpy_columns, dot_columns, lane_sum, ln_into, softmax_in_place};
 use crate::model::GenerativeModel;
 
 /// Result of a VMP run.
@@ -174,12 +174,14 @@ pub fn vmp(
             );
             let q = &mut qs[tau];
             // ε = v - ln q ; ln q <- ln q + κ ε ; q = σ(ln q). Store the new logits in v.
-            // Branch-free logarithms and exponentials that vectorise (`maths::ln_fast`, `exp_fast`).
+            // `ln q` by the table logarithm (`maths::ln_fast`); the softmax keeps `std`'s `exp`
+            // (a vectorised `exp` here changed which action wins in the planner's exact ties,
+            // see BENCHMARKS.md).
             ln_into(q, &mut ws.acc);
             for (vi, lq) in ws.v.iter_mut().zip(ws.acc.iter()) {
                 *vi = lq + kappa * (*vi - lq);
             }
-            softmax_fast_in_place(&mut ws.v);
+            softmax_in_place(&mut ws.v);
             for (qi, vi) in q.iter_mut().zip(&ws.v) {
                 change = change.max((*qi - *vi).abs());
                 *qi = *vi;
