@@ -17,6 +17,7 @@
 
 use crate::maths::{axpy_columns, dot_columns, lane_sum, ln_into, softmax_in_place};
 use crate::model::GenerativeModel;
+use crate::transition::LogBScratch;
 
 /// Result of a VMP run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,7 +39,7 @@ pub struct VmpWorkspace {
     /// `ln ŝ`, shared by slot 0's message and `F`.
     ln_s_hat: Vec<f64>,
     /// Marginals and partial messages of the factored `ln B`.
-    scratch: Vec<f64>,
+    scratch: LogBScratch,
 }
 
 /// The message `v_τ` of slot `tau` (eq. "message passing") into `v`; `acc` and `scratch`
@@ -53,7 +54,7 @@ fn message_into(
     tau: usize,
     v: &mut [f64],
     acc: &mut [f64],
-    scratch: &mut Vec<f64>,
+    scratch: &mut LogBScratch,
 ) {
     let n = gm.n_states();
     let last = obs.len() - 1;
@@ -90,7 +91,7 @@ pub fn free_energy(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: 
     let mut ln_s_hat = vec![0.0; s_hat.len()];
     ln_into(s_hat, &mut ln_s_hat);
     let mut acc = vec![0.0; gm.n_states()];
-    free_energy_with(gm, &ln_s_hat, obs, actions, qs, &mut acc, &mut Vec::new())
+    free_energy_with(gm, &ln_s_hat, obs, actions, qs, &mut acc, &mut LogBScratch::default())
 }
 
 /// [`free_energy`] given `ln ŝ`, with scratch `acc` (length n_states) and `scratch`.
@@ -101,7 +102,7 @@ fn free_energy_with(
     actions: &[usize],
     qs: &[Vec<f64>],
     acc: &mut [f64],
-    scratch: &mut Vec<f64>,
+    scratch: &mut LogBScratch,
 ) -> f64 {
     let n = gm.n_states();
     let mut f = 0.0;

@@ -213,17 +213,36 @@ pub struct FactoredLogB {
     n: usize,
     n_actions: usize,
     terms: Vec<LogTerm>,
-    /// Sum over factors of `n_x + n_y` (scratch for the marginals and partial messages).
-    scratch_len: usize,
+}
+
+/// Most values of `x_f` or `y_f` a [`FactoredLogB`] term may have: indices are `u8`, so
+/// that reading the scratch arrays (of this length) needs no bounds checks.
+const LOG_TERM_MAX: usize = 256;
+
+/// Scratch of [`FactoredLogB`]'s messages: a factor's marginal of `q` and its partial
+/// message. Keep one per agent (in the VMP workspace).
+#[derive(Debug, Clone)]
+pub struct LogBScratch {
+    a: [f64; LOG_TERM_MAX],
+    b: [f64; LOG_TERM_MAX],
+}
+
+impl Default for LogBScratch {
+    fn default() -> Self {
+        LogBScratch {
+            a: [0.0; LOG_TERM_MAX],
+            b: [0.0; LOG_TERM_MAX],
+        }
+    }
 }
 
 /// One factor's term of [`FactoredLogB`].
 #[derive(Debug, Clone, PartialEq)]
 struct LogTerm {
     /// `x_f(s)` for every joint state `s` (previous-time parents, mixed radix).
-    x_of: Vec<u32>,
+    x_of: Vec<u8>,
     /// `y_f(s')` for every joint state `s'` (own value, then next-time parents).
-    y_of: Vec<u32>,
+    y_of: Vec<u8>,
     nx: usize,
     ny: usize,
     /// Per action, `ln p` laid out `[x * ny + y]`.
@@ -232,7 +251,7 @@ struct LogTerm {
 
 impl FactoredLogB {
     /// Build from the structure and the CPT means (as [`FactoredTransition::new`]). `None`
-    /// for a single factor or a structure whose index does not fit in 32 bits.
+    /// for a single factor, or when a factor's parents take more than 256 joint values.
     pub fn new(structure: &Structure, means: &[Vec<f64>], n_actions: usize) -> Option<Self> {
         let factors = structure.factors();
         let nf = factors.len();
@@ -259,14 +278,17 @@ impl FactoredLogB {
             let radix = |vars: &[usize], vals: &[usize]| vars.iter().fold(0, |acc, &j| acc * factors[j].size + vals[j]);
             let nx: usize = prev_parents.iter().map(|&j| factors[j].size).product();
             let ny: usize = next_vars.iter().map(|&j| factors[j].size).product();
+            if nx > LOG_TERM_MAX || ny > LOG_TERM_MAX {
+                return None;
+            }
             let (mut x_of, mut y_of) = (Vec::with_capacity(n), Vec::with_capacity(n));
             // A representative joint state for every x and every y.
             let (mut rep_x, mut rep_y) = (vec![usize::MAX; nx], vec![usize::MAX; ny]);
             for s in 0..n {
                 structure.decode_into(s, &mut vals);
                 let (x, y) = (radix(&prev_parents, &vals), radix(&next_vars, &vals));
-                x_of.push(x as u32);
-                y_of.push(y as u32);
+                x_of.push(x as u8);
+                y_of.push(y as u8);
                 if rep_x[x] == usize::MAX {
                     rep_x[x] = s;
                 }
@@ -297,13 +319,7 @@ impl FactoredLogB {
                 table,
             });
         }
-        let scratch_len = terms.iter().map(|t| t.nx + t.ny).sum();
-        Some(FactoredLogB {
-            n,
-            n_actions,
-            terms,
-            scratch_len,
-        })
+        Some(FactoredLogB { n, n_actions, terms })
     }
 
     /// Number of actions.
@@ -311,21 +327,20 @@ impl FactoredLogB {
         self.n_actions
     }
 
-    /// `out[s'] = Σ_s ln B[u][s', s] q[s]` (the forward message). `scratch` is resized.
-    pub fn forward(&self, u: usize, q: &[f64], out: &mut [f64], scratch: &mut Vec<f64>) {
+    /// `out[s'] = Σ_s ln B[u][s', s] q[s]` (the forward message).
+    pub fn forward(&self, u: usize, q: &[f64], out: &mut [f64], sc: &mut LogBScratch) {
         let out = &mut out[..self.n];
         out.fill(0.0);
-        scratch.resize(self.scratch_len, 0.0);
+        let (mx, w) = (&mut sc.a, &mut sc.b);
         for t in &self.terms {
-            let (mx, w) = scratch[..t.nx + t.ny].split_at_mut(t.nx);
-            mx.fill(0.0);
+            mx[..t.nx].fill(0.0);
             for (x, qs) in t.x_of.iter().zip(&q[..self.n]) {
                 mx[*x as usize] += qs;
             }
             // w[y] = Σ_x mx[x] T[x, y].
-            w.fill(0.0);
-            for (row, m) in t.table[u].chunks_exact(t.ny).zip(mx.iter()) {
-                for (wy, ty) in w.iter_mut().zip(row) {
+            w[..t.ny].fill(0.0);
+            for (row, m) in t.table[u].chunks_exact(t.ny).zip(&mx[..t.nx]) {
+                for (wy, ty) in w[..t.ny].iter_mut().zip(row) {
                     *wy += m * ty;
                 }
             }
@@ -336,19 +351,18 @@ impl FactoredLogB {
     }
 
     /// `out[s] = Σ_{s'} q[s'] ln B[u][s', s]` (the backward message, `(ln B[u])ᵀ q`).
-    pub fn backward(&self, u: usize, q: &[f64], out: &mut [f64], scratch: &mut Vec<f64>) {
+    pub fn backward(&self, u: usize, q: &[f64], out: &mut [f64], sc: &mut LogBScratch) {
         let out = &mut out[..self.n];
         out.fill(0.0);
-        scratch.resize(self.scratch_len, 0.0);
+        let (r, my) = (&mut sc.a, &mut sc.b);
         for t in &self.terms {
-            let (r, my) = scratch[..t.nx + t.ny].split_at_mut(t.nx);
-            my.fill(0.0);
+            my[..t.ny].fill(0.0);
             for (y, qs) in t.y_of.iter().zip(&q[..self.n]) {
                 my[*y as usize] += qs;
             }
             // r[x] = Σ_y T[x, y] my[y].
-            for (rx, row) in r.iter_mut().zip(t.table[u].chunks_exact(t.ny)) {
-                *rx = row.iter().zip(my.iter()).map(|(a, b)| a * b).sum();
+            for (rx, row) in r[..t.nx].iter_mut().zip(t.table[u].chunks_exact(t.ny)) {
+                *rx = row.iter().zip(&my[..t.ny]).map(|(a, b)| a * b).sum();
             }
             for (o, x) in out.iter_mut().zip(&t.x_of) {
                 *o += r[*x as usize];
@@ -357,13 +371,12 @@ impl FactoredLogB {
     }
 
     /// `q_nextᵀ (ln B[u]) q_prev` (the transition term of `F`, Definition "VFE").
-    pub fn quadratic(&self, u: usize, q_next: &[f64], q_prev: &[f64], scratch: &mut Vec<f64>) -> f64 {
-        scratch.resize(self.scratch_len, 0.0);
+    pub fn quadratic(&self, u: usize, q_next: &[f64], q_prev: &[f64], sc: &mut LogBScratch) -> f64 {
         let mut total = 0.0;
+        let (mx, my) = (&mut sc.a, &mut sc.b);
         for t in &self.terms {
-            let (mx, my) = scratch[..t.nx + t.ny].split_at_mut(t.nx);
-            mx.fill(0.0);
-            my.fill(0.0);
+            mx[..t.nx].fill(0.0);
+            my[..t.ny].fill(0.0);
             for ((x, y), (a, b)) in t
                 .x_of
                 .iter()
@@ -373,8 +386,8 @@ impl FactoredLogB {
                 mx[*x as usize] += a;
                 my[*y as usize] += b;
             }
-            for (row, m) in t.table[u].chunks_exact(t.ny).zip(mx.iter()) {
-                total += m * row.iter().zip(my.iter()).map(|(a, b)| a * b).sum::<f64>();
+            for (row, m) in t.table[u].chunks_exact(t.ny).zip(&mx[..t.nx]) {
+                total += m * row.iter().zip(&my[..t.ny]).map(|(a, b)| a * b).sum::<f64>();
             }
         }
         total
@@ -665,7 +678,7 @@ mod tests {
             };
             let (qa, qb) = (draw(), draw());
             let ln_b = &gm.ln_b[u];
-            let (mut out, mut scratch) = (vec![0.0; n], Vec::new());
+            let (mut out, mut scratch) = (vec![0.0; n], LogBScratch::default());
             lb.forward(u, &qa, &mut out, &mut scratch);
             for (i, o) in out.iter().enumerate() {
                 let want: f64 = (0..n).map(|j| ln_b[(i, j)] * qa[j]).sum();
