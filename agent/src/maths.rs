@@ -148,10 +148,21 @@ pub fn risk_sum(p: &[f64], c: &[f64]) -> f64 {
     let mut acc = [0.0f64; 4];
     // The logarithms of a chunk first (a loop that vectorises), then its terms, added
     // to four lanes by index modulo 4 as `lane_sum` does.
-    for (k, (pc, cc)) in p.chunks(CHUNK).zip(c.chunks(CHUNK)).enumerate() {
+    for (pc, cc) in p.chunks(CHUNK).zip(c.chunks(CHUNK)) {
         ln_into(pc, &mut buf);
-        for (i, ((pi, li), ci)) in pc.iter().zip(&buf).zip(cc).enumerate() {
-            acc[(k * CHUNK + i) % 4] += pi * (li - ci);
+        // CHUNK is a multiple of 4, so entry i of the chunk goes to lane i % 4.
+        let full = pc.len() - pc.len() % 4;
+        for ((p4, l4), c4) in pc[..full]
+            .chunks_exact(4)
+            .zip(buf[..full].chunks_exact(4))
+            .zip(cc[..full].chunks_exact(4))
+        {
+            for l in 0..4 {
+                acc[l] += p4[l] * (l4[l] - c4[l]);
+            }
+        }
+        for (l, ((pi, li), ci)) in pc[full..].iter().zip(&buf[full..]).zip(&cc[full..]).enumerate() {
+            acc[l] += pi * (li - ci);
         }
     }
     (acc[0] + acc[1]) + (acc[2] + acc[3])
