@@ -51,6 +51,123 @@ pub fn lane_sum(n: usize, f: impl Fn(usize) -> f64) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3])
 }
 
+/// `ln 2` split so that `k · LN2_HI` is exact for `|k| < 2^11`: `LN2_HI` holds the
+/// leading 32 bits of `ln 2`, `LN2_LO = ln 2 - LN2_HI` the rest.
+const LN2_HI: f64 = f64::from_bits(0x3FE6_2E42_FEE0_0000);
+const LN2_LO: f64 = 1.9082149292705877e-10;
+/// `2^52 + 1023`: subtracting it from the float whose bits are `0x433 << 52 | e` gives
+/// the unbiased exponent `e - 1023` exactly (no integer-to-float conversion needed, so
+/// the compiler keeps the loop in SSE2 registers).
+const EXP_MAGIC: f64 = 4_503_599_627_370_496.0 + 1023.0;
+
+/// Natural logarithm of a positive normal `x` by a series (no table): builds the table
+/// of [`ln_fast`] at compile time, and is its reference in the tests.
+///
+/// `x = 2^k m` with `m` in `[√2/2, √2)`; with `f = m - 1` and `s = f / (2 + f)`,
+/// `ln m = 2 atanh s = 2s + 2s (s²/3 + s⁴/5 + … + s¹⁸/19)` (the Taylor series of
+/// `atanh`, `|s| <= 0.1716`, truncated where the next term is below 1e-17 of the result),
+/// written `f - s (f - 2 s² Q(s²))` since `2s = f - s f`; `k ln 2` is added in two parts.
+/// Max error against `std`'s `ln` ~1 ulp of `max(|ln x|, 1)`.
+const fn ln_series(x: f64) -> f64 {
+    let bits = x.to_bits();
+    let mut k = f64::from_bits((bits >> 52) | 0x4330_0000_0000_0000) - EXP_MAGIC;
+    let mut m = f64::from_bits((bits & 0x000F_FFFF_FFFF_FFFF) | 0x3FF0_0000_0000_0000);
+    if m > std::f64::consts::SQRT_2 {
+        m *= 0.5;
+        k += 1.0;
+    }
+    let f = m - 1.0;
+    let s = f / (2.0 + f);
+    let z = s * s;
+    let q = 1.0 / 3.0
+        + z * (1.0 / 5.0
+            + z * (1.0 / 7.0
+                + z * (1.0 / 9.0
+                    + z * (1.0 / 11.0 + z * (1.0 / 13.0 + z * (1.0 / 15.0 + z * (1.0 / 17.0 + z * (1.0 / 19.0))))))));
+    let ln_m = f - s * (f - 2.0 * z * q);
+    k * LN2_HI + (k * LN2_LO + ln_m)
+}
+
+/// The table of [`ln_fast`] has an entry per `1/128` of the mantissa, ends included.
+const LN_TABLE_STEPS: usize = 128;
+
+/// Per point `c_i = 1 + i/128` (`i = 0..=128`): `[1/c_i rounded, -ln(that), 0]`,
+/// computed at compile time by [`ln_series`]. Entry 0 is `[1, 0, 0]`, so that `ln 1 = 0`
+/// exactly; the last (`c = 2`) is `[1/2, 0, 1]`: the mantissa is halved and the exponent
+/// raised by one, so that `ln x` just below 1 is `ln(1 + r)` with an exact `r`.
+const LN_TABLE: [[f64; 3]; LN_TABLE_STEPS + 1] = {
+    let mut t = [[0.0; 3]; LN_TABLE_STEPS + 1];
+    let mut i = 0;
+    while i < LN_TABLE_STEPS {
+        let inv = 1.0 / (1.0 + i as f64 / LN_TABLE_STEPS as f64);
+        t[i] = [inv, -ln_series(inv), 0.0];
+        i += 1;
+    }
+    t[LN_TABLE_STEPS] = [0.5, 0.0, 1.0];
+    t
+};
+
+/// Natural logarithm of a positive normal `x`, branch-free, so that loops over slices
+/// vectorise (docs/ARCHITECTURE.md §4.1; used through [`ln_into`] and [`risk_sum`]).
+///
+/// `x = 2^k m`, `m` in `[1, 2)`; the top 8 bits of `m`, rounded to 7, pick the nearest
+/// `c = 1 + i/128 ≈ 1/inv` from a 129-entry table, `r = m · inv - 1` (`|r| <= 2^-8`), and
+/// `ln x = k ln 2 - ln inv + ln(1 + r)` (for `c = 2`: `(k + 1) ln 2 + ln(1 + r)`, with
+/// `r = m/2 - 1`) with `ln(1 + r)` by its Taylor series to `r^6/6`
+/// (the next term is below 3e-18). Plain IEEE operations and a constant table (no FMA,
+/// no run-time dispatch): every x86-64 machine computes the same bits, scalar or
+/// vectorised. Max error against `std`'s `ln` ~2 ulp of `max(|ln x|, 1)` (test
+/// `fast_ln_and_exp_match_std`). Not for zero, subnormal, negative or non-finite `x`:
+/// callers floor first.
+#[inline(always)]
+pub fn ln_fast(x: f64) -> f64 {
+    let bits = x.to_bits();
+    let k = f64::from_bits((bits >> 52) | 0x4330_0000_0000_0000) - EXP_MAGIC;
+    let m = f64::from_bits((bits & 0x000F_FFFF_FFFF_FFFF) | 0x3FF0_0000_0000_0000);
+    let [inv, ln_c, k_add] = LN_TABLE[((((bits >> 44) & 0xFF) + 1) >> 1) as usize];
+    let k = k + k_add;
+    let r = m * inv - 1.0;
+    let p = r * r * (-0.5 + r * (1.0 / 3.0 + r * (-0.25 + r * (0.2 - r * (1.0 / 6.0)))));
+    k * LN2_HI + (ln_c + (k * LN2_LO + (r + p)))
+}
+
+/// `out[i] = ln(max(x[i], 1e-16))` with [`ln_fast`] (docs/ARCHITECTURE.md §4.1); the
+/// loop vectorises.
+pub fn ln_into(x: &[f64], out: &mut [f64]) {
+    for (o, v) in out[..x.len()].iter_mut().zip(x) {
+        *o = ln_fast(v.max(LN_FLOOR));
+    }
+}
+
+/// `Σ_i p_i (ln p_i - c_i)` with the floored [`ln_fast`], summed by [`lane_sum`]; zero
+/// entries add exactly 0. The risk of one step of the EFE (Prop. 1, `KL[A s || c]`).
+pub fn risk_sum(p: &[f64], c: &[f64]) -> f64 {
+    const CHUNK: usize = 64;
+    let c = &c[..p.len()];
+    let mut buf = [0.0f64; CHUNK];
+    let mut acc = [0.0f64; 4];
+    // The logarithms of a chunk first (a loop that vectorises), then its terms, added
+    // to four lanes by index modulo 4 as `lane_sum` does.
+    for (pc, cc) in p.chunks(CHUNK).zip(c.chunks(CHUNK)) {
+        ln_into(pc, &mut buf);
+        // CHUNK is a multiple of 4, so entry i of the chunk goes to lane i % 4.
+        let full = pc.len() - pc.len() % 4;
+        for ((p4, l4), c4) in pc[..full]
+            .chunks_exact(4)
+            .zip(buf[..full].chunks_exact(4))
+            .zip(cc[..full].chunks_exact(4))
+        {
+            for l in 0..4 {
+                acc[l] += p4[l] * (l4[l] - c4[l]);
+            }
+        }
+        for (l, ((pi, li), ci)) in pc[full..].iter().zip(&buf[full..]).zip(&cc[full..]).enumerate() {
+            acc[l] += pi * (li - ci);
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3])
+}
+
 /// Rows of `out` computed together by [`axpy_columns`] and [`dot_columns`], held in
 /// registers while the columns stream past.
 const BLOCK: usize = 8;
@@ -225,6 +342,54 @@ mod tests {
                 let want: f64 = (0..n).map(|i| m[i * n + s] * x[i]).sum();
                 assert_eq!(g.to_bits(), want.to_bits());
             }
+        }
+    }
+
+    /// Maximum error of the table `ln` (and of the series that builds its table) against
+    /// `std` over the range the agent uses, `[1e-16, 1]` (probabilities, floored), and
+    /// beyond up to 1e6. Errors are measured in units of `f64::EPSILON` relative to
+    /// `max(|std|, 1)` (absolute near `ln 1 = 0`).
+    #[test]
+    fn fast_ln_matches_std() {
+        let n = 200_000;
+        let xs: Vec<f64> = (0..=n)
+            .map(|i| 10f64.powf(-16.0 + 22.0 * i as f64 / n as f64))
+            .collect();
+        let mut got = vec![0.0; xs.len()];
+        ln_into(&xs, &mut got);
+        let mut worst: f64 = 0.0;
+        for (x, g) in xs.iter().zip(&got) {
+            let want = x.ln();
+            worst = worst.max((g - want).abs() / want.abs().max(1.0) / f64::EPSILON);
+        }
+        eprintln!("ln: worst {worst} eps");
+        assert!(worst <= 2.0, "ln: {worst} eps");
+        let worst = xs
+            .iter()
+            .map(|x| (ln_series(*x) - x.ln()).abs() / x.ln().abs().max(1.0) / f64::EPSILON)
+            .fold(0.0, f64::max);
+        eprintln!("ln_series: worst {worst} eps");
+        assert!(worst <= 1.5, "ln_series: {worst} eps");
+        // The floor, zero and values just around 1.
+        ln_into(&[0.0, 1e-300, 1.0, 1.0 - 1e-12, 1.0 + 1e-12], &mut got);
+        assert_eq!(got[0], LN_FLOOR.ln());
+        assert_eq!(got[1], LN_FLOOR.ln());
+        assert_eq!(got[2], 0.0);
+        assert!((got[3] - (1.0f64 - 1e-12).ln()).abs() < 1e-27);
+        assert!((got[4] - (1.0f64 + 1e-12).ln()).abs() < 1e-27);
+    }
+
+    /// The risk with the table `ln` agrees with the `std` form to rounding, for lengths
+    /// that are and are not multiples of the lanes and of the chunk.
+    #[test]
+    fn risk_sum_matches_the_std_form() {
+        for n in [1usize, 3, 4, 7, 64, 130] {
+            let x: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 40.0 * (i % 3) as f64).collect();
+            let mut a = x.clone();
+            softmax_in_place(&mut a);
+            let c: Vec<f64> = (0..n).map(|i| -(i as f64) * 0.3).collect();
+            let want: f64 = a.iter().zip(&c).map(|(p, ci)| p * (ln(*p) - ci)).sum();
+            assert!((risk_sum(&a, &c) - want).abs() < 1e-14, "{n}");
         }
     }
 

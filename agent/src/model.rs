@@ -5,10 +5,10 @@
 use crate::check;
 use crate::error::{AgentError, FieldError, ParamError};
 use crate::limits::{MAX_ACTIONS, MAX_STATES, MAX_VALUE};
-use crate::maths::{ln, log_softmax};
+use crate::maths::{LN_FLOOR, ln, log_softmax};
 use crate::params::ModelPriors;
 use crate::structure::{Parent, Structure};
-use crate::transition::FactoredTransition;
+use crate::transition::{FactoredLogB, FactoredTransition};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -40,6 +40,10 @@ pub struct GenerativeModel {
     /// The same `B[u]` as per-factor steps (§II-A), when the model came from a factored
     /// world model whose structure allows it; planning uses it for dense beliefs.
     pub factored: Option<FactoredTransition>,
+    /// `ln B[u]` as per-factor terms (perception's messages and `F`), when the model came
+    /// from a factored world model and every entry of `B` is at least the log floor, so
+    /// that the factored sum is `ln B` up to rounding (see [`FactoredLogB`]).
+    pub log_factored: Option<FactoredLogB>,
 }
 
 impl GenerativeModel {
@@ -64,6 +68,7 @@ impl GenerativeModel {
             c,
             d,
             factored: None,
+            log_factored: None,
         }
     }
 
@@ -480,8 +485,16 @@ impl WorldModel {
         }
         self.gm_plan = GenerativeModel::new(a.clone(), b_plan, c.clone(), d.clone());
         self.gm_plan.factored = factored.as_ref().map(|ft| ft.with_terminal(&self.terminal));
+        // Perception's messages through ln B factor by factor, when no entry of B is under
+        // the log floor (then the per-factor sum is the floored ln B up to rounding).
+        let log_factored = if b.iter().all(|m| m.iter().all(|p| *p >= LN_FLOOR)) {
+            FactoredLogB::new(&self.structure, &means, self.n_actions)
+        } else {
+            None
+        };
         self.gm = GenerativeModel::new(a, b, c, d);
         self.gm.factored = factored;
+        self.gm.log_factored = log_factored;
     }
 
     /// Posterior means of each CPT, laid out like the counts (rows pooled where

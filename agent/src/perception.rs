@@ -15,8 +15,9 @@
 //! geodesic toward that minimiser, along which `KL[q || q*]` (hence `F`) is
 //! non-increasing too — both are property-tested.
 
-use crate::maths::{axpy_columns, dot_columns, ln, softmax_in_place};
+use crate::maths::{axpy_columns, dot_columns, lane_sum, ln_into, softmax_in_place};
 use crate::model::GenerativeModel;
+use crate::transition::LogBScratch;
 
 /// Result of a VMP run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,9 +38,12 @@ pub struct VmpWorkspace {
     acc: Vec<f64>,
     /// `ln ŝ`, shared by slot 0's message and `F`.
     ln_s_hat: Vec<f64>,
+    /// Marginals and partial messages of the factored `ln B`.
+    scratch: LogBScratch,
 }
 
-/// The message `v_τ` of slot `tau` (eq. "message passing") into `v`; `acc` is scratch.
+/// The message `v_τ` of slot `tau` (eq. "message passing") into `v`; `acc` and `scratch`
+/// are scratch. Through the factored `ln B` when the model has it (`FactoredLogB`).
 #[allow(clippy::too_many_arguments)]
 fn message_into(
     gm: &GenerativeModel,
@@ -50,6 +54,7 @@ fn message_into(
     tau: usize,
     v: &mut [f64],
     acc: &mut [f64],
+    scratch: &mut LogBScratch,
 ) {
     let n = gm.n_states();
     let last = obs.len() - 1;
@@ -57,11 +62,17 @@ fn message_into(
     if tau == 0 {
         v.copy_from_slice(ln_s_hat);
     } else {
-        axpy_columns(gm.ln_b[actions[tau - 1]].as_slice(), n, &qs[tau - 1], v);
+        match &gm.log_factored {
+            Some(lb) => lb.forward(actions[tau - 1], &qs[tau - 1], v, scratch),
+            None => axpy_columns(gm.ln_b[actions[tau - 1]].as_slice(), n, &qs[tau - 1], v),
+        }
     }
     // Message 2: backward, (ln B[a_τ])^T q_{τ+1}.
     if tau < last {
-        dot_columns(gm.ln_b_t[actions[tau]].as_slice(), n, &qs[tau + 1], acc);
+        match &gm.log_factored {
+            Some(lb) => lb.backward(actions[tau], &qs[tau + 1], acc, scratch),
+            None => dot_columns(gm.ln_b_t[actions[tau]].as_slice(), n, &qs[tau + 1], acc),
+        }
         for (vi, a) in v.iter_mut().zip(acc.iter()) {
             *vi += a;
         }
@@ -77,12 +88,13 @@ fn message_into(
 /// `F = Σ_τ q_τ·(ln q_τ - (ln A)^T o_τ) - q_0·ln ŝ - Σ_{τ>0} q_τ^T (ln B[a_{τ-1}]) q_{τ-1}`.
 /// `F >= -ln p(o_window)` (Lemma 1), with equality at the exact posterior for W = 1.
 pub fn free_energy(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], actions: &[usize], qs: &[Vec<f64>]) -> f64 {
-    let ln_s_hat: Vec<f64> = s_hat.iter().map(|p| ln(*p)).collect();
+    let mut ln_s_hat = vec![0.0; s_hat.len()];
+    ln_into(s_hat, &mut ln_s_hat);
     let mut acc = vec![0.0; gm.n_states()];
-    free_energy_with(gm, &ln_s_hat, obs, actions, qs, &mut acc)
+    free_energy_with(gm, &ln_s_hat, obs, actions, qs, &mut acc, &mut LogBScratch::default())
 }
 
-/// [`free_energy`] given `ln ŝ`, with scratch `acc` (length n_states).
+/// [`free_energy`] given `ln ŝ`, with scratch `acc` (length n_states) and `scratch`.
 fn free_energy_with(
     gm: &GenerativeModel,
     ln_s_hat: &[f64],
@@ -90,22 +102,24 @@ fn free_energy_with(
     actions: &[usize],
     qs: &[Vec<f64>],
     acc: &mut [f64],
+    scratch: &mut LogBScratch,
 ) -> f64 {
     let n = gm.n_states();
     let mut f = 0.0;
     for (tau, q) in qs.iter().enumerate().take(obs.len()) {
         let o = obs[tau];
-        for (s, p) in q.iter().enumerate() {
-            if *p > 0.0 {
-                f += p * (ln(*p) - gm.ln_a[(o, s)]);
-            }
-        }
+        // Σ_s q (ln q - ln A[o, s]); zero entries add exactly 0 (the floored logs are finite).
+        ln_into(q, acc);
+        let ln_a = gm.ln_a.row(o);
+        f += lane_sum(n, |s| q[s] * (acc[s] - ln_a[s]));
         if tau == 0 {
             f -= q
                 .iter()
                 .zip(ln_s_hat)
                 .map(|(p, l)| if *p > 0.0 { p * l } else { 0.0 })
                 .sum::<f64>();
+        } else if let Some(lb) = &gm.log_factored {
+            f -= lb.quadratic(actions[tau - 1], q, &qs[tau - 1], scratch);
         } else {
             // acc[j] = (column j of ln B[a_{τ-1}]) · q_τ.
             dot_columns(gm.ln_b_t[actions[tau - 1]].as_slice(), n, q, acc);
@@ -139,8 +153,8 @@ pub fn vmp(
     let n = gm.n_states();
     ws.v.resize(n, 0.0);
     ws.acc.resize(n, 0.0);
-    ws.ln_s_hat.clear();
-    ws.ln_s_hat.extend(s_hat.iter().map(|p| ln(*p)));
+    ws.ln_s_hat.resize(n, 0.0);
+    ln_into(s_hat, &mut ws.ln_s_hat);
     let w = obs.len();
     let mut iterations = 0;
     let mut converged = false;
@@ -148,11 +162,24 @@ pub fn vmp(
         iterations += 1;
         let mut change: f64 = 0.0;
         for tau in 0..w {
-            message_into(gm, &ws.ln_s_hat, obs, actions, qs, tau, &mut ws.v, &mut ws.acc);
+            message_into(
+                gm,
+                &ws.ln_s_hat,
+                obs,
+                actions,
+                qs,
+                tau,
+                &mut ws.v,
+                &mut ws.acc,
+                &mut ws.scratch,
+            );
             let q = &mut qs[tau];
             // ε = v - ln q ; ln q <- ln q + κ ε ; q = σ(ln q). Store the new logits in v.
-            for (vi, qi) in ws.v.iter_mut().zip(q.iter()) {
-                let lq = ln(*qi);
+            // `ln q` by the table logarithm (`maths::ln_fast`); the softmax keeps `std`'s `exp`
+            // (a vectorised `exp` here changed which action wins in the planner's exact ties,
+            // see BENCHMARKS.md).
+            ln_into(q, &mut ws.acc);
+            for (vi, lq) in ws.v.iter_mut().zip(ws.acc.iter()) {
                 *vi = lq + kappa * (*vi - lq);
             }
             softmax_in_place(&mut ws.v);
@@ -162,7 +189,15 @@ pub fn vmp(
             }
         }
         if let Some(cb) = on_sweep.as_deref_mut() {
-            cb(free_energy_with(gm, &ws.ln_s_hat, obs, actions, qs, &mut ws.acc));
+            cb(free_energy_with(
+                gm,
+                &ws.ln_s_hat,
+                obs,
+                actions,
+                qs,
+                &mut ws.acc,
+                &mut ws.scratch,
+            ));
         }
         if change < tol {
             converged = true;
@@ -171,7 +206,7 @@ pub fn vmp(
     }
     VmpOutcome {
         iterations,
-        free_energy: free_energy_with(gm, &ws.ln_s_hat, obs, actions, qs, &mut ws.acc),
+        free_energy: free_energy_with(gm, &ws.ln_s_hat, obs, actions, qs, &mut ws.acc, &mut ws.scratch),
         converged,
     }
 }

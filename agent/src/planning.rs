@@ -17,7 +17,7 @@
 //! prefixes: `U + U^2 + ... + U^H` mat-vecs instead of `H U^H`. Policies are ordered
 //! lexicographically (first action most significant): `[0,0], [0,1], ...`.
 
-use crate::maths::{lane_sum, ln, softmax_in_place};
+use crate::maths::{ln, risk_sum, softmax_in_place};
 use crate::model::GenerativeModel;
 use crate::surprise::matvec_sparse_x;
 
@@ -31,8 +31,8 @@ pub fn step_efe(gm: &GenerativeModel, s: &[f64], obuf: &mut [f64]) -> (f64, f64)
         obuf
     };
     // Zero entries add exactly 0 (the floored log and C are finite): no branch needed.
-    let c = &gm.c[..o.len()];
-    let risk = lane_sum(o.len(), |i| o[i] * (ln(o[i]) - c[i]));
+    // Branch-free logarithms that vectorise (`maths::risk_sum`, `maths::ln_fast`).
+    let risk = risk_sum(o, &gm.c);
     let ambiguity = if gm.a_identity {
         0.0
     } else {

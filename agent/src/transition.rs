@@ -196,6 +196,204 @@ impl FactoredTransition {
     }
 }
 
+/// `ln B[u]` as a sum of per-factor terms, for perception's messages and `F`
+/// (§III eq. "message passing"; docs/ARCHITECTURE.md §4.5):
+///
+/// `ln B[u][s', s] = Σ_f ln p(s'_f | parents_f, u) = Σ_f T_f[u][x_f(s), y_f(s')]`,
+///
+/// where `x_f(s)` indexes the previous-time parents of factor `f` and `y_f(s')` its own
+/// next value with its next-time parents. So a message through `ln B` never needs the
+/// dense `N x N` matrix: with `q` summed into its marginal over `x_f` (or `y_f`), a
+/// factor's part is a small table product, broadcast back over the joint index. The
+/// model uses it only when every entry of the dense `B` is at least the log floor
+/// `1e-16` (docs/ARCHITECTURE.md §4.1), so that `ln(max(B, 1e-16)) = ln B` and the
+/// factored sum is the dense floored logarithm up to rounding.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FactoredLogB {
+    n: usize,
+    n_actions: usize,
+    terms: Vec<LogTerm>,
+}
+
+/// Most values of `x_f` or `y_f` a [`FactoredLogB`] term may have: indices are `u8`, so
+/// that reading the scratch arrays (of this length) needs no bounds checks.
+const LOG_TERM_MAX: usize = 256;
+
+/// Scratch of [`FactoredLogB`]'s messages: a factor's marginal of `q` and its partial
+/// message. Keep one per agent (in the VMP workspace).
+#[derive(Debug, Clone)]
+pub struct LogBScratch {
+    a: [f64; LOG_TERM_MAX],
+    b: [f64; LOG_TERM_MAX],
+}
+
+impl Default for LogBScratch {
+    fn default() -> Self {
+        LogBScratch {
+            a: [0.0; LOG_TERM_MAX],
+            b: [0.0; LOG_TERM_MAX],
+        }
+    }
+}
+
+/// One factor's term of [`FactoredLogB`].
+#[derive(Debug, Clone, PartialEq)]
+struct LogTerm {
+    /// `x_f(s)` for every joint state `s` (previous-time parents, mixed radix).
+    x_of: Vec<u8>,
+    /// `y_f(s')` for every joint state `s'` (own value, then next-time parents).
+    y_of: Vec<u8>,
+    nx: usize,
+    ny: usize,
+    /// Per action, `ln p` laid out `[x * ny + y]`.
+    table: Vec<Vec<f64>>,
+}
+
+impl FactoredLogB {
+    /// Build from the structure and the CPT means (as [`FactoredTransition::new`]). `None`
+    /// for a single factor, or when a factor's parents take more than 256 joint values.
+    pub fn new(structure: &Structure, means: &[Vec<f64>], n_actions: usize) -> Option<Self> {
+        let factors = structure.factors();
+        let nf = factors.len();
+        let n = structure.joint_size();
+        if nf < 2 || n > u32::MAX as usize {
+            return None;
+        }
+        let mut vals = vec![0usize; nf];
+        let mut terms = Vec::with_capacity(nf);
+        for (f, fac) in factors.iter().enumerate() {
+            let prev_parents: Vec<usize> = fac
+                .parents
+                .iter()
+                .filter_map(|p| match *p {
+                    Parent::Prev(j) => Some(j),
+                    Parent::Next(_) => None,
+                })
+                .collect();
+            let mut next_vars = vec![f];
+            next_vars.extend(fac.parents.iter().filter_map(|p| match *p {
+                Parent::Next(j) => Some(j),
+                Parent::Prev(_) => None,
+            }));
+            let radix = |vars: &[usize], vals: &[usize]| vars.iter().fold(0, |acc, &j| acc * factors[j].size + vals[j]);
+            let nx: usize = prev_parents.iter().map(|&j| factors[j].size).product();
+            let ny: usize = next_vars.iter().map(|&j| factors[j].size).product();
+            if nx > LOG_TERM_MAX || ny > LOG_TERM_MAX {
+                return None;
+            }
+            let (mut x_of, mut y_of) = (Vec::with_capacity(n), Vec::with_capacity(n));
+            // A representative joint state for every x and every y.
+            let (mut rep_x, mut rep_y) = (vec![usize::MAX; nx], vec![usize::MAX; ny]);
+            for s in 0..n {
+                structure.decode_into(s, &mut vals);
+                let (x, y) = (radix(&prev_parents, &vals), radix(&next_vars, &vals));
+                x_of.push(x as u8);
+                y_of.push(y as u8);
+                if rep_x[x] == usize::MAX {
+                    rep_x[x] = s;
+                }
+                if rep_y[y] == usize::MAX {
+                    rep_y[y] = s;
+                }
+            }
+            let size = fac.size;
+            let table = (0..n_actions)
+                .map(|u| {
+                    let mut t = vec![0.0; nx * ny];
+                    for (x, &sx) in rep_x.iter().enumerate() {
+                        let prev = structure.decode(sx);
+                        for (y, &sy) in rep_y.iter().enumerate() {
+                            let next = structure.decode(sy);
+                            let cfg = structure.config_index(f, &prev, &next, u, n_actions);
+                            t[x * ny + y] = means[f][cfg * size + next[f]].ln();
+                        }
+                    }
+                    t
+                })
+                .collect();
+            terms.push(LogTerm {
+                x_of,
+                y_of,
+                nx,
+                ny,
+                table,
+            });
+        }
+        Some(FactoredLogB { n, n_actions, terms })
+    }
+
+    /// Number of actions.
+    pub fn n_actions(&self) -> usize {
+        self.n_actions
+    }
+
+    /// `out[s'] = Σ_s ln B[u][s', s] q[s]` (the forward message).
+    pub fn forward(&self, u: usize, q: &[f64], out: &mut [f64], sc: &mut LogBScratch) {
+        let out = &mut out[..self.n];
+        out.fill(0.0);
+        let (mx, w) = (&mut sc.a, &mut sc.b);
+        for t in &self.terms {
+            mx[..t.nx].fill(0.0);
+            for (x, qs) in t.x_of.iter().zip(&q[..self.n]) {
+                mx[*x as usize] += qs;
+            }
+            // w[y] = Σ_x mx[x] T[x, y].
+            w[..t.ny].fill(0.0);
+            for (row, m) in t.table[u].chunks_exact(t.ny).zip(&mx[..t.nx]) {
+                for (wy, ty) in w[..t.ny].iter_mut().zip(row) {
+                    *wy += m * ty;
+                }
+            }
+            for (o, y) in out.iter_mut().zip(&t.y_of) {
+                *o += w[*y as usize];
+            }
+        }
+    }
+
+    /// `out[s] = Σ_{s'} q[s'] ln B[u][s', s]` (the backward message, `(ln B[u])ᵀ q`).
+    pub fn backward(&self, u: usize, q: &[f64], out: &mut [f64], sc: &mut LogBScratch) {
+        let out = &mut out[..self.n];
+        out.fill(0.0);
+        let (r, my) = (&mut sc.a, &mut sc.b);
+        for t in &self.terms {
+            my[..t.ny].fill(0.0);
+            for (y, qs) in t.y_of.iter().zip(&q[..self.n]) {
+                my[*y as usize] += qs;
+            }
+            // r[x] = Σ_y T[x, y] my[y].
+            for (rx, row) in r[..t.nx].iter_mut().zip(t.table[u].chunks_exact(t.ny)) {
+                *rx = row.iter().zip(&my[..t.ny]).map(|(a, b)| a * b).sum();
+            }
+            for (o, x) in out.iter_mut().zip(&t.x_of) {
+                *o += r[*x as usize];
+            }
+        }
+    }
+
+    /// `q_nextᵀ (ln B[u]) q_prev` (the transition term of `F`, Definition "VFE").
+    pub fn quadratic(&self, u: usize, q_next: &[f64], q_prev: &[f64], sc: &mut LogBScratch) -> f64 {
+        let mut total = 0.0;
+        let (mx, my) = (&mut sc.a, &mut sc.b);
+        for t in &self.terms {
+            mx[..t.nx].fill(0.0);
+            my[..t.ny].fill(0.0);
+            for ((x, y), (a, b)) in t
+                .x_of
+                .iter()
+                .zip(&t.y_of)
+                .zip(q_prev[..self.n].iter().zip(&q_next[..self.n]))
+            {
+                mx[*x as usize] += a;
+                my[*y as usize] += b;
+            }
+            for (row, m) in t.table[u].chunks_exact(t.ny).zip(&mx[..t.nx]) {
+                total += m * row.iter().zip(&my[..t.ny]).map(|(a, b)| a * b).sum::<f64>();
+            }
+        }
+        total
+    }
+}
+
 /// One step (see [`Step`]) with `K` previous values and run length `W` (the factor's
 /// stride) known at compile time: every block is a fixed-size tile the compiler unrolls
 /// and vectorises. `dst[i] = ((0 + c_0 s_0) + c_1 s_1) + ...`, term by term in `t` order.
@@ -455,6 +653,45 @@ mod tests {
                     }
                 }
             }
+        }
+
+        /// The factored `ln B` (forward and backward messages, `F`'s quadratic form) equals
+        /// the dense floored `ln B` to rounding, for random sizes, counts and beliefs; the
+        /// model attaches it to the generative model (no entry of these `B` is under the floor).
+        #[test]
+        fn factored_log_b_equals_dense_ln_b(
+            sizes in prop::array::uniform4(1usize..5),
+            seed in 0u64..1000,
+            u in 0usize..3,
+        ) {
+            let st = Structure::paper_default(sizes).unwrap();
+            let n = st.joint_size();
+            let w = random_model(st, seed, &[]);
+            let gm = w.generative();
+            let lb = gm.log_factored.as_ref().expect("every B entry is above the floor");
+            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5eed);
+            let mut draw = || {
+                let mut x: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
+                let z: f64 = x.iter().sum();
+                x.iter_mut().for_each(|v| *v /= z);
+                x
+            };
+            let (qa, qb) = (draw(), draw());
+            let ln_b = &gm.ln_b[u];
+            let (mut out, mut scratch) = (vec![0.0; n], LogBScratch::default());
+            lb.forward(u, &qa, &mut out, &mut scratch);
+            for (i, o) in out.iter().enumerate() {
+                let want: f64 = (0..n).map(|j| ln_b[(i, j)] * qa[j]).sum();
+                prop_assert!((o - want).abs() < 1e-12 * want.abs().max(1.0), "{o} vs {want}");
+            }
+            lb.backward(u, &qb, &mut out, &mut scratch);
+            for (j, o) in out.iter().enumerate() {
+                let want: f64 = (0..n).map(|i| ln_b[(i, j)] * qb[i]).sum();
+                prop_assert!((o - want).abs() < 1e-12 * want.abs().max(1.0), "{o} vs {want}");
+            }
+            let want: f64 = (0..n).map(|i| (0..n).map(|j| qb[i] * ln_b[(i, j)] * qa[j]).sum::<f64>()).sum();
+            let got = lb.quadratic(u, &qb, &qa, &mut scratch);
+            prop_assert!((got - want).abs() < 1e-12 * want.abs().max(1.0), "{got} vs {want}");
         }
 
         /// The factor-by-factor product equals the dense joint `B[u] x` (and the planning
