@@ -98,6 +98,16 @@ pub struct RewardPair {
     pub test_map: Reward,
 }
 
+impl RewardPair {
+    /// The rewards of a training and a test map.
+    pub fn of(train_map: &Map, test_map: &Map) -> Self {
+        RewardPair {
+            train_map: train_map.reward.clone(),
+            test_map: test_map.reward.clone(),
+        }
+    }
+}
+
 /// The table of one protocol.
 #[derive(Debug, Clone, Serialize)]
 pub struct ProtocolTable {
@@ -264,10 +274,7 @@ fn summarize(
         train_seeds: agents.iter().map(|a| a.train_seed).collect(),
         train_episodes: agents.first().and_then(|a| a.train_episodes),
         episodes: setup.episodes,
-        reward: RewardPair {
-            train_map: setup.train_map.reward.clone(),
-            test_map: setup.test_map.reward.clone(),
-        },
+        reward: RewardPair::of(setup.train_map, setup.test_map),
         train_reward: stat(METRICS[0].1),
         test_reward: stat(METRICS[1].1),
         success_rate: stat(METRICS[2].1),

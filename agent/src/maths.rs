@@ -117,7 +117,7 @@ const LN_TABLE: [[f64; 3]; LN_TABLE_STEPS + 1] = {
 /// (the next term is below 3e-18). Plain IEEE operations and a constant table (no FMA,
 /// no run-time dispatch): every x86-64 machine computes the same bits, scalar or
 /// vectorised. Max error against `std`'s `ln` ~2 ulp of `max(|ln x|, 1)` (test
-/// `fast_ln_and_exp_match_std`). Not for zero, subnormal, negative or non-finite `x`:
+/// `fast_ln_matches_std`). Not for zero, subnormal, negative or non-finite `x`:
 /// callers floor first.
 #[inline(always)]
 pub fn ln_fast(x: f64) -> f64 {
@@ -139,7 +139,7 @@ pub fn ln_into(x: &[f64], out: &mut [f64]) {
     }
 }
 
-/// `Σ_i p_i (ln p_i - c_i)` with the floored [`ln_fast`], summed by [`lane_sum`]; zero
+/// `Σ_i p_i (ln p_i - c_i)` with the floored [`ln_fast`], summed in four lanes in [`lane_sum`]'s order; zero
 /// entries add exactly 0. The risk of one step of the EFE (Prop. 1, `KL[A s || c]`).
 pub fn risk_sum(p: &[f64], c: &[f64]) -> f64 {
     const CHUNK: usize = 64;

@@ -14,7 +14,7 @@ use crate::methods::{Method, PaperFigures};
 use crate::plots::{BarPanel, BarRow, bar_key, grouped_bars};
 use crate::protocol::{Protocol, ProtocolChoice};
 use crate::report::{Csv, num, write_json};
-use crate::study::{METRICS, MethodSummary, ProtocolTable, StudySetup, run_study};
+use crate::study::{METRICS, MethodSummary, ProtocolTable, RewardPair, StudySetup, run_study};
 use crate::{maps, rewards};
 
 /// Training episodes by default (the paper's 6000).
@@ -101,7 +101,7 @@ pub struct CompareReport {
     /// Test map name.
     pub test_map: String,
     /// The reward settings of both maps (`train_map`, `test_map`).
-    pub reward: serde_json::Value,
+    pub reward: RewardPair,
     /// Evaluation seed (episode seeds derive from it, the same for every agent).
     pub seed: u64,
     /// Training seeds of the agents (null for an agent file that does not say).
@@ -163,7 +163,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         columns: columns(&train_map.name, &test_map.name, args.episodes),
         train_map: train_map.name.clone(),
         test_map: test_map.name.clone(),
-        reward: serde_json::json!({"train_map": train_map.reward, "test_map": test_map.reward}),
+        reward: RewardPair::of(&train_map, &test_map),
         seed: args.agent.seed,
         train_seeds: agents.iter().map(|a| a.train_seed).collect(),
         agent_file: args.agent.agent.as_ref().map(|p| p.display().to_string()),

@@ -1,6 +1,9 @@
 //! `unforeseen export-model`: a trained agent's planning model in the `inspect` JSON
 //! layout, so that the reasoning tick can be rerun elsewhere (e.g. in pymdp, see
-//! `scripts/pymdp_bench.py` and BENCHMARKS.md).
+//! `scripts/pymdp_bench.py` and BENCHMARKS.md). The layout holds one transition model, the
+//! planning one (episode-ending states absorbing); the agent's first planning step goes
+//! through the learned `B` instead (`root_step`), which differs only from a state that
+//! ends the episode, so from every other observation the exported tree is the agent's.
 
 use clap::Args;
 use std::path::PathBuf;
