@@ -11,6 +11,7 @@ mod doc_paths;
 mod end_to_end;
 mod figures;
 mod fuzz;
+mod golden;
 mod outputs;
 mod protocols;
 mod readme;
