@@ -1,5 +1,5 @@
 //! Build script: a fingerprint of the source that determines a trained agent (the sim,
-//! discretizer and agent crates, the training loop, the rewards and the locked
+//! discretizer, env and agent crates, the training loop, the rewards and the locked
 //! dependency versions), so the agent cache of `--train-seeds` (src/agents.rs) never
 //! serves an agent trained by different code; and one of all the source that determines
 //! results (the same plus the whole `src/`), so that `batch --resume` never mixes lines
@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 const INPUTS: &[&str] = &[
     "sim/src",
     "discretizer/src",
+    "env/src",
     "agent/src",
     "src/training.rs",
     "src/rewards.rs",

@@ -11,15 +11,15 @@ use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 use unforeseen::tick_replay::{TickTimes, jaywalk_family, record};
-use unforeseen_agent::controller::Controller;
+use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_agent::model::WorldModel;
 use unforeseen_agent::params::{GateMode, ModelPriors, QParams, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::q_learning::QLearning;
 use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_agent::structure::{Factor, Parent, Structure};
-use unforeseen_discretizer::Discretizer;
-use unforeseen_sim::{Action, World, embedded};
+use unforeseen_env::{Env, EnvConfig};
+use unforeseen_sim::embedded;
 
 mod common;
 use common::{agent, bundle, criterion_config};
@@ -143,20 +143,21 @@ fn reasoning_tick_replay(c: &mut Criterion, bundle: &AgentBundle) {
 /// one block.
 fn feedforward_tick(c: &mut Criterion, bundle: &AgentBundle) {
     let map = embedded::load("intersection").expect("map");
-    let disc = Discretizer::new(&map.bins).expect("discretizer");
+    let mut env = Env::new(&map, EnvConfig::default()).expect("env");
     let mut probe = agent(bundle, ScaledParams::default());
-    let mut world = World::from_map(&map, 1);
+    let mut o = env.reset(1).0.index().expect("discrete");
     probe.begin_episode(1);
     let mut chain = Vec::new();
     let mut natural_ff = 0;
     loop {
-        let o = disc.encode(disc.state(&world.snapshot()));
         chain.push(o);
         let d = probe.act(o);
         natural_ff += usize::from(!d.reasoned);
-        if world.step(Action::from_index(d.action).expect("action")).done() {
+        let step = env.step(d.action).expect("action");
+        if step.terminated || step.truncated {
             break;
         }
+        o = step.observation.index().expect("discrete");
     }
     let mut a = agent(
         bundle,
@@ -200,19 +201,19 @@ fn feedforward_tick(c: &mut Criterion, bundle: &AgentBundle) {
 /// jaywalk episode (Triggered reasoning, as in evaluation). The clone is untimed.
 fn learning_update(c: &mut Criterion, bundle: &AgentBundle) {
     let map = embedded::load("jaywalk").expect("map");
-    let disc = Discretizer::new(&map.bins).expect("discretizer");
+    let mut env = Env::new(&map, EnvConfig::default()).expect("env");
     let mut a = agent(bundle, ScaledParams::default());
-    let mut world = World::from_map(&map, 3);
+    let mut o = env.reset(3).0.index().expect("discrete");
     a.begin_episode(3);
     let mut ticks = 0;
     loop {
-        let o = disc.encode(disc.state(&world.snapshot()));
         let d = a.act(o);
-        let out = world.step(Action::from_index(d.action).expect("action"));
+        let step = env.step(d.action).expect("action");
         ticks += 1;
-        let next = disc.encode(disc.state(&world.snapshot()));
-        a.observe(0.0, next, out.done());
-        if out.done() {
+        o = step.observation.index().expect("discrete");
+        let ending = Ending::from_flags(step.terminated, step.truncated);
+        a.observe(step.reward, o, ending);
+        if ending.is_over() {
             break;
         }
     }

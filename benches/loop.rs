@@ -14,13 +14,14 @@ use unforeseen::training::train;
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_discretizer::Discretizer;
+use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::{Action, World, embedded};
 
 mod common;
 use common::{agent, bundle, criterion_config, train_cfg};
 
-/// `physics_decision_step`: one `World::step` on the intersection map (decision_dt 1 s
+/// `physics_decision_step`: one `World::step` on the intersection map (the physics alone,
+/// below `Env`) (decision_dt 1 s
 /// at 60 Hz = 60 Rapier sub-steps, plus lights, spawns and events). The car speeds up
 /// on the first tick and then holds its speed; a finished world is rebuilt untimed.
 fn physics_decision_step(c: &mut Criterion) {
@@ -53,11 +54,11 @@ fn physics_decision_step(c: &mut Criterion) {
 /// test-time learning.
 fn episode(c: &mut Criterion, bundle: &AgentBundle) {
     let map = embedded::load("jaywalk").expect("map");
-    let disc = Discretizer::new(&map.bins).expect("discretizer");
+    let mut env = Env::new(&map, EnvConfig::default()).expect("env");
     let params = ScaledParams::default();
     let seeds = eval_seeds(7, &map, Method::Scaled, 0);
     let mut probe = Method::Scaled.controller(bundle, &params).expect("controller");
-    let (r, _) = run_episode(&map, &disc, probe.as_mut(), seeds, false);
+    let (r, _) = run_episode(&mut env, probe.as_mut(), seeds, false).expect("episode");
     eprintln!(
         "episode: {} ticks, {} reasoning, return {:.1}, success {}",
         r.ticks, r.reasoning_ticks, r.ret, r.success
@@ -65,7 +66,7 @@ fn episode(c: &mut Criterion, bundle: &AgentBundle) {
     c.bench_function("episode", |b| {
         b.iter_batched(
             || Method::Scaled.controller(bundle, &params).expect("controller"),
-            |mut ctl| run_episode(&map, &disc, ctl.as_mut(), seeds, false),
+            |mut ctl| run_episode(&mut env, ctl.as_mut(), seeds, false).expect("episode"),
             BatchSize::SmallInput,
         )
     });
@@ -84,28 +85,31 @@ fn training_throughput(c: &mut Criterion) {
 
 /// `decision_throughput`: the closed loop on the intersection map with
 /// `decision_dt = 0.1` (10 Hz decisions, 6 Rapier sub-steps per decision at 60 Hz) and
-/// `max_steps = 400` (same 40 s horizon): `World::step` + snapshot + discretizer +
-/// `ScaledAgent::act` (surprise-triggered reasoning, default parameters). One element
-/// is one decision tick; episode restarts (world construction, `begin_episode`) are
-/// untimed and no test-time learning runs.
+/// `max_steps = 400` (same 40 s horizon): `Env::step` (world step, snapshot, discretizer)
+/// + `ScaledAgent::act` (surprise-triggered reasoning, default parameters). One element
+/// is one decision tick; episode restarts (`Env::reset`, `begin_episode`) are untimed and
+/// no test-time learning runs.
 fn decision_throughput(c: &mut Criterion, bundle: &AgentBundle) {
     let mut map = embedded::load("intersection").expect("map");
     map.episode.decision_dt = 0.1;
     map.episode.max_steps = 400;
-    let disc = Discretizer::new(&map.bins).expect("discretizer");
+    let mut env = Env::new(&map, EnvConfig::default()).expect("env");
     let mut agent = agent(bundle, ScaledParams::default());
     // Reasoning share of the loop (for the report).
     {
-        let mut world = World::from_map(&map, 0);
+        let (obs, _) = env.reset(0);
+        let mut obs = obs.index().expect("discrete");
         agent.begin_episode(0);
         let (mut ticks, mut reasoned) = (0, 0);
         loop {
-            let d = agent.act(disc.encode(disc.state(&world.snapshot())));
+            let d = agent.act(obs);
             ticks += 1;
             reasoned += u32::from(d.reasoned);
-            if world.step(Action::from_index(d.action).expect("action")).done() {
+            let step = env.step(d.action).expect("action");
+            if step.terminated || step.truncated {
                 break;
             }
+            obs = step.observation.index().expect("discrete");
         }
         eprintln!("decision_throughput: episode 0 has {ticks} ticks, {reasoned} reasoning");
     }
@@ -115,17 +119,17 @@ fn decision_throughput(c: &mut Criterion, bundle: &AgentBundle) {
         b.iter_custom(|iters| {
             let mut total = Duration::ZERO;
             let mut seed = 0;
-            let mut world = World::from_map(&map, seed);
+            let mut obs = env.reset(seed).0.index().expect("discrete");
             agent.begin_episode(seed);
             let mut t = Instant::now();
             for _ in 0..iters {
-                let obs = disc.encode(disc.state(&world.snapshot()));
                 let d = agent.act(obs);
-                let out = world.step(Action::from_index(d.action).expect("action"));
-                if out.done() {
+                let step = env.step(d.action).expect("action");
+                obs = step.observation.index().expect("discrete");
+                if step.terminated || step.truncated {
                     total += t.elapsed();
                     seed += 1;
-                    world = World::from_map(&map, seed);
+                    obs = env.reset(seed).0.index().expect("discrete");
                     agent.begin_episode(seed);
                     t = Instant::now();
                 }

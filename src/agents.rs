@@ -100,6 +100,7 @@ pub fn cache_key(map: &Map, cfg: &TrainConfig) -> anyhow::Result<String> {
         "priors": cfg.priors,
         "bayes": cfg.bayes,
         "tau_c": cfg.tau_c,
+        "timeout_as": cfg.timeout_as,
         "version": env!("CARGO_PKG_VERSION"),
         "code": env!("UNFORESEEN_TRAINING_FINGERPRINT"),
     });

@@ -9,6 +9,7 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_discretizer::{Discretizer, State};
+use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::{Action, Map};
 
 use crate::agent_file::check_compatible;
@@ -40,16 +41,16 @@ pub fn evaluate(
     seed: u64,
     quiet: bool,
 ) -> anyhow::Result<Vec<EpisodeResult>> {
-    let disc = Discretizer::new(&map.bins)?;
+    let mut env = Env::new(map, EnvConfig::default())?;
     let bar = progress::bar(episodes, &format!("{} {}", method.name(), map.name), quiet);
     let results = (0..episodes)
         .map(|ep| {
             bar.inc(1);
-            run_episode(map, &disc, controller, eval_seeds(seed, map, method, ep), false).0
+            Ok(run_episode(&mut env, controller, eval_seeds(seed, map, method, ep), false)?.0)
         })
         .collect();
     bar.finish_and_clear();
-    Ok(results)
+    results
 }
 
 /// Runs `episodes` evaluation episodes of `method` on `map` under `protocol`, advancing
@@ -90,20 +91,24 @@ pub fn evaluate_with(
     seed: u64,
     bar: &ProgressBar,
 ) -> anyhow::Result<Vec<EpisodeResult>> {
-    let disc = Discretizer::new(&map.bins)?;
-    let run = |controller: &mut dyn Controller, ep: u64| {
-        let result = run_episode(map, &disc, controller, eval_seeds(seed, map, method, ep), false).0;
+    let new_env = || Env::new(map, EnvConfig::default());
+    let run = |env: &mut Env, controller: &mut dyn Controller, ep: u64| -> anyhow::Result<EpisodeResult> {
+        let result = run_episode(env, controller, eval_seeds(seed, map, method, ep), false)?.0;
         bar.inc(1);
-        result
+        Ok(result)
     };
     match protocol.effective(method, params) {
         Protocol::ZeroShot => (0..episodes)
             .into_par_iter()
-            .map(|ep| Ok(run(make()?.as_mut(), ep)))
+            .map_init(new_env, |env, ep| {
+                let env = env.as_mut().map_err(|e| e.clone())?;
+                run(env, make()?.as_mut(), ep)
+            })
             .collect(),
         Protocol::Continual => {
             let mut controller = make()?;
-            Ok((0..episodes).map(|ep| run(controller.as_mut(), ep)).collect())
+            let mut env = new_env()?;
+            (0..episodes).map(|ep| run(&mut env, controller.as_mut(), ep)).collect()
         }
     }
 }
@@ -190,27 +195,20 @@ pub fn trace(
     protocol: Protocol,
     episode: u64,
 ) -> anyhow::Result<(EpisodeResult, Vec<Tick>)> {
-    let disc = Discretizer::new(&map.bins)?;
+    let mut env = Env::new(map, EnvConfig::default())?;
     check_compatible(bundle, map)?;
     let mut controller = method.controller(bundle, params)?;
     if protocol.effective(method, params) == Protocol::Continual {
         for ep in 0..episode {
-            run_episode(
-                map,
-                &disc,
-                controller.as_mut(),
-                eval_seeds(seed, map, method, ep),
-                false,
-            );
+            run_episode(&mut env, controller.as_mut(), eval_seeds(seed, map, method, ep), false)?;
         }
     }
     Ok(run_episode(
-        map,
-        &disc,
+        &mut env,
         controller.as_mut(),
         eval_seeds(seed, map, method, episode),
         true,
-    ))
+    )?)
 }
 
 /// One point of the test-time learning curves (Fig. 9): what the agent brings into
@@ -249,7 +247,8 @@ pub fn learn(
     seed: u64,
     quiet: bool,
 ) -> anyhow::Result<Vec<LearnPoint>> {
-    let disc = Discretizer::new(&map.bins)?;
+    let mut env = Env::new(map, EnvConfig::default())?;
+    let disc = env.discretizer().clone();
     check_compatible(bundle, map)?;
     let mut agent = crate::methods::scaled_agent(
         bundle,
@@ -266,7 +265,7 @@ pub fn learn(
         let p_pedestrian_green_d2 = pedestrian_on_green_d2(&agent);
         let p_stay_green_d2 = agent.model().cpt_prob(3, 1, &[1, 1, 2], None);
         let before = agent.nu().to_vec();
-        let (result, ticks) = run_episode(map, &disc, &mut agent, eval_seeds(seed, map, Method::Scaled, ep), true);
+        let (result, ticks) = run_episode(&mut env, &mut agent, eval_seeds(seed, map, Method::Scaled, ep), true)?;
         if event_state.is_none() {
             event_state = ticks
                 .iter()

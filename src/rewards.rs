@@ -1,8 +1,10 @@
-//! Rewards (§VI): the per-tick reward the runner pays out, and the per-state reward
-//! R(s) behind the agent's preferences C = log_softmax(R / tau_c) (§IV; docs/ARCHITECTURE.md §4.3).
+//! Rewards (§VI): the per-state reward R(s) behind the agent's preferences
+//! C = log_softmax(R / tau_c) (§IV; docs/ARCHITECTURE.md §4.3), the episode-ending states
+//! of its planning model, and a one-line description of a map's reward. The per-tick
+//! reward the env pays is [`unforeseen_env::RewardTerms`].
 
 use unforeseen_discretizer::Discretizer;
-use unforeseen_sim::{Map, StepOutcome};
+use unforeseen_sim::Map;
 
 /// One line naming a map's reward, for tables: its four numbers, and whether it pays
 /// rapid approach (a tick at the car's top speed nets at most 0, so every slower tick
@@ -19,20 +21,6 @@ pub fn describe(map: &Map) -> String {
         "{kind}: {}/m of progress, -{} per tick, goal {:+}, crash {:+}",
         r.progress_per_metre, r.step_cost, r.goal, r.crash
     )
-}
-
-/// The reward of one decision tick: progress toward the goal, minus the step cost,
-/// plus the goal bonus or the crash penalty when the tick ends the episode that way.
-pub fn tick_reward(map: &Map, outcome: &StepOutcome) -> f64 {
-    let r = &map.reward;
-    let mut reward = r.progress_per_metre * outcome.progress - r.step_cost;
-    if outcome.goal {
-        reward += r.goal;
-    }
-    if outcome.collision {
-        reward += r.crash;
-    }
-    reward
 }
 
 /// Distance bins that overlap the crosswalk (the paper's "intersection at d = 1").

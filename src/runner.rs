@@ -1,14 +1,12 @@
-//! The episode runner: map -> world -> discretizer -> controller -> action -> world,
-//! one decision tick at a time (docs/ARCHITECTURE.md §1), with the reward and metrics of §VI.
+//! The episode runner: a [`Controller`] driving an [`Env`] (map -> world -> discretizer
+//! -> controller -> action -> world, one decision tick at a time; docs/ARCHITECTURE.md
+//! §1), with the metrics of §VI.
 
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
-use unforeseen_agent::controller::Controller;
-use unforeseen_discretizer::{Discretizer, State};
-use unforeseen_sim::{Action, Map, Snapshot, World};
-
-use crate::rewards::tick_reward;
+use unforeseen_agent::controller::{Controller, Ending};
+use unforeseen_discretizer::State;
+use unforeseen_env::{Env, EnvError};
+use unforeseen_sim::{Action, Snapshot};
 
 /// One decision tick of an episode, as shown by `trace`.
 #[derive(Debug, Clone)]
@@ -64,77 +62,88 @@ pub struct EpisodeResult {
 /// Seeds of one episode: the world's randomness and the controller's.
 #[derive(Debug, Clone, Copy)]
 pub struct EpisodeSeeds {
-    /// Seeds the world (light offset, spawns) and the observation noise.
+    /// Seeds the world (light offset, spawns) and the observation noise ([`Env::reset`]).
     pub world: u64,
     /// Seeds the controller's own sampling, if any.
     pub controller: u64,
 }
 
-/// Runs one episode of `controller` on `map`. With `record`, every tick is returned.
+/// Why an episode could not run: the controller chose an action that is not one of the
+/// three (a bug in the controller, or a policy given from outside).
+#[derive(Debug, thiserror::Error)]
+#[error("{controller}: {source}")]
+pub struct EpisodeError {
+    /// The controller's name.
+    pub controller: String,
+    /// What the env refused.
+    #[source]
+    pub source: EnvError,
+}
+
+/// Runs one episode of `controller` in `env` (a loop over [`Env::reset`] and
+/// [`Env::step`]). With `record`, every tick is returned, and the terminal frame after them.
 pub fn run_episode(
-    map: &Map,
-    disc: &Discretizer,
+    env: &mut Env,
     controller: &mut dyn Controller,
     seeds: EpisodeSeeds,
     record: bool,
-) -> (EpisodeResult, Vec<Tick>) {
-    let mut world = World::from_map(map, seeds.world);
-    let mut noise = ChaCha8Rng::seed_from_u64(seeds.world ^ 0x6f62_7365_7276_6521);
+) -> Result<(EpisodeResult, Vec<Tick>), EpisodeError> {
+    let (obs, mut info) = env.reset(seeds.world);
+    let mut index = obs.index().unwrap_or_else(|| env.discretizer().encode(info.observed));
     let mut result = EpisodeResult::default();
     let mut ticks = Vec::new();
     controller.begin_episode(seeds.controller);
-
-    let mut snap = world.snapshot();
-    let mut state = disc.state(&snap);
-    let mut observed = disc.observe(state, &mut noise);
     loop {
         let started = Instant::now();
-        let decision = controller.act(disc.encode(observed));
+        let decision = controller.act(index);
         let ns = started.elapsed().as_nanos() as u64;
-        let action = Action::from_index(decision.action)
-            .unwrap_or_else(|| panic!("{} chose action {} of 3", controller.name(), decision.action));
         result.decide_ns += ns;
         if decision.reasoned {
             result.reasoning_ticks += 1;
             result.reasoning_ns += ns;
         }
-        if result.jaywalk_surprise.is_none() && state.p == 1 && state.l == 1 {
+        if result.jaywalk_surprise.is_none() && info.state.p == 1 && info.state.l == 1 {
             result.jaywalk_surprise = decision.surprise;
         }
-
-        let outcome = world.step(action);
-        let reward = tick_reward(map, &outcome);
-        result.ret += reward;
+        let before = record.then(|| env.snapshot().clone());
+        let step = env.step(decision.action).map_err(|source| EpisodeError {
+            controller: controller.name().to_string(),
+            source,
+        })?;
+        result.ret += step.reward;
         result.ticks += 1;
-        let next_snap = world.snapshot();
-        let next_state = disc.state(&next_snap);
-        let next_observed = disc.observe(next_state, &mut noise);
-        controller.observe(reward, disc.encode(next_observed), outcome.done());
-        if record {
+        let next_index = step
+            .observation
+            .index()
+            .unwrap_or_else(|| env.discretizer().encode(step.info.observed));
+        let ending = Ending::from_flags(step.terminated, step.truncated);
+        controller.observe(step.reward, next_index, ending);
+        if let Some(snapshot) = before {
             ticks.push(Tick {
-                step: outcome.step.saturating_sub(1),
-                state,
-                observed,
-                action,
+                step: info.step,
+                state: info.state,
+                observed: info.observed,
+                action: Action::from_index(decision.action).unwrap_or(Action::Maintain),
                 reasoned: decision.reasoned,
                 surprise: decision.surprise,
                 theta: decision.theta,
                 policy: decision.policy.to_vec(),
                 psi: decision.psi.as_deref().map(<[f64]>::to_vec),
-                reward,
-                snapshot: snap,
+                reward: step.reward,
+                snapshot,
             });
         }
-        if outcome.done() {
-            result.collision = outcome.collision;
-            result.success = outcome.goal && !outcome.collision;
-            result.timeout = outcome.timeout;
+        if ending.is_over() {
+            let events = step.info.events;
+            result.collision = events.collision;
+            result.success = events.goal && !events.collision;
+            result.timeout = events.timeout;
             if record {
                 // The terminal frame, for the filmstrip.
                 ticks.push(Tick {
-                    step: outcome.step,
-                    state: next_state,
-                    observed: next_observed,
+                    step: step.info.step,
+                    state: step.info.state,
+                    observed: step.info.observed,
                     action: Action::Maintain,
                     reasoned: false,
                     surprise: None,
@@ -142,13 +151,13 @@ pub fn run_episode(
                     policy: Vec::new(),
                     psi: None,
                     reward: 0.0,
-                    snapshot: next_snap,
+                    snapshot: env.snapshot().clone(),
                 });
             }
             break;
         }
-        (snap, state, observed) = (next_snap, next_state, next_observed);
+        (info, index) = (step.info, next_index);
     }
     controller.end_episode();
-    (result, ticks)
+    Ok((result, ticks))
 }

@@ -17,11 +17,11 @@
 
 use std::time::{Duration, Instant};
 
-use unforeseen_agent::controller::{Controller, Decision};
+use unforeseen_agent::controller::{Controller, Decision, Ending};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
-use unforeseen_discretizer::Discretizer;
+use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::Map;
 
 use crate::experiments::eval_seeds;
@@ -86,8 +86,8 @@ impl Controller for Recorder<'_> {
         self.reasoned.push(d.reasoned);
         d
     }
-    fn observe(&mut self, reward: f64, next_obs: usize, done: bool) {
-        self.inner.observe(reward, next_obs, done);
+    fn observe(&mut self, reward: f64, next_obs: usize, ending: Ending) {
+        self.inner.observe(reward, next_obs, ending);
     }
     fn end_episode(&mut self) {
         self.inner.end_episode();
@@ -105,7 +105,7 @@ pub fn record(
 ) -> anyhow::Result<Recording> {
     let mut out = Recording::default();
     for map in maps {
-        let disc = Discretizer::new(&map.bins)?;
+        let mut env = Env::new(map, EnvConfig::default())?;
         for ep in 0..episodes {
             let mut agent = ScaledAgent::new(bundle.world_model.clone(), &bundle.q_learning, params.clone())?;
             let seeds = eval_seeds(seed, map, Method::Scaled, ep);
@@ -115,7 +115,7 @@ pub fn record(
                 actions: Vec::new(),
                 reasoned: Vec::new(),
             };
-            let (result, _) = run_episode(map, &disc, &mut rec, seeds, false);
+            let (result, _) = run_episode(&mut env, &mut rec, seeds, false)?;
             out.episodes.push(RecordedEpisode {
                 map: map.name.clone(),
                 episode: ep,

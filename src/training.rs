@@ -13,10 +13,11 @@ use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::q_learning::QLearning;
 use unforeseen_agent::structure::Structure;
 use unforeseen_discretizer::Discretizer;
-use unforeseen_sim::{Action, Map, World};
+use unforeseen_env::{Env, EnvConfig};
+use unforeseen_sim::{Action, Map};
 
 use crate::progress;
-use crate::rewards::{state_rewards, terminal_states, tick_reward};
+use crate::rewards::{state_rewards, terminal_states};
 use crate::seeds::episode_seed;
 
 /// Everything training needs besides the map.
@@ -34,6 +35,8 @@ pub struct TrainConfig {
     pub bayes: BayesRlParams,
     /// Temperature tau_c of the preferences C = log_softmax(R / tau_c).
     pub tau_c: f64,
+    /// What a time-out is to the learners (default: a truncation they bootstrap through).
+    pub timeout_as: TimeoutAs,
     /// Hide the progress bar.
     pub quiet: bool,
 }
@@ -51,9 +54,24 @@ impl TrainConfig {
             priors: ModelPriors::default(),
             bayes: BayesRlParams::default(),
             tau_c: 1.0,
+            timeout_as: TimeoutAs::Truncation,
             quiet: false,
         }
     }
+}
+
+/// What a time-out (an episode cut off at `episode.max_steps` ticks) is to Q-learning's
+/// and Bayesian RL's updates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TimeoutAs {
+    /// A truncation: the state reached is not terminal, so Q-learning bootstraps through it
+    /// and Bayesian RL records the transition to it (Gymnasium's `truncated`).
+    #[default]
+    Truncation,
+    /// A terminal state (value 0, an absorbing transition), as if the task had ended there:
+    /// the ablation that reproduces agents trained before time-outs were told apart.
+    Termination,
 }
 
 /// What training recorded: the return of every episode.
@@ -61,6 +79,8 @@ impl TrainConfig {
 pub struct TrainLog {
     /// Return of every training episode (with exploration).
     pub returns: Vec<f64>,
+    /// Training episodes that timed out.
+    pub timeouts: u64,
 }
 
 /// Trains all learners on `map` and bundles them (with the preferences set from the
@@ -89,26 +109,32 @@ pub fn train_with_bar(map: &Map, cfg: &TrainConfig, bar: &ProgressBar) -> anyhow
     let mut bayes_factored = BayesRl::new(n, n_actions, factored)?;
     let mut log = TrainLog::default();
     let stream = format!("{}/train", map.name);
+    let mut env = Env::new(map, EnvConfig::default())?;
     for episode in 0..cfg.episodes {
         let seed = episode_seed(cfg.seed, &stream, episode);
-        let mut world = World::from_map(map, seed);
+        // Training observes the true state (fully observed, whatever the map's noise).
+        let (_, info) = env.reset(seed);
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6578_706c_6f72_6521);
-        let mut s = disc.encode(disc.state(&world.snapshot()));
+        let mut s = disc.encode(info.state);
         model.observe_initial(s);
         let mut ret = 0.0;
         loop {
             let a = q.act_epsilon_greedy(s, &mut rng);
-            let outcome = world.step(Action::from_index(a).expect("Q-learning picks one of 3 actions"));
-            let r = tick_reward(map, &outcome);
-            let s_next = disc.encode(disc.state(&world.snapshot()));
-            let done = outcome.done();
-            q.update(s, a, r, s_next, done);
+            let step = env.step(a)?;
+            let r = step.reward;
+            let s_next = disc.encode(step.info.state);
+            let terminal = match cfg.timeout_as {
+                TimeoutAs::Truncation => step.terminated,
+                TimeoutAs::Termination => step.terminated || step.truncated,
+            };
+            q.update(s, a, r, s_next, terminal);
             model.observe_transition(s, a, s_next);
-            bayes.observe_transition(s, a, r, s_next, done);
-            bayes_factored.observe_transition(s, a, r, s_next, done);
+            bayes.observe_transition(s, a, r, s_next, terminal);
+            bayes_factored.observe_transition(s, a, r, s_next, terminal);
             ret += r;
             s = s_next;
-            if done {
+            if step.terminated || step.truncated {
+                log.timeouts += u64::from(step.truncated);
                 break;
             }
         }
@@ -123,6 +149,7 @@ pub fn train_with_bar(map: &Map, cfg: &TrainConfig, bar: &ProgressBar) -> anyhow
     meta.insert("map".into(), map.name.clone());
     meta.insert("episodes".into(), cfg.episodes.to_string());
     meta.insert("seed".into(), cfg.seed.to_string());
+    meta.insert("timeout_as".into(), format!("{:?}", cfg.timeout_as).to_lowercase());
     meta.insert("factor_sizes".into(), format!("{:?}", disc.factor_sizes()));
     meta.insert("unforeseen_version".into(), env!("CARGO_PKG_VERSION").into());
     let mut bundle = AgentBundle::new(q, model, bayes, meta);

@@ -4,7 +4,7 @@
 //! or finite-horizon lookahead). Terminal transitions lead to an absorbing state of value 0.
 
 use crate::check;
-use crate::controller::{Controller, Decision, one_hot};
+use crate::controller::{Controller, Decision, Ending, one_hot};
 use crate::error::{AgentError, FieldError, ParamError};
 use crate::limits::{MAX_ACTIONS, MAX_STATES};
 use crate::maths::argmax;
@@ -203,9 +203,16 @@ impl BayesRl {
         self.n_actions
     }
 
+    /// Counts of transitions into the terminal (absorbing) state, `[s * A + a]`.
+    pub fn terminal_counts(&self) -> &[f64] {
+        &self.terminal
+    }
+
     /// Update the Dirichlet counts and the running mean reward with one transition.
-    /// A terminal transition (`done`) goes to the absorbing state (value 0).
-    pub fn observe_transition(&mut self, s: usize, a: usize, r: f64, s_next: usize, done: bool) {
+    /// A transition into a terminal state (`terminal`: goal or collision) goes to the
+    /// absorbing state (value 0); a time-out is not terminal and is recorded as the
+    /// transition to `s_next` it was.
+    pub fn observe_transition(&mut self, s: usize, a: usize, r: f64, s_next: usize, terminal: bool) {
         let (n, na) = (self.n_states, self.n_actions);
         if s >= n || a >= na || s_next >= n {
             return;
@@ -213,7 +220,7 @@ impl BayesRl {
         let i = s * na + a;
         self.visits[i] += 1.0;
         self.reward_sum[i] += r;
-        if done {
+        if terminal {
             self.terminal[i] += 1.0;
         } else {
             self.counts[i * n + s_next] += 1.0;
@@ -374,11 +381,11 @@ impl Controller for BayesRl {
             ..Default::default()
         }
     }
-    fn observe(&mut self, reward: f64, next_obs: usize, done: bool) {
+    fn observe(&mut self, reward: f64, next_obs: usize, ending: Ending) {
         if self.params.learn_online
             && let Some((s, a)) = self.last
         {
-            self.observe_transition(s, a, reward, next_obs, done);
+            self.observe_transition(s, a, reward, next_obs, ending.is_terminal());
         }
     }
 }

@@ -20,6 +20,42 @@ pub struct Decision {
     pub scaling_iters: u32,
 }
 
+/// How a tick left the episode: going on, ended in a terminal state of the task (goal or
+/// collision: nothing follows, a value estimate stops there), or cut off by the tick limit
+/// (the state is not terminal: a value estimate bootstraps through it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ending {
+    /// The episode goes on.
+    Continues,
+    /// The episode reached a terminal state (goal or collision).
+    Terminated,
+    /// The episode ran out of ticks in a non-terminal state (time-out).
+    Truncated,
+}
+
+impl Ending {
+    /// From Gymnasium's two flags (`terminated` wins if both are set).
+    pub fn from_flags(terminated: bool, truncated: bool) -> Self {
+        if terminated {
+            Ending::Terminated
+        } else if truncated {
+            Ending::Truncated
+        } else {
+            Ending::Continues
+        }
+    }
+
+    /// Whether the episode is over (terminated or truncated).
+    pub fn is_over(self) -> bool {
+        self != Ending::Continues
+    }
+
+    /// Whether the next state is terminal (no bootstrap through it).
+    pub fn is_terminal(self) -> bool {
+        self == Ending::Terminated
+    }
+}
+
 /// A method that acts on observations (docs/ARCHITECTURE.md §5).
 pub trait Controller: Send {
     /// Method name, e.g. `"scaled"`.
@@ -28,8 +64,9 @@ pub trait Controller: Send {
     fn begin_episode(&mut self, seed: u64);
     /// Decide the action for observation `obs`.
     fn act(&mut self, obs: usize) -> Decision;
-    /// Online evidence after acting (reward, next observation, terminal flag).
-    fn observe(&mut self, _reward: f64, _next_obs: usize, _done: bool) {}
+    /// Online evidence after acting: the reward, the next observation, and whether the
+    /// tick ended the episode ([`Ending`]).
+    fn observe(&mut self, _reward: f64, _next_obs: usize, _ending: Ending) {}
     /// End of episode (the scaled agent learns here, §V).
     fn end_episode(&mut self) {}
 }

@@ -154,9 +154,11 @@ impl QLearning {
         }
     }
 
-    /// `Q[s,a] += α (r + γ max_a' Q[s',a'] (0 if done) - Q[s,a])`.
-    pub fn update(&mut self, s: usize, a: usize, r: f64, s_next: usize, done: bool) {
-        let future = if done {
+    /// `Q[s,a] += α (r + γ max_a' Q[s',a'] (0 if terminal) - Q[s,a])`. `terminal` is set
+    /// only when `s_next` ends the task (goal or collision); after a time-out the value
+    /// bootstraps through `s_next`, which is not terminal.
+    pub fn update(&mut self, s: usize, a: usize, r: f64, s_next: usize, terminal: bool) {
+        let future = if terminal {
             0.0
         } else {
             self.q(s_next).iter().copied().fold(f64::NEG_INFINITY, f64::max)

@@ -13,7 +13,7 @@
 //! the surprise itself, `Decision::theta` what the trigger compared with `ε`. Planning always
 //! predicts with the full transition model, which keeps the pedestrian's persistence.
 
-use crate::controller::{Controller, Decision, Dist};
+use crate::controller::{Controller, Decision, Dist, Ending};
 use crate::error::AgentError;
 use crate::gate::StateGate;
 use crate::learning;
@@ -377,8 +377,8 @@ impl Controller for ScaledAgent {
         }
     }
 
-    fn observe(&mut self, _reward: f64, next_obs: usize, done: bool) {
-        if done {
+    fn observe(&mut self, _reward: f64, next_obs: usize, ending: Ending) {
+        if ending.is_over() {
             self.final_obs = Some(next_obs);
         }
     }

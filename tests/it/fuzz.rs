@@ -17,7 +17,8 @@ use unforeseen::methods::Method;
 use unforeseen::runner::{EpisodeSeeds, run_episode};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_discretizer::Discretizer;
-use unforeseen_sim::{Action, Map, World};
+use unforeseen_env::{Env, EnvConfig, ObservationForm};
+use unforeseen_sim::{Action, Map};
 
 fn cases() -> usize {
     std::env::var("UNFORESEEN_FUZZ_CASES")
@@ -192,14 +193,21 @@ fn mutated_maps_are_refused_or_run_within_the_limits() {
             per_episode <= unforeseen_sim::MAX_EPISODE_SUBSTEPS,
             "case {case}\n{text}"
         );
-        // ...and their worlds step.
-        let mut world = World::from_map(&map, case as u64);
+        // ...and their envs step, with finite kinematic observations.
+        let config = EnvConfig {
+            observation: ObservationForm::Kinematic,
+            ..EnvConfig::default()
+        };
+        let mut env = Env::new(&map, config).expect("a valid map makes an env");
+        env.reset(case as u64);
         for _ in 0..3 {
-            if world.is_done() {
+            if env.is_done() {
                 break;
             }
-            let out = world.step(Action::SpeedUp);
-            assert!(out.progress.is_finite(), "case {case}\n{text}");
+            let step = env.step(Action::SpeedUp.index()).expect("a valid action");
+            assert!(step.info.reward.progress.is_finite(), "case {case}\n{text}");
+            let obs = step.observation.kinematic().expect("kinematic");
+            assert!(obs.iter().all(|x| x.is_finite()), "case {case}: {obs:?}\n{text}");
         }
     }
     eprintln!("maps: {n} mutated, {accepted} accepted");
@@ -210,7 +218,7 @@ fn mutated_maps_are_refused_or_run_within_the_limits() {
 fn mutated_agent_files_are_refused_or_drive_the_car() {
     let valid = common::tiny_agent_text();
     let map = common::tiny_map();
-    let disc = Discretizer::new(&map.bins).unwrap();
+    let mut env = Env::new(&map, EnvConfig::default()).unwrap();
     let path = Path::new("agent.ron");
     let params = ScaledParams::default();
     let mut rng = ChaCha8Rng::seed_from_u64(12);
@@ -244,7 +252,7 @@ fn mutated_agent_files_are_refused_or_drive_the_car() {
                     world: case as u64 + episode,
                     controller: episode,
                 };
-                let (result, ticks) = run_episode(&map, &disc, controller.as_mut(), seeds, true);
+                let (result, ticks) = run_episode(&mut env, controller.as_mut(), seeds, true).unwrap();
                 assert!(result.ret.is_finite(), "case {case} {method}");
                 // Every decision (the last frame is the terminal state, with no decision).
                 for t in &ticks[..ticks.len() - 1] {

@@ -15,7 +15,9 @@ use unforeseen::methods::Method;
 use unforeseen::protocol::Protocol;
 use unforeseen::runner::{EpisodeResult, Tick};
 use unforeseen::seeds::content_hash;
+use unforeseen::training::{TimeoutAs, train};
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::persist::AgentBundle;
 
 fn bits(x: f64) -> String {
     format!("{:016x}", x.to_bits())
@@ -69,16 +71,15 @@ fn push_episode(out: &mut String, result: &EpisodeResult, ticks: &[Tick]) {
 
 /// The trained agent's tables (Q-table, world-model counts, Bayesian-RL counts), without
 /// its metadata.
-fn agent_digest() -> String {
-    let mut bundle = common::bundle().clone();
+fn agent_digest(bundle: &AgentBundle) -> String {
+    let mut bundle = bundle.clone();
     bundle.meta.clear();
     content_hash(bundle.to_ron_string().as_bytes())
 }
 
 /// Every method's episodes 0..3 on `map` zero-shot, and the scaled agent's episode 5 of a
 /// continual run (after learning from episodes 0..5).
-fn episodes_digest(map: &unforeseen_sim::Map) -> String {
-    let bundle = common::bundle();
+fn episodes_digest(bundle: &AgentBundle, map: &unforeseen_sim::Map) -> String {
     let params = ScaledParams::default();
     let mut out = String::new();
     let methods = [
@@ -112,21 +113,72 @@ fn noisy_jaywalk() -> unforeseen_sim::Map {
     unforeseen_sim::Map::from_str_named("noisy_jaywalk.ron", text, &embedded).expect("valid map")
 }
 
-#[test]
-fn trained_agent_and_decisions_are_unchanged() {
-    let agent = agent_digest();
-    let intersection = episodes_digest(&unforeseen::maps::load("intersection").unwrap());
-    let jaywalk = episodes_digest(&unforeseen::maps::load("jaywalk").unwrap());
-    let noisy = episodes_digest(&noisy_jaywalk());
-    let got = [agent.as_str(), intersection.as_str(), jaywalk.as_str(), noisy.as_str()];
-    assert_eq!(got, GOLDEN, "agent, intersection, jaywalk, noisy jaywalk digests");
+/// The agent's digest and its episodes' on the intersection, the jaywalk and the noisy
+/// jaywalk.
+fn digests(bundle: &AgentBundle) -> [String; 4] {
+    [
+        agent_digest(bundle),
+        episodes_digest(bundle, &unforeseen::maps::load("intersection").unwrap()),
+        episodes_digest(bundle, &unforeseen::maps::load("jaywalk").unwrap()),
+        episodes_digest(bundle, &noisy_jaywalk()),
+    ]
 }
 
-/// Digests of [`trained_agent_and_decisions_are_unchanged`]: the agent, then the episodes
-/// on the intersection, the jaywalk and the noisy jaywalk.
-const GOLDEN: [&str; 4] = [
+/// Training with time-outs taken as terminal states reproduces the agent, and every
+/// decision, of the code before the episode API (`Env`): the digests below were
+/// recorded on that code.
+#[test]
+fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
+    let map = unforeseen::maps::load("intersection").unwrap();
+    let mut cfg = common::small_config(7);
+    cfg.timeout_as = TimeoutAs::Termination;
+    let (bundle, _) = train(&map, &cfg).unwrap();
+    assert_eq!(digests(&bundle), GOLDEN_TIMEOUT_AS_TERMINATION);
+}
+
+/// The default training (time-outs truncate: the learners bootstrap through them). None of
+/// this agent's training episodes times out, so it is the agent of before too (the two
+/// settings differ where episodes time out: `timeouts_truncate_and_learners_bootstrap`).
+#[test]
+fn trained_agent_and_decisions_are_unchanged() {
+    let map = unforeseen::maps::load("intersection").unwrap();
+    let (_, log) = train(&map, &common::small_config(7)).unwrap();
+    assert_eq!(log.timeouts, 0);
+    assert_eq!(digests(common::bundle()), GOLDEN);
+}
+
+/// On a map whose episodes often time out (the tiny map: 12 ticks), the two settings
+/// train different agents: a truncation is not terminal, so Bayesian RL records the
+/// transition it was instead of an absorbing one, and Q-learning bootstraps through it.
+#[test]
+fn timeouts_truncate_and_learners_bootstrap() {
+    let map = common::tiny_map();
+    let mut cfg = common::small_config(3);
+    cfg.episodes = 60;
+    let (truncating, log) = train(&map, &cfg).unwrap();
+    cfg.timeout_as = TimeoutAs::Termination;
+    let (terminating, log_t) = train(&map, &cfg).unwrap();
+    assert!(log.timeouts > 0, "the tiny map's episodes time out");
+    assert_eq!(
+        log.timeouts, log_t.timeouts,
+        "the same episodes (the exploration does not depend on the setting's effect)"
+    );
+    let terminal = |b: &AgentBundle| b.bayes_rl.terminal_counts().iter().sum::<f64>();
+    assert_eq!(
+        terminal(&terminating) - terminal(&truncating),
+        log.timeouts as f64,
+        "every time-out is one terminal transition more when taken as terminal"
+    );
+    assert_ne!(truncating.q_learning, terminating.q_learning);
+}
+
+/// Digests of [`timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before`].
+const GOLDEN_TIMEOUT_AS_TERMINATION: [&str; 4] = [
     "10356990b4c98627",
     "72e903b779f23fb4",
     "fd86969ccbedd97b",
     "35e3e279adc323a8",
 ];
+
+/// Digests of [`trained_agent_and_decisions_are_unchanged`].
+const GOLDEN: [&str; 4] = GOLDEN_TIMEOUT_AS_TERMINATION;

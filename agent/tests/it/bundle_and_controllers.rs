@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 use unforeseen_agent::bayes_rl::BayesRl;
-use unforeseen_agent::controller::Controller;
+use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_agent::error::{InspectError, PersistError};
 use unforeseen_agent::inspect::inspect_json;
 use unforeseen_agent::model::WorldModel;
@@ -110,7 +110,7 @@ fn controllers_share_the_trait() {
             assert!(dec.action < 3);
             assert!((dec.policy.iter().sum::<f64>() - 1.0).abs() < 1e-9, "{}", m.name());
             reasoned += dec.reasoned as usize;
-            m.observe(1.0, st.encode(&[d - 1, 1, 1, 0]), d == 1);
+            m.observe(1.0, st.encode(&[d - 1, 1, 1, 0]), Ending::from_flags(d == 1, false));
         }
         // A jaywalker appears on green: unforeseen for the scaled agent.
         let dec = m.act(st.encode(&[2, 1, 1, 1]));
