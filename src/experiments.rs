@@ -251,13 +251,11 @@ pub fn learn(
 ) -> anyhow::Result<Vec<LearnPoint>> {
     let disc = Discretizer::new(&map.bins)?;
     check_compatible(bundle, map)?;
-    let mut agent = crate::methods::scaled_agent(
-        bundle,
-        ScaledParams {
-            learning: true,
-            ..params.clone()
-        },
-    )?;
+    let mut agent = crate::methods::scaled_agent(bundle, {
+        let mut p = params.clone();
+        p.learning.enabled = true;
+        p
+    })?;
     let bar = progress::bar(episodes, "learning", quiet);
     let mut event_state: Option<usize> = None;
     let mut points = Vec::new();
