@@ -11,7 +11,7 @@ use unforeseen_agent::params::ScaledParams;
 
 use crate::error::Error;
 
-/// The keys `--set` accepts, in table order (derived from [`ScaledParams`]'s fields).
+/// The keys `--set` accepts, sorted by group, then key (derived from [`ScaledParams`]'s fields).
 pub fn keys() -> Vec<&'static str> {
     param_table::key_names()
 }

@@ -54,7 +54,7 @@ fn tree(p: &ScaledParams) -> Value {
     serde_json::to_value(p).unwrap_or(Value::Null)
 }
 
-/// Every parameter, in the order of the groups and their fields.
+/// Every parameter, sorted by group, then by key (the order of the serialized object).
 pub fn keys() -> &'static [Key] {
     static KEYS: OnceLock<Vec<Key>> = OnceLock::new();
     KEYS.get_or_init(|| {
@@ -73,7 +73,7 @@ pub fn keys() -> &'static [Key] {
     })
 }
 
-/// Every key (flat), in table order: what `--set` and error messages list.
+/// Every key (flat), in the order of [`keys`]: what `--set` and error messages list.
 pub fn key_names() -> Vec<&'static str> {
     keys().iter().map(|k| k.name.as_str()).collect()
 }
