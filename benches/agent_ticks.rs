@@ -39,11 +39,9 @@ fn reasoning_tick(c: &mut Criterion, bundle: &AgentBundle) {
     for (group, untimed_ticks) in [("reasoning_tick", 0), ("reasoning_tick_mid", 3)] {
         let mut g = c.benchmark_group(group);
         for h in 1..=5 {
-            let params = ScaledParams {
-                reasoning: ReasoningMode::Always,
-                horizon: h,
-                ..ScaledParams::default()
-            };
+            let mut params = ScaledParams::default();
+            params.scaling.reasoning = ReasoningMode::Always;
+            params.planning.horizon = h;
             let mut a = agent(bundle, params);
             g.bench_with_input(BenchmarkId::from_parameter(h), &h, |b, _| {
                 b.iter_custom(|iters| {
@@ -82,10 +80,8 @@ fn reasoning_tick_replay(c: &mut Criterion, bundle: &AgentBundle) {
     let maps = jaywalk_family().expect("jaywalk family");
     let mut g = c.benchmark_group("reasoning_tick_replay");
     for h in 1..=5 {
-        let params = ScaledParams {
-            horizon: h,
-            ..ScaledParams::default()
-        };
+        let mut params = ScaledParams::default();
+        params.planning.horizon = h;
         let rec = record(bundle, &params, &maps, REPLAY_EPISODES, 7).expect("recording");
         let mut a = agent(bundle, params);
         let mut fastest: Option<TickTimes> = None;
@@ -159,13 +155,9 @@ fn feedforward_tick(c: &mut Criterion, bundle: &AgentBundle) {
         }
         o = step.observation.index().expect("discrete");
     }
-    let mut a = agent(
-        bundle,
-        ScaledParams {
-            epsilon: 0.999,
-            ..ScaledParams::default()
-        },
-    );
+    let mut never = ScaledParams::default();
+    never.gate.epsilon = 0.999;
+    let mut a = agent(bundle, never);
     a.begin_episode(0);
     let ff = chain.iter().map(|o| a.act(*o)).skip(1).filter(|d| !d.reasoned).count();
     eprintln!(
@@ -292,22 +284,15 @@ fn reasoning_tick_states(c: &mut Criterion) {
         for (kind, structure) in models {
             let m = synthetic_model(structure, &mut rng);
             assert_eq!(m.generative().factored.is_some(), kind == "factored");
-            let q = QLearning::new(n, 3, QParams::default());
+            let q = QLearning::new(n, 3, QParams::default()).expect("Q-table");
             // The flat model has no pedestrian factor to gate on or to pool (reasoning is
             // forced anyway): one-step gate, no persistence pooling.
-            let params = if kind == "dense" {
-                ScaledParams {
-                    reasoning: ReasoningMode::Always,
-                    gate: GateMode::OneStep,
-                    persistence_ignores: String::new(),
-                    ..ScaledParams::default()
-                }
-            } else {
-                ScaledParams {
-                    reasoning: ReasoningMode::Always,
-                    ..ScaledParams::default()
-                }
-            };
+            let mut params = ScaledParams::default();
+            params.scaling.reasoning = ReasoningMode::Always;
+            if kind == "dense" {
+                params.gate.mode = GateMode::OneStep;
+                params.planning.persistence_ignores = String::new();
+            }
             let mut a = ScaledAgent::new(m, &q, params).expect("agent");
             let obs = n / 2 + 1;
             g.bench_with_input(BenchmarkId::new(kind, format!("{n}_{label}")), &obs, |b, obs| {

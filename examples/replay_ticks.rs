@@ -77,13 +77,9 @@ fn main() -> anyhow::Result<()> {
             train(&map, &cfg)?.0
         }
     };
-    let params = unforeseen::cli::params::apply(
-        ScaledParams {
-            horizon,
-            ..ScaledParams::default()
-        },
-        &sets,
-    )?;
+    let mut base = ScaledParams::default();
+    base.planning.horizon = horizon;
+    let params = unforeseen::cli::params::apply(base, &sets)?;
     let maps = jaywalk_family()?;
     let started = Instant::now();
     let rec = record(&bundle, &params, &maps, episodes, seed)?;

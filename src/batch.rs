@@ -20,6 +20,7 @@ use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+use unforeseen_agent::param_table;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::{Map, MethodName};
 
@@ -63,7 +64,8 @@ impl ParamSet {
 pub const MAX_PARAM_SETS: usize = 10_000;
 
 /// Expands `--set key=v1,v2` options into the cross product of parameter sets, in the
-/// order the options were given (the last varies fastest).
+/// order the options were given (the last varies fastest). Values equal after parsing
+/// (`omega=0.5,5e-1`) count once, in the order of their first occurrence.
 /// At most [`MAX_PARAM_SETS`] sets.
 pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
     let mut out = vec![ParamSet(Vec::new())];
@@ -74,26 +76,37 @@ pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
             .split_once('=')
             .ok_or_else(|| Error::flag(&flag, "expected KEY=V1,V2,..., e.g. --set horizon=1,2,3"))?;
         let key = key.trim();
-        if keys.contains(&key) {
+        // `epsilon` and `gate.epsilon` are one parameter.
+        let canonical = param_table::lookup(key).map_or(key, |k| k.name.as_str());
+        if keys.contains(&canonical) {
             return Err(Error::flag(
                 &flag,
                 format!("`{key}` is set twice; give all its values in one --set, e.g. --set {key}=1,2"),
             ));
         }
-        keys.push(key);
-        let values: Vec<&str> = values.split(',').map(str::trim).collect();
-        if values.iter().any(|v| v.is_empty()) {
+        keys.push(canonical);
+        let listed: Vec<&str> = values.split(',').map(str::trim).collect();
+        if listed.iter().any(|v| v.is_empty()) {
             return Err(Error::flag(
                 &flag,
                 format!("an empty value; separate values by single commas, e.g. --set {key}=1,2"),
             ));
         }
-        if let Some(v) = values
-            .iter()
-            .enumerate()
-            .find_map(|(i, v)| values[..i].contains(v).then_some(v))
-        {
-            return Err(Error::flag(&flag, format!("the value {v} is listed twice")));
+        // Equal values (after parsing: `0.5` and `5e-1`) give one parameter set, the first
+        // spelling kept. A value that does not parse on its own is kept as written: the
+        // error, if any, comes when the sets are applied.
+        let parsed = |v: &str| {
+            let mut p = ScaledParams::default();
+            p.set_str(key, v).and_then(|()| p.get(key)).ok()
+        };
+        let mut values: Vec<&str> = Vec::new();
+        let mut seen: Vec<Result<serde_json::Value, &str>> = Vec::new();
+        for v in listed {
+            let id = parsed(v).ok_or(v);
+            if !seen.contains(&id) {
+                seen.push(id);
+                values.push(v);
+            }
         }
         if out.len().saturating_mul(values.len()) > MAX_PARAM_SETS {
             return Err(Error::flag(
@@ -451,7 +464,7 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine
         &hidden,
     )?;
     let agg = Aggregate::of(&results);
-    let tree: usize = (1..=params.horizon).map(|k| 3usize.pow(k as u32)).sum();
+    let tree: usize = (1..=params.planning.horizon).map(|k| 3usize.pow(k as u32)).sum();
     let plans_by_efe = unit.method.is_scaled();
     Ok(ResultLine {
         unit: unit.index,

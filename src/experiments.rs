@@ -250,13 +250,11 @@ pub fn learn(
     let mut env = Env::new(map, EnvConfig::default())?;
     let disc = env.discretizer().clone();
     check_compatible(bundle, map)?;
-    let mut agent = crate::methods::scaled_agent(
-        bundle,
-        ScaledParams {
-            learning: true,
-            ..params.clone()
-        },
-    )?;
+    let mut agent = crate::methods::scaled_agent(bundle, {
+        let mut p = params.clone();
+        p.learning.enabled = true;
+        p
+    })?;
     let bar = progress::bar(episodes, "learning", quiet);
     let mut event_state: Option<usize> = None;
     let mut points = Vec::new();

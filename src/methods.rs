@@ -117,7 +117,7 @@ impl Method {
     pub fn learns_across_episodes(self, params: &ScaledParams) -> bool {
         match self {
             Method::Scaled | Method::ScaledAlways | Method::ScaledOneStepGate | Method::ScaledGateLearnsAll => {
-                params.learning
+                params.learning.enabled
             }
             Method::ScaledNoLearning | Method::QLearning => false,
             Method::BrakeOnPedestrian | Method::NeverBrake => false,
@@ -149,6 +149,12 @@ impl Method {
         let scaled = |params: ScaledParams| -> anyhow::Result<Box<dyn Controller>> {
             Ok(Box::new(scaled_agent(bundle, params)?))
         };
+        // An ablation: the given parameters with one changed.
+        let ablation = |change: fn(&mut ScaledParams)| {
+            let mut p = params.clone();
+            change(&mut p);
+            scaled(p)
+        };
         Ok(match self {
             Method::QLearning => Box::new(bundle.q_learning.clone()),
             Method::BayesRl => Box::new(bundle.bayes_rl.clone()),
@@ -157,22 +163,10 @@ impl Method {
                 fix: "retrain it with `unforeseen train`".into(),
             })?),
             Method::Scaled => scaled(params.clone())?,
-            Method::ScaledAlways => scaled(ScaledParams {
-                reasoning: ReasoningMode::Always,
-                ..params.clone()
-            })?,
-            Method::ScaledNoLearning => scaled(ScaledParams {
-                learning: false,
-                ..params.clone()
-            })?,
-            Method::ScaledOneStepGate => scaled(ScaledParams {
-                gate: GateMode::OneStep,
-                ..params.clone()
-            })?,
-            Method::ScaledGateLearnsAll => scaled(ScaledParams {
-                gate_learning: GateLearning::Every,
-                ..params.clone()
-            })?,
+            Method::ScaledAlways => ablation(|p| p.scaling.reasoning = ReasoningMode::Always)?,
+            Method::ScaledNoLearning => ablation(|p| p.learning.enabled = false)?,
+            Method::ScaledOneStepGate => ablation(|p| p.gate.mode = GateMode::OneStep)?,
+            Method::ScaledGateLearnsAll => ablation(|p| p.gate.gate_learning = GateLearning::Every)?,
             Method::BrakeOnPedestrian | Method::NeverBrake => {
                 let sizes = bundle.world_model.structure().sizes();
                 self.scripted_controller(&sizes)?

@@ -22,15 +22,13 @@ fn main() {
     let mut d0 = vec![0.0; 64];
     d0[st.encode(&[3, 1, 1, 0])] = 1.0;
     w.set_d(&d0).unwrap();
-    let q = QLearning::new(64, 3, QParams::default());
+    let q = QLearning::new(64, 3, QParams::default()).unwrap();
     for (label, mode) in [
         ("triggered (feed-forward)", ReasoningMode::Triggered),
         ("always (reasoning, H=3)", ReasoningMode::Always),
     ] {
-        let params = ScaledParams {
-            reasoning: mode,
-            ..Default::default()
-        };
+        let mut params = ScaledParams::default();
+        params.scaling.reasoning = mode;
         let mut agent = ScaledAgent::new(w.clone(), &q, params).unwrap();
         let n = 20_000;
         let obs = [

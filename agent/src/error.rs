@@ -1,5 +1,6 @@
 //! Typed errors of the agent crate (`thiserror` in libraries; no panics on bad input).
 
+use std::borrow::Cow;
 use thiserror::Error;
 
 /// A hyperparameter outside its documented range (see the tables in [`crate::params`]).
@@ -10,18 +11,43 @@ pub struct ParamError {
     pub name: &'static str,
     /// The rejected value, formatted.
     pub value: String,
-    /// The valid range, in words, e.g. `"> 0"`.
-    pub expected: &'static str,
+    /// The valid range, in words, e.g. `"> 0"` (for a factor name, the model's names).
+    pub expected: Cow<'static, str>,
 }
 
 impl ParamError {
-    pub(crate) fn new(name: &'static str, value: impl ToString, expected: &'static str) -> Self {
+    pub(crate) fn new(name: &'static str, value: impl ToString, expected: impl Into<Cow<'static, str>>) -> Self {
         Self {
             name,
             value: value.to_string(),
-            expected,
+            expected: expected.into(),
         }
     }
+}
+
+/// A parameter of [`crate::params::ScaledParams`] set by name
+/// ([`crate::param_table`]) with an unknown key or a value it does not admit.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SetError {
+    /// No parameter has this key.
+    #[error("unknown parameter `{key}`; known: {}", known.join(", "))]
+    UnknownKey {
+        /// The key as given.
+        key: String,
+        /// Every key ([`crate::param_table::key_names`]).
+        known: Vec<&'static str>,
+    },
+    /// The value does not fit the parameter: `problem` states what is allowed (an enum's
+    /// values, a number's range and why).
+    #[error("parameter `{key}` = {value} is invalid: {problem}")]
+    BadValue {
+        /// The key as given.
+        key: String,
+        /// The value as given.
+        value: String,
+        /// What is wrong and what is allowed.
+        problem: String,
+    },
 }
 
 /// A stored value of the wrong shape or out of range, found when reading a persisted

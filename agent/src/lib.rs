@@ -6,7 +6,7 @@
 //! learning, and the two baselines (tabular Q-learning, Bayesian RL). All three methods
 //! implement [`controller::Controller`].
 //!
-//! Module map (named after the paper): [`maths`], [`params`], [`structure`], [`model`], [`transition`] (factored `B`),
+//! Module map (named after the paper): [`maths`], [`params`] (and [`param_table`], the scaled agent's parameters by name), [`structure`], [`model`], [`transition`] (factored `B`),
 //! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
 //! [`scaled`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
@@ -18,7 +18,7 @@
 //! let mut w = WorldModel::new(st.clone(), 3, &ModelPriors::default()).unwrap();
 //! w.observe_transition(st.encode(&[3, 1, 1, 0]), 0, st.encode(&[2, 1, 1, 0]));
 //! w.materialize();
-//! let q = QLearning::new(64, 3, QParams::default());
+//! let q = QLearning::new(64, 3, QParams::default()).unwrap();
 //! let mut agent = ScaledAgent::new(w, &q, ScaledParams::default()).unwrap();
 //! agent.begin_episode(1);
 //! let d = agent.act(st.encode(&[3, 1, 1, 0]));
@@ -34,6 +34,7 @@ pub mod learning;
 pub mod limits;
 pub mod maths;
 pub mod model;
+pub mod param_table;
 pub mod params;
 pub mod perception;
 pub mod persist;

@@ -1,12 +1,15 @@
 //! Hyperparameters in checked parameter types (linfa style: plain structs with
-//! documented defaults, `check()` returns a typed [`ParamError`] instead of panicking).
+//! documented defaults, `check()` returns a typed [`ParamError`] instead of panicking;
+//! for the scaled agent, `check()` returns the validated [`CheckedScaledParams`]).
 //!
 //! Every constructor that takes parameters ([`crate::model::WorldModel::new`],
 //! [`crate::scaled::ScaledAgent::new`], [`crate::bayes_rl::BayesRl::new`],
-//! [`crate::q_learning::QLearning::try_new`]) calls `check()` and returns the error.
-//! Defaults follow the paper's §VI where it states them.
+//! [`crate::q_learning::QLearning::new`]) calls `check()` and returns the error.
+//! Defaults follow the paper's §VI where it states them. The scaled agent's parameters
+//! are read and set by name through [`crate::param_table`].
 
 use crate::error::ParamError;
+use crate::structure::{Parent, Structure};
 use serde::{Deserialize, Serialize};
 
 fn in_half_open01(name: &'static str, x: f64) -> Result<(), ParamError> {
@@ -109,6 +112,7 @@ impl ModelPriors {
 
 /// How the scaled policy is computed (§IV Theorem 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
 pub enum ScalingMode {
     /// The iterative update of eq. "gradient_descent_equations" with eq. "stopping_criterion".
     #[default]
@@ -118,17 +122,22 @@ pub enum ScalingMode {
 }
 
 /// How the action is drawn from the policy acted upon (docs/ARCHITECTURE.md §4.9).
+/// By name also `sample=true|false` (see [`crate::param_table::ALIASES`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
 pub enum ActionSelection {
     /// The mode (ties: lowest index). Default in evaluation.
     #[default]
+    #[serde(alias = "false", alias = "no", alias = "0")]
     Mode,
     /// Sample with the agent's seeded ChaCha8 RNG.
+    #[serde(alias = "true", alias = "yes", alias = "1")]
     Sample,
 }
 
 /// When reasoning (VMP + planning + scaling) runs (§II footnote, §IV; ablation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
 pub enum ReasoningMode {
     /// Only when θ_t > ε (the paper's method).
     #[default]
@@ -139,6 +148,7 @@ pub enum ReasoningMode {
 
 /// What the reasoning trigger measures (§II, §VI; docs/ARCHITECTURE.md §4.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
 pub enum GateMode {
     /// Surprise on the state: `-ln P(x_t | parents_t)` of the watched factor (the paper's
     /// "surprise measured from the state space", Fig. 9a-b), see [`crate::gate`].
@@ -152,6 +162,7 @@ pub enum GateMode {
 /// How the gate's table learns a situation as familiar (§V applied to the gate;
 /// docs/ARCHITECTURE.md §4.4). Beyond the paper, whose rule is only `θ <= ε`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
 pub enum GateLearning {
     /// A reasoning tick counts in the gate's table with weight `π'(a_o) / max_u π'(u)`,
     /// where `a_o` is the habit's action after this episode's update of `ν`: a situation
@@ -166,6 +177,7 @@ pub enum GateLearning {
 /// What the trigger subtracts from the gate's surprise before `θ = 1 - exp(-Ω S)`
 /// ([`crate::gate::StateGate::excess_surprise`]). Beyond the paper, whose trigger reads `S`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
 pub enum GateBaseline {
     /// The surprise expected in the state, `c(s) H(row)`, where `c(s)` grows with the
     /// reasoning ticks in that state that endorsed the habit (full after `gate_memory`):
@@ -180,62 +192,114 @@ pub enum GateBaseline {
 /// Which model the EFE tree's first step from `q_t` goes through
 /// ([`crate::planning::EfeTree::evaluate`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
 pub enum RootStep {
     /// The learned `B`: the car observes `q_t` while the episode goes on, so from a
     /// crash-risk state braking out of it counts; later steps absorb.
     #[default]
     Learned,
-    /// Ablation (sessions 1-4): the planning model's, where episode-ending states are
-    /// absorbing from the root on, so every action from a crash-risk state ends alike.
+    /// Ablation: the planning model's, where episode-ending states are absorbing from
+    /// the root on, so every action from a crash-risk state ends alike.
     Absorbing,
 }
 
-/// Hyperparameters of the paper's agent ([`crate::scaled::ScaledAgent`]).
+/// Hyperparameters of the paper's agent ([`crate::scaled::ScaledAgent`]), grouped by the
+/// paper's concepts. Every parameter has a key (the name in the table below; the
+/// dotted `group.key` is accepted too) by which it is read and set
+/// ([`ScaledParams::get`], [`ScaledParams::set_str`], [`ScaledParams::set_value`],
+/// [`crate::param_table`]): the keys are those of the serialized groups, so a field added
+/// to a group is settable by name with no other edit.
 ///
-/// | field | default | range | paper |
-/// |---|---|---|---|
-/// | `omega` Ω | 0.425 | > 0 | §IV θ = 1 - exp(-Ω S), §VI |
-/// | `epsilon` ε | 0.2 | [0, 1) | §II reasoning trigger θ > ε, §VI |
-/// | `gamma` γ | 0.5 | > 0 | Cor. 1 q(π) = σ(-γG), §VI |
-/// | `varsigma` ς | 0.05 | >= 0 | eq. "stopping_criterion", §VI |
-/// | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
-/// | `max_scaling_iters` | 50 | 1..=10000 | cap of the scaling loop |
-/// | `horizon` H | 3 | 1..=8 | policy length (3^H policies) |
-/// | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks) |
-/// | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
-/// | `vmp_tol` | 1e-6 | > 0 | VMP convergence threshold on max |Δ q| |
-/// | `vmp_max_iters` | 32 | 1..=10000 | VMP iteration cap |
-/// | `scaling_mode` | Iterative | | Theorem 1 iterative / closed form |
-/// | `action_selection` | Mode | | mode or sample |
-/// | `reasoning` | Triggered | | triggered or always (ablation) |
-/// | `learning` | true | | test-time learning §V at episode end |
-/// | `learning_rate` | 1.0 | >= 0 | multiplies the expected counts added in §V |
-/// | `nu0` ν0 | 10.0 | > 0 | prior strength of ν = ν0 σ(Q/T) (docs/ARCHITECTURE.md §4.8) |
-/// | `nu_temperature` T | 1.0 | > 0 | temperature of ν's softmax over Q |
-/// | `gate` | State | | §VI surprise on the state, or the one-step joint surprise (ablation) |
-/// | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
-/// | `gate_memory` | 20.0 | > 0 (inf allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
-/// | `gate_learning` | Endorsed | | reasoning ticks count in the gate's table as far as the planner endorses the habit |
-/// | `gate_baseline` | Endorsed | | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `None` is the paper's trigger) |
-/// | `persistence_ignores` | `"d+L"` | next-time parents' names joined by `+`, or `""` | the watched factor's persistence (rows where it was present) is pooled over these parents in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
-/// | `root_step` | Learned | | the EFE tree's first step uses the learned `B`, later steps the absorbing planning model ([`RootStep`]; `Absorbing` is sessions 1-4's planner) |
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+/// | group | key | default | range | paper |
+/// |---|---|---|---|---|
+/// | `gate` | `omega` Ω | 0.425 | finite and > 0 | §IV θ = 1 - exp(-Ω S), §VI |
+/// | `gate` | `epsilon` ε | 0.2 | [0, 1) | §II reasoning trigger θ > ε, §VI |
+/// | `gate` | `gate` | `state` | `state`, `one-step` | §VI surprise on the state, or the one-step joint surprise (ablation) ([`GateMode`]) |
+/// | `gate` | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
+/// | `gate` | `gate_memory` | 20.0 | > 0 (`inf` allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
+/// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
+/// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `none` is the paper's trigger) ([`GateBaseline`]) |
+/// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
+/// | `perception` | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
+/// | `perception` | `vmp_tol` | 1e-6 | finite and > 0 | VMP convergence threshold on max \|Δ q\| |
+/// | `perception` | `vmp_max_iters` | 32 | 1..=10000 | VMP iteration cap |
+/// | `planning` | `gamma` γ | 0.5 | finite and > 0 | Cor. 1 q(π) = σ(-γG), §VI |
+/// | `planning` | `horizon` H | 3 | 1..=8 | policy length (n_actions^H policies, Prop. 1) |
+/// | `planning` | `root_step` | `learned` | `learned`, `absorbing` | the EFE tree's first step uses the learned `B`, later steps the absorbing planning model ([`RootStep`]; `absorbing` absorbs from the root on) |
+/// | `planning` | `persistence_ignores` | `"d+L"` | next-time parents' names joined by `+`, or `""` (also written `none`) | the watched factor's persistence (rows where it was present) is pooled over these parents in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
+/// | `scaling` | `varsigma` ς | 0.05 | finite and >= 0 | eq. "stopping_criterion", §VI |
+/// | `scaling` | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
+/// | `scaling` | `max_scaling_iters` | 50 | 1..=10000 | cap of the scaling loop |
+/// | `scaling` | `scaling_mode` | `iterative` | `iterative`, `closed-form` | Theorem 1 iterative / closed form ([`ScalingMode`]) |
+/// | `scaling` | `action_selection` | `mode` | `mode`, `sample` | act on the mode of the policy or sample it ([`ActionSelection`]) |
+/// | `scaling` | `reasoning` | `triggered` | `triggered`, `always` | reason when θ > ε, or on every tick (ablation) ([`ReasoningMode`]) |
+/// | `learning` | `learning` | true | true, false | test-time learning §V at episode end |
+/// | `learning` | `learning_rate` | 1.0 | finite and >= 0 | multiplies the expected counts added in §V |
+/// | `learning` | `nu0` ν0 | 10.0 | finite and > 0 | prior strength of ν = ν0 σ(Q/T) (docs/ARCHITECTURE.md §4.8) |
+/// | `learning` | `nu_temperature` T | 1.0 | finite and > 0 | temperature of ν's softmax over Q |
+///
+/// Where each range is enforced: numbers and enum values when set by name and by
+/// [`ScaledParams::check`]; the spelling of `gate_factor` and `persistence_ignores` (names
+/// without spaces, `+` between names, no name twice, the watched factor not among the
+/// pooled ones) by `check`; that they name factors of the model (the watched factor, and
+/// next-time parents of it) only where a model is known, by
+/// [`CheckedScaledParams::check_factors`], which [`crate::scaled::ScaledAgent::new`] calls.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct ScaledParams {
+    /// The reasoning trigger (§II, §IV, §VI).
+    pub gate: GateParams,
+    /// VMP perception (§III).
+    pub perception: PerceptionParams,
+    /// EFE planning (§IV, Prop. 1, Cor. 1).
+    pub planning: PlanningParams,
+    /// Test-time policy scaling and action selection (§IV, Theorem 1).
+    pub scaling: ScalingParams,
+    /// Test-time learning (§V).
+    pub learning: LearningParams,
+}
+
+/// The reasoning trigger's parameters (table of [`ScaledParams`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GateParams {
     /// Ω, saturation of the normalised surprise.
     pub omega: f64,
     /// ε, reasoning threshold on θ.
     pub epsilon: f64,
-    /// γ, policy precision.
-    pub gamma: f64,
-    /// ς, stopping tolerance.
-    pub varsigma: f64,
-    /// Scaling step size in (0, 1].
-    pub kappa_pi: f64,
-    /// Maximum scaling iterations.
-    pub max_scaling_iters: u32,
-    /// Planning horizon H.
-    pub horizon: usize,
+    /// What the reasoning trigger measures (key `gate`).
+    #[serde(rename = "gate")]
+    pub mode: GateMode,
+    /// Name of the factor the state gate watches (given its next-time parents).
+    pub gate_factor: String,
+    /// Data counts each row of the state gate's table keeps (bounded memory; `inf`
+    /// is written as the string `"inf"`).
+    #[serde(with = "f64_or_inf")]
+    pub gate_memory: f64,
+    /// How the gate's table learns a situation as familiar.
+    pub gate_learning: GateLearning,
+    /// What the trigger subtracts from the gate's surprise.
+    pub gate_baseline: GateBaseline,
+}
+
+impl Default for GateParams {
+    fn default() -> Self {
+        Self {
+            omega: 0.425,
+            epsilon: 0.2,
+            mode: GateMode::State,
+            gate_factor: "p".into(),
+            gate_memory: 20.0,
+            gate_learning: GateLearning::Endorsed,
+            gate_baseline: GateBaseline::Endorsed,
+        }
+    }
+}
+
+/// VMP perception's parameters (table of [`ScaledParams`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PerceptionParams {
     /// VMP window W.
     pub vmp_window: usize,
     /// VMP step size κ.
@@ -244,110 +308,368 @@ pub struct ScaledParams {
     pub vmp_tol: f64,
     /// VMP iteration cap.
     pub vmp_max_iters: u32,
+}
+
+impl Default for PerceptionParams {
+    fn default() -> Self {
+        Self {
+            vmp_window: 4,
+            vmp_kappa: 1.0,
+            vmp_tol: 1e-6,
+            vmp_max_iters: 32,
+        }
+    }
+}
+
+/// EFE planning's parameters (table of [`ScaledParams`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PlanningParams {
+    /// γ, policy precision.
+    pub gamma: f64,
+    /// Planning horizon H.
+    pub horizon: usize,
+    /// The model of the EFE tree's first step.
+    pub root_step: RootStep,
+    /// The next-time parents the watched factor's persistence does not depend on, joined
+    /// by `+` (`""`: none; `"none"` is read as `""`).
+    #[serde(deserialize_with = "factor_list")]
+    pub persistence_ignores: String,
+}
+
+impl Default for PlanningParams {
+    fn default() -> Self {
+        Self {
+            gamma: 0.5,
+            horizon: 3,
+            root_step: RootStep::Learned,
+            persistence_ignores: "d+L".into(),
+        }
+    }
+}
+
+/// Policy scaling's parameters (table of [`ScaledParams`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ScalingParams {
+    /// ς, stopping tolerance.
+    pub varsigma: f64,
+    /// Scaling step size in (0, 1].
+    pub kappa_pi: f64,
+    /// Maximum scaling iterations.
+    pub max_scaling_iters: u32,
     /// Iterative or closed-form scaling.
     pub scaling_mode: ScalingMode,
     /// Mode or sample.
     pub action_selection: ActionSelection,
     /// Triggered or always.
     pub reasoning: ReasoningMode,
-    /// Test-time learning on/off.
-    pub learning: bool,
+}
+
+impl Default for ScalingParams {
+    fn default() -> Self {
+        Self {
+            varsigma: 0.05,
+            kappa_pi: 1.0,
+            max_scaling_iters: 50,
+            scaling_mode: ScalingMode::Iterative,
+            action_selection: ActionSelection::Mode,
+            reasoning: ReasoningMode::Triggered,
+        }
+    }
+}
+
+/// Test-time learning's parameters (table of [`ScaledParams`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LearningParams {
+    /// Test-time learning on/off (key `learning`).
+    #[serde(rename = "learning")]
+    pub enabled: bool,
     /// Test-time learning rate.
     pub learning_rate: f64,
     /// ν0, prior strength of the policy counts.
     pub nu0: f64,
     /// T, temperature of the Q softmax that initialises ν.
     pub nu_temperature: f64,
-    /// What the reasoning trigger measures.
-    pub gate: GateMode,
-    /// Name of the factor the state gate watches (given its next-time parents).
-    pub gate_factor: String,
-    /// Data counts each row of the state gate's table keeps (bounded memory).
-    pub gate_memory: f64,
-    /// How the gate's table learns a situation as familiar.
-    pub gate_learning: GateLearning,
-    /// What the trigger subtracts from the gate's surprise.
-    pub gate_baseline: GateBaseline,
-    /// The next-time parents the watched factor's persistence does not depend on, joined
-    /// by `+` (`""`: none).
-    pub persistence_ignores: String,
-    /// The model of the EFE tree's first step.
-    pub root_step: RootStep,
 }
 
-impl Default for ScaledParams {
+impl Default for LearningParams {
     fn default() -> Self {
         Self {
-            omega: 0.425,
-            epsilon: 0.2,
-            gamma: 0.5,
-            varsigma: 0.05,
-            kappa_pi: 1.0,
-            max_scaling_iters: 50,
-            horizon: 3,
-            vmp_window: 4,
-            vmp_kappa: 1.0,
-            vmp_tol: 1e-6,
-            vmp_max_iters: 32,
-            scaling_mode: ScalingMode::Iterative,
-            action_selection: ActionSelection::Mode,
-            reasoning: ReasoningMode::Triggered,
-            learning: true,
+            enabled: true,
             learning_rate: 1.0,
             nu0: 10.0,
             nu_temperature: 1.0,
-            gate: GateMode::State,
-            gate_factor: "p".into(),
-            gate_memory: 20.0,
-            gate_learning: GateLearning::Endorsed,
-            gate_baseline: GateBaseline::Endorsed,
-            persistence_ignores: "d+L".into(),
-            root_step: RootStep::Learned,
         }
     }
 }
 
+/// `gate_memory`: a number, or `"inf"` (JSON has no infinity).
+mod f64_or_inf {
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+
+    pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if x.is_finite() {
+            s.serialize_f64(*x)
+        } else {
+            s.serialize_str(&x.to_string())
+        }
+    }
+
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Repr {
+        Number(f64),
+        Text(String),
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        match Repr::deserialize(d)? {
+            Repr::Number(x) => Ok(x),
+            Repr::Text(t) => t
+                .trim()
+                .parse()
+                .map_err(|_| D::Error::custom(format!("'{t}' is not a number (or inf)"))),
+        }
+    }
+}
+
+/// `persistence_ignores`: `"none"` is read as `""` (no pooling).
+fn factor_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    let s = String::deserialize(d)?;
+    Ok(if s.trim() == "none" { String::new() } else { s })
+}
+
+/// The range of one numeric parameter of [`ScaledParams`], as [`ScaledParams::check`]
+/// enforces it and error messages state it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bound {
+    /// Finite and > 0.
+    Positive,
+    /// Finite and >= 0.
+    NonNegative,
+    /// In (0, 1].
+    HalfOpenUnit,
+    /// In [0, 1).
+    BelowOne,
+    /// > 0, infinity allowed.
+    PositiveOrInf,
+    /// A whole number in `1..=max`: counts that size an allocation or a loop, so that no
+    /// setting asks for more memory or time than a run has.
+    Count {
+        /// Largest value.
+        max: usize,
+        /// The range and why, e.g. `"in 1..=1000 (...)"`.
+        expected: &'static str,
+    },
+}
+
+impl Bound {
+    /// The range in words, as error messages give it.
+    pub fn expected(self) -> &'static str {
+        match self {
+            Bound::Positive => "finite and > 0",
+            Bound::NonNegative => "finite and >= 0",
+            Bound::HalfOpenUnit => "in (0, 1]",
+            Bound::BelowOne => "in [0, 1)",
+            Bound::PositiveOrInf => "> 0 (inf for unbounded)",
+            Bound::Count { expected, .. } => expected,
+        }
+    }
+
+    /// Whether `x` is in range (a count must be whole).
+    pub fn admits(self, x: f64) -> bool {
+        match self {
+            Bound::Positive => x > 0.0 && x.is_finite(),
+            Bound::NonNegative => x >= 0.0 && x.is_finite(),
+            Bound::HalfOpenUnit => x > 0.0 && x <= 1.0,
+            Bound::BelowOne => (0.0..1.0).contains(&x),
+            Bound::PositiveOrInf => x > 0.0,
+            Bound::Count { max, .. } => x.fract() == 0.0 && x >= 1.0 && x <= max as f64,
+        }
+    }
+}
+
+/// Largest planning horizon: the EFE tree evaluates `n_actions^H` policies per reasoning tick.
+pub const MAX_HORIZON: usize = 8;
+
 impl ScaledParams {
-    /// Validate ranges (table above).
-    pub fn check(&self) -> Result<(), ParamError> {
-        positive("omega", self.omega)?;
-        if !(0.0..1.0).contains(&self.epsilon) {
-            return Err(ParamError::new("epsilon", self.epsilon, "in [0, 1)"));
+    /// Every numeric parameter's key, value and range (the table above).
+    pub fn bounds(&self) -> [(&'static str, f64, Bound); 15] {
+        let (g, pe, pl, s, l) = (
+            &self.gate,
+            &self.perception,
+            &self.planning,
+            &self.scaling,
+            &self.learning,
+        );
+        let count = |max, expected| Bound::Count { max, expected };
+        [
+            ("omega", g.omega, Bound::Positive),
+            ("epsilon", g.epsilon, Bound::BelowOne),
+            ("gate_memory", g.gate_memory, Bound::PositiveOrInf),
+            (
+                "vmp_window",
+                pe.vmp_window as f64,
+                count(
+                    MAX_VMP_WINDOW,
+                    "in 1..=1000 (the perception keeps a belief per tick of the window)",
+                ),
+            ),
+            ("vmp_kappa", pe.vmp_kappa, Bound::HalfOpenUnit),
+            ("vmp_tol", pe.vmp_tol, Bound::Positive),
+            (
+                "vmp_max_iters",
+                f64::from(pe.vmp_max_iters),
+                count(MAX_ITERATIONS, "in 1..=10000 (VMP runs on every reasoning tick)"),
+            ),
+            ("gamma", pl.gamma, Bound::Positive),
+            (
+                "horizon",
+                pl.horizon as f64,
+                count(
+                    MAX_HORIZON,
+                    "in 1..=8 (the planner evaluates n_actions^H policies on every reasoning tick)",
+                ),
+            ),
+            ("varsigma", s.varsigma, Bound::NonNegative),
+            ("kappa_pi", s.kappa_pi, Bound::HalfOpenUnit),
+            (
+                "max_scaling_iters",
+                f64::from(s.max_scaling_iters),
+                count(
+                    MAX_ITERATIONS,
+                    "in 1..=10000 (the scaling loop runs on every reasoning tick)",
+                ),
+            ),
+            ("learning_rate", l.learning_rate, Bound::NonNegative),
+            ("nu0", l.nu0, Bound::Positive),
+            ("nu_temperature", l.nu_temperature, Bound::Positive),
+        ]
+    }
+
+    /// The range of the numeric parameter `key` (a flat key), if it is one.
+    pub fn bound_of(key: &str) -> Option<Bound> {
+        ScaledParams::default()
+            .bounds()
+            .into_iter()
+            .find(|(k, _, _)| *k == key)
+            .map(|(_, _, b)| b)
+    }
+
+    /// Every violation of the table's ranges and of the factor names' spelling, in
+    /// table order.
+    pub(crate) fn problems(&self) -> Vec<ParamError> {
+        let mut out: Vec<ParamError> = self
+            .bounds()
+            .into_iter()
+            .filter(|(_, x, b)| !b.admits(*x))
+            .map(|(k, x, b)| ParamError::new(k, x, b.expected()))
+            .collect();
+        let factor = &self.gate.gate_factor;
+        let bad_name = |n: &str| n.is_empty() || n.contains('+') || n.chars().any(char::is_whitespace);
+        if bad_name(factor) {
+            out.push(ParamError::new(
+                "gate_factor",
+                format!("{factor:?}"),
+                "a factor's name (not empty, no spaces, no `+`)",
+            ));
         }
-        positive("gamma", self.gamma)?;
-        non_negative("varsigma", self.varsigma)?;
-        in_half_open01("kappa_pi", self.kappa_pi)?;
-        at_most(
-            "max_scaling_iters",
-            self.max_scaling_iters as usize,
-            MAX_ITERATIONS,
-            "in 1..=10000 (the scaling loop runs on every reasoning tick)",
-        )?;
-        if !(1..=8).contains(&self.horizon) {
-            return Err(ParamError::new("horizon", self.horizon, "in 1..=8"));
+        let ignores = &self.planning.persistence_ignores;
+        if !ignores.is_empty() {
+            let names: Vec<&str> = ignores.split('+').collect();
+            let twice = names.iter().enumerate().any(|(i, n)| names[..i].contains(n));
+            if names.iter().any(|n| bad_name(n)) || twice || names.contains(&factor.as_str()) {
+                out.push(ParamError::new(
+                    "persistence_ignores",
+                    format!("{ignores:?}"),
+                    "factor names joined by `+` (no spaces, none twice, not gate_factor), or \"\" / none",
+                ));
+            }
         }
-        at_most(
-            "vmp_window",
-            self.vmp_window,
-            MAX_VMP_WINDOW,
-            "in 1..=1000 (the perception keeps a belief per tick of the window)",
-        )?;
-        in_half_open01("vmp_kappa", self.vmp_kappa)?;
-        positive("vmp_tol", self.vmp_tol)?;
-        at_most(
-            "vmp_max_iters",
-            self.vmp_max_iters as usize,
-            MAX_ITERATIONS,
-            "in 1..=10000 (VMP runs on every reasoning tick)",
-        )?;
-        non_negative("learning_rate", self.learning_rate)?;
-        positive("nu0", self.nu0)?;
-        positive("nu_temperature", self.nu_temperature)?;
-        if self.gate_memory.is_nan() || self.gate_memory <= 0.0 {
+        out
+    }
+
+    /// Validate ranges (table above) without consuming the parameters.
+    pub fn check_ref(&self) -> Result<(), ParamError> {
+        match self.problems().into_iter().next() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    /// Validate ranges (table above) and return the checked parameters the agent is built from.
+    pub fn check(self) -> Result<CheckedScaledParams, ParamError> {
+        self.check_ref()?;
+        Ok(CheckedScaledParams(self))
+    }
+}
+
+/// [`ScaledParams`] whose ranges have been checked ([`ScaledParams::check`]); read them
+/// through `Deref`. Whether the factor names fit a model is checked by
+/// [`CheckedScaledParams::check_factors`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct CheckedScaledParams(ScaledParams);
+
+impl std::ops::Deref for CheckedScaledParams {
+    type Target = ScaledParams;
+    fn deref(&self) -> &ScaledParams {
+        &self.0
+    }
+}
+
+impl TryFrom<ScaledParams> for CheckedScaledParams {
+    type Error = ParamError;
+    fn try_from(p: ScaledParams) -> Result<Self, ParamError> {
+        p.check()
+    }
+}
+
+impl CheckedScaledParams {
+    /// The parameters.
+    pub fn into_inner(self) -> ScaledParams {
+        self.0
+    }
+
+    /// Checks the factor names against a model's structure: `gate_factor` names a
+    /// factor (when the state gate or the pooling uses it) and every name of
+    /// `persistence_ignores` is a next-time parent of it. The error names the key and
+    /// the names allowed.
+    pub fn check_factors(&self, structure: &Structure) -> Result<(), ParamError> {
+        let factors = structure.factors();
+        let (name, ignores) = (&self.gate.gate_factor, &self.planning.persistence_ignores);
+        if self.gate.mode != GateMode::State && ignores.is_empty() {
+            return Ok(());
+        }
+        let Some(f) = factors.iter().position(|f| &f.name == name) else {
+            let names: Vec<&str> = factors.iter().map(|f| f.name.as_str()).collect();
             return Err(ParamError::new(
-                "gate_memory",
-                self.gate_memory,
-                "> 0 (inf for unbounded)",
+                "gate_factor",
+                format!("{name:?}"),
+                format!("one of the model's factors: {}", names.join(", ")),
+            ));
+        };
+        if ignores.is_empty() {
+            return Ok(());
+        }
+        let parents: Vec<&str> = factors[f]
+            .parents
+            .iter()
+            .filter_map(|p| match p {
+                Parent::Next(g) => Some(factors[*g].name.as_str()),
+                Parent::Prev(_) => None,
+            })
+            .collect();
+        if ignores.split('+').any(|n| !parents.contains(&n)) {
+            return Err(ParamError::new(
+                "persistence_ignores",
+                format!("{ignores:?}"),
+                format!(
+                    "next-time parents of `{name}` joined by `+` (of: {}), or \"\" / none",
+                    parents.join(", ")
+                ),
             ));
         }
         Ok(())
@@ -400,7 +722,7 @@ impl Default for QParams {
 
 impl QParams {
     /// Validate ranges (table above; `bias_action` is checked against `n_actions` by
-    /// [`crate::q_learning::QLearning::try_new`]).
+    /// [`crate::q_learning::QLearning::new`]).
     pub fn check(&self) -> Result<(), ParamError> {
         in_half_open01("alpha", self.alpha)?;
         in_closed01("discount", self.discount)?;
@@ -523,9 +845,11 @@ mod tests {
 
     #[test]
     fn defaults_are_valid_and_match_paper() {
-        let p = ScaledParams::default();
-        p.check().unwrap();
-        assert_eq!((p.omega, p.epsilon, p.gamma, p.varsigma), (0.425, 0.2, 0.5, 0.05));
+        let p = ScaledParams::default().check().unwrap();
+        assert_eq!(
+            (p.gate.omega, p.gate.epsilon, p.planning.gamma, p.scaling.varsigma),
+            (0.425, 0.2, 0.5, 0.05)
+        );
         QParams::default().check().unwrap();
         BayesRlParams::default().check().unwrap();
         ModelPriors::default().check().unwrap();
@@ -533,10 +857,8 @@ mod tests {
 
     #[test]
     fn invalid_values_are_typed_errors() {
-        let p = ScaledParams {
-            omega: -1.0,
-            ..Default::default()
-        };
+        let mut p = ScaledParams::default();
+        p.gate.omega = -1.0;
         assert_eq!(p.check().unwrap_err().name, "omega");
         let q = QParams {
             alpha: 0.0,

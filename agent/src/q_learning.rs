@@ -80,27 +80,10 @@ impl TryFrom<QLearningRepr> for QLearning {
 }
 
 impl QLearning {
-    /// A table with `Q = 0` except `Q[s, bias_action] = bias` (§VI). Never panics: an
-    /// out-of-range `bias_action` is ignored; validate with [`QParams::check`] or use
-    /// [`QLearning::try_new`] for typed errors.
-    pub fn new(n_states: usize, n_actions: usize, params: QParams) -> QLearning {
-        let mut table = vec![0.0; n_states * n_actions];
-        if let Some(b) = params.bias_action.filter(|b| *b < n_actions) {
-            for s in 0..n_states {
-                table[s * n_actions + b] = params.bias;
-            }
-        }
-        QLearning {
-            n_states,
-            n_actions,
-            epsilon: params.epsilon,
-            params,
-            table,
-        }
-    }
-
-    /// Like [`QLearning::new`] but checks the parameters and sizes.
-    pub fn try_new(n_states: usize, n_actions: usize, params: QParams) -> Result<QLearning, AgentError> {
+    /// A table with `Q = 0` except `Q[s, bias_action] = bias` (§VI), after checking the
+    /// parameters ([`QParams::check`]), the sizes (at least one state and one action) and
+    /// `bias_action < n_actions`.
+    pub fn new(n_states: usize, n_actions: usize, params: QParams) -> Result<QLearning, AgentError> {
         params.check()?;
         if n_states == 0 {
             return Err(ParamError::new("n_states", 0, ">= 1").into());
@@ -111,7 +94,24 @@ impl QLearning {
         if let Some(b) = params.bias_action.filter(|b| *b >= n_actions) {
             return Err(ParamError::new("bias_action", b, "< n_actions").into());
         }
-        Ok(QLearning::new(n_states, n_actions, params))
+        let mut table = vec![0.0; n_states * n_actions];
+        if let Some(b) = params.bias_action {
+            for s in 0..n_states {
+                table[s * n_actions + b] = params.bias;
+            }
+        }
+        Ok(QLearning {
+            n_states,
+            n_actions,
+            epsilon: params.epsilon,
+            params,
+            table,
+        })
+    }
+
+    /// The same as [`QLearning::new`] (the name earlier callers use).
+    pub fn try_new(n_states: usize, n_actions: usize, params: QParams) -> Result<QLearning, AgentError> {
+        QLearning::new(n_states, n_actions, params)
     }
 
     /// Number of states.

@@ -20,7 +20,8 @@ use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{
-    ActionSelection, GateBaseline, GateLearning, GateMode, ReasoningMode, RootStep, ScaledParams, ScalingMode,
+    ActionSelection, CheckedScaledParams, GateBaseline, GateLearning, GateMode, ReasoningMode, RootStep, ScaledParams,
+    ScalingMode,
 };
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s_into};
@@ -59,7 +60,7 @@ pub struct ReasoningTrace {
 #[derive(Debug, Clone)]
 pub struct ScaledAgent {
     model: WorldModel,
-    params: ScaledParams,
+    params: CheckedScaledParams,
     n_states: usize,
     n_actions: usize,
     /// Policy counts `ν`, `[s * n_actions + u]`.
@@ -90,17 +91,31 @@ pub struct ScaledAgent {
 
 impl ScaledAgent {
     /// Build the agent from a trained world model and Q-table: `ν = ν0 σ(Q[s,·]/T)` (docs/ARCHITECTURE.md §4.8).
-    pub fn new(mut model: WorldModel, q: &QLearning, params: ScaledParams) -> Result<ScaledAgent, AgentError> {
-        params.check()?;
-        let pooling = (!params.persistence_ignores.is_empty())
-            .then_some((params.gate_factor.as_str(), params.persistence_ignores.as_str()));
+    /// Checks `params` ([`ScaledParams::check`]) and builds the agent with
+    /// [`ScaledAgent::with_checked`].
+    pub fn new(model: WorldModel, q: &QLearning, params: ScaledParams) -> Result<ScaledAgent, AgentError> {
+        ScaledAgent::with_checked(model, q, params.check()?)
+    }
+
+    /// Build the agent from checked parameters; first checks their factor names against
+    /// the model ([`CheckedScaledParams::check_factors`]).
+    pub fn with_checked(
+        mut model: WorldModel,
+        q: &QLearning,
+        params: CheckedScaledParams,
+    ) -> Result<ScaledAgent, AgentError> {
+        params.check_factors(model.structure())?;
+        let pooling = (!params.planning.persistence_ignores.is_empty()).then_some((
+            params.gate.gate_factor.as_str(),
+            params.planning.persistence_ignores.as_str(),
+        ));
         model.set_persistence_pooling(pooling)?;
         let n = model.n_states();
         let na = model.n_actions();
-        if crate::limits::policies(na, params.horizon).is_none() {
+        if crate::limits::policies(na, params.planning.horizon).is_none() {
             return Err(crate::error::ParamError::new(
                 "horizon",
-                params.horizon,
+                params.planning.horizon,
                 "such that n_actions ^ horizon <= 65536 (limits::MAX_POLICIES)",
             )
             .into());
@@ -119,16 +134,20 @@ impl ScaledAgent {
                 found: q.n_actions(),
             });
         }
-        let nu = learning::nu_from_q(q.table(), na, params.nu0, params.nu_temperature);
-        let gate = match params.gate {
-            GateMode::State => Some(StateGate::from_model(&model, &params.gate_factor, params.gate_memory)?),
+        let nu = learning::nu_from_q(q.table(), na, params.learning.nu0, params.learning.nu_temperature);
+        let gate = match params.gate.mode {
+            GateMode::State => Some(StateGate::from_model(
+                &model,
+                &params.gate.gate_factor,
+                params.gate.gate_memory,
+            )?),
             GateMode::OneStep => None,
         };
         let n_obs = model.generative().n_obs();
         Ok(ScaledAgent {
-            tree: EfeTree::new(n, n_obs, na, params.horizon),
-            window_q: vec![vec![0.0; n]; params.vmp_window],
-            window_obs: Vec::with_capacity(params.vmp_window),
+            tree: EfeTree::new(n, n_obs, na, params.planning.horizon),
+            window_q: vec![vec![0.0; n]; params.perception.vmp_window],
+            window_obs: Vec::with_capacity(params.perception.vmp_window),
             rng: ChaCha8Rng::seed_from_u64(0),
             vmp_ws: VmpWorkspace::default(),
             s_hat: vec![0.0; n],
@@ -188,7 +207,7 @@ impl ScaledAgent {
     }
 
     fn select(&mut self, dist: &[f64]) -> usize {
-        match self.params.action_selection {
+        match self.params.scaling.action_selection {
             ActionSelection::Mode => argmax(dist),
             ActionSelection::Sample => {
                 let r: f64 = self.rng.random();
@@ -210,7 +229,7 @@ impl ScaledAgent {
         let gm = self.model.generative();
         let n = self.n_states;
         let t = self.hist_obs.len();
-        let w = self.params.vmp_window.min(t + 1);
+        let w = self.params.perception.vmp_window.min(t + 1);
         let first = t + 1 - w;
         // Prior of the first window slot.
         if first == 0 {
@@ -232,9 +251,9 @@ impl ScaledAgent {
             &self.window_obs,
             &self.hist_act[first..t],
             &mut self.window_q[..w],
-            self.params.vmp_kappa,
-            self.params.vmp_tol,
-            self.params.vmp_max_iters,
+            self.params.perception.vmp_kappa,
+            self.params.perception.vmp_tol,
+            self.params.perception.vmp_max_iters,
             &mut self.vmp_ws,
             None,
         );
@@ -248,12 +267,16 @@ impl ScaledAgent {
         // (module docs of `planning`).
         // The models change only at the end of an episode (`begin_episode` invalidates
         // the tree), so the tree may reuse the previous tick's subtrees.
-        let root = match self.params.root_step {
+        let root = match self.params.planning.root_step {
             RootStep::Learned => self.model.generative(),
             RootStep::Absorbing => self.model.planning_generative(),
         };
-        self.tree
-            .evaluate_reusing(self.model.planning_generative(), root, &self.q_cur, self.params.gamma);
+        self.tree.evaluate_reusing(
+            self.model.planning_generative(),
+            root,
+            &self.q_cur,
+            self.params.planning.gamma,
+        );
         learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
         let tr = &mut self.last;
         tr.free_energy = out.free_energy;
@@ -262,19 +285,19 @@ impl ScaledAgent {
         tr.q_pi.clone_from(&self.tree.q_pi);
         tr.psi.clone_from(&self.tree.psi);
         tr.q_s.resize(self.n_actions, 0.0);
-        q_s_into(&self.tree.psi, self.params.gamma, &mut tr.q_s);
+        q_s_into(&self.tree.psi, self.params.planning.gamma, &mut tr.q_s);
         tr.pi_o.clone_from(&self.pi);
         tr.pi_scaled.resize(self.n_actions, 0.0);
         // Scaling (Theorem 1).
-        let iters = match self.params.scaling_mode {
+        let iters = match self.params.scaling.scaling_mode {
             ScalingMode::Iterative => {
                 let o = scale_iterative(
                     &self.pi,
                     &self.tree.psi,
                     th,
-                    self.params.kappa_pi,
-                    self.params.varsigma,
-                    self.params.max_scaling_iters,
+                    self.params.scaling.kappa_pi,
+                    self.params.scaling.varsigma,
+                    self.params.scaling.max_scaling_iters,
                     &mut tr.pi_scaled,
                     None,
                 );
@@ -336,7 +359,7 @@ impl Controller for ScaledAgent {
         let (s, trigger) = match &self.gate {
             Some(gate) => {
                 let s = gate.surprise(&self.q_cur);
-                match self.params.gate_baseline {
+                match self.params.gate.gate_baseline {
                     GateBaseline::Endorsed => (s, gate.excess_surprise(&self.q_cur, s)),
                     GateBaseline::None => (s, s),
                 }
@@ -346,8 +369,8 @@ impl Controller for ScaledAgent {
                 (s, s)
             }
         };
-        let th = theta(trigger, self.params.omega);
-        let reasoned = self.params.reasoning == ReasoningMode::Always || th > self.params.epsilon;
+        let th = theta(trigger, self.params.gate.omega);
+        let reasoned = self.params.scaling.reasoning == ReasoningMode::Always || th > self.params.gate.epsilon;
         let mut scaling_iters = 0;
         if reasoned {
             scaling_iters = self.reason(obs, th);
@@ -395,11 +418,11 @@ impl Controller for ScaledAgent {
     /// endorsement is also recorded for its state ([`crate::gate::StateGate::endorse`]),
     /// which is what [`GateBaseline::Endorsed`] subtracts the expected surprise by.
     fn end_episode(&mut self) {
-        if !self.params.learning || self.hist_obs.is_empty() {
+        if !self.params.learning.enabled || self.hist_obs.is_empty() {
             return;
         }
         let n = self.n_states;
-        let lr = self.params.learning_rate;
+        let lr = self.params.learning.learning_rate;
         let na = self.n_actions;
         let steps = self.hist_obs.len();
         let mut taken = vec![0.0; na];
@@ -425,7 +448,7 @@ impl Controller for ScaledAgent {
                 learning::pi_o_belief(&self.nu, na, q, &mut habit);
                 let e = endorsement(&self.hist_pi[k * na..(k + 1) * na], argmax(&habit));
                 let s = argmax(q);
-                if self.params.gate_learning == GateLearning::Endorsed {
+                if self.params.gate.gate_learning == GateLearning::Endorsed {
                     let cell = gate.cell_of(s);
                     weight[cell] = f64::min(weight[cell], e);
                 }

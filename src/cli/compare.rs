@@ -172,7 +172,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             .flatten(),
         train_episodes: agents.first().and_then(|a| a.train_episodes),
         episodes: args.episodes,
-        action_selection: format!("{:?}", params.action_selection),
+        action_selection: format!("{:?}", params.scaling.action_selection),
         scaled_params: serde_json::to_value(&params)?,
         tables,
     };

@@ -72,8 +72,8 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         gm,
         vec![structure.encode(&values)],
         vec![],
-        params.horizon,
-        params.gamma,
+        params.planning.horizon,
+        params.planning.gamma,
     );
     // JSON has no NaN or infinity (serde_json writes them as null): refuse rather than
     // write a model no reader can use. A checked agent file never gets here.
@@ -92,8 +92,8 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
         args.out.display(),
         gm.n_states(),
         gm.n_actions(),
-        params.horizon,
-        params.gamma
+        params.planning.horizon,
+        params.planning.gamma
     );
     Ok(())
 }

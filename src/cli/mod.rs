@@ -110,9 +110,9 @@ pub struct AgentArgs {
     /// embedded training map (`intersection`) with the default episodes and `--seed`.
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
-    /// Scaled-agent parameter overrides, e.g. `--set omega=0.3 --set horizon=2`
-    /// (keys: omega, epsilon, gamma, varsigma, horizon, kappa_pi, vmp_window, max_scaling_iters, nu0, nu_temperature, learning_rate, sample, gate, gate_factor, gate_memory, gate_learning, gate_baseline, persistence_ignores, root_step).
-    #[arg(long = "set", value_name = "KEY=VALUE")]
+    /// Scaled-agent parameter overrides (help text: [`crate::overrides::help`], the keys
+    /// derived from the parameter table).
+    #[arg(long = "set", value_name = "KEY=VALUE", help = crate::overrides::help())]
     pub set: Vec<String>,
     /// Run seed: the evaluation episodes and, without `--agent`, the training run derive from it.
     #[arg(long, default_value_t = 7)]

@@ -151,7 +151,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         &dir.join("theta.svg"),
         &format!("{} on {}: normalized surprise", args.method, map.name),
         &points,
-        params.epsilon,
+        params.gate.epsilon,
     )?;
     filmstrip(
         &dir.join("filmstrip.svg"),
@@ -169,7 +169,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
             "{} {outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
             args.method, result.ticks, result.ret, result.reasoning_ticks
         );
-        let page = replay_html(&title, &outcome, &map, &ticks, params.epsilon)?;
+        let page = replay_html(&title, &outcome, &map, &ticks, params.gate.epsilon)?;
         write_atomic(html, page.as_bytes())?;
         println!("wrote {} (open it in a browser)", html.display());
     }

@@ -65,14 +65,13 @@ fn bad_sweeps_and_job_counts_exit_2() {
     assert_bad_input(&batch(&["--jobs", "0"]), &["--jobs", "1 to 256"]);
     assert_bad_input(&batch(&["--jobs", "100000"]), &["--jobs", "1 to 256"]);
     assert_bad_input(&batch(&["--set", "horizon=1,,2"]), &["horizon=1,,2", "empty value"]);
-    assert_bad_input(&batch(&["--set", "horizon=1,1"]), &["horizon=1,1", "listed twice"]);
     assert_bad_input(
         &batch(&["--set", "horizon=1", "--set", "horizon=2"]),
         &["horizon", "set twice"],
     );
     assert_bad_input(
         &batch(&["--set", "max_scaling_iters=4294967297"]),
-        &["max_scaling_iters", "at most"],
+        &["max_scaling_iters", "1..=10000"],
     );
     // A cross product beyond the bound is refused before anything is built.
     let many: String = (1..=200).map(|i| format!("0.{i:03}")).collect::<Vec<_>>().join(",");
@@ -105,6 +104,27 @@ fn bad_parameter_overrides_exit_2() {
         &unforeseen(&["eval", "--agent", a, "--episodes", "1", "--set", "gamma=-1"]),
         &["gamma"],
     );
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", a, "--episodes", "1", "--set", "scaling_mode=fast"]),
+        &["scaling_mode", "iterative, closed-form"],
+    );
+    assert_bad_input(
+        &unforeseen(&["eval", "--agent", a, "--episodes", "1", "--set", "gate_factor=x"]),
+        &["gate_factor", "d, v, L, p"],
+    );
+    // Every parameter is settable from the command line, the closed form of Theorem 1 too.
+    let out = unforeseen(&[
+        "eval",
+        "--agent",
+        a,
+        "--episodes",
+        "1",
+        "--set",
+        "scaling_mode=closed-form",
+        "--set",
+        "perception.vmp_tol=1e-4",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
 }
 
 #[test]

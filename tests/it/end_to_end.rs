@@ -36,7 +36,7 @@ fn scaled_avoids_the_jaywalker_that_q_learning_hits() {
         "the first jaywalk tick must trigger reasoning: {:?}",
         jay[0]
     );
-    assert!(jay[0].theta.unwrap() > params.epsilon);
+    assert!(jay[0].theta.unwrap() > params.gate.epsilon);
     // The gate reads the state (§VI): before any test-time learning it stays open on every
     // tick the pedestrian is on the crosswalk under green, and is closed before they appear.
     assert!(
@@ -122,10 +122,8 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
     };
     let (first, last) = reasoning(&ScaledParams::default());
     assert!(last < first, "reasoning ticks, first 5 episodes {first}, last 5 {last}");
-    let paper = ScaledParams {
-        gate_baseline: unforeseen_agent::params::GateBaseline::None,
-        ..ScaledParams::default()
-    };
+    let mut paper = ScaledParams::default();
+    paper.gate.gate_baseline = unforeseen_agent::params::GateBaseline::None;
     let (_, last_paper) = reasoning(&paper);
     assert!(
         last < last_paper,
@@ -148,10 +146,8 @@ fn scaled_waits_for_the_slow_walker() {
         Aggregate::of(&evaluate(&map, agent.as_mut(), Method::Scaled, 10, 7, true).unwrap()).success_rate
     };
     assert_eq!(success(&ScaledParams::default()), 1.0);
-    let absorbing = ScaledParams {
-        root_step: unforeseen_agent::params::RootStep::Absorbing,
-        ..ScaledParams::default()
-    };
+    let mut absorbing = ScaledParams::default();
+    absorbing.planning.root_step = unforeseen_agent::params::RootStep::Absorbing;
     assert!(
         success(&absorbing) < 1.0,
         "the absorbing root should lose a slow-walker episode"

@@ -13,6 +13,7 @@ mod figures;
 mod fuzz;
 mod golden;
 mod outputs;
+mod overrides;
 mod protocols;
 mod readme;
 mod reference;

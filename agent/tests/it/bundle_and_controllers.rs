@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use unforeseen_agent::bayes_rl::BayesRl;
 use unforeseen_agent::controller::{Controller, Ending};
-use unforeseen_agent::error::{InspectError, PersistError};
+use unforeseen_agent::error::{AgentError, InspectError, PersistError};
 use unforeseen_agent::inspect::inspect_json;
 use unforeseen_agent::model::WorldModel;
 use unforeseen_agent::params::{BayesModel, BayesRlParams, ModelPriors, Planner, QParams, ReasoningMode, ScaledParams};
@@ -17,7 +17,7 @@ use unforeseen_agent::structure::Structure;
 fn trained() -> (WorldModel, QLearning, BayesRl) {
     let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
     let mut w = WorldModel::new(st.clone(), 3, &ModelPriors::default()).unwrap();
-    let mut q = QLearning::new(64, 3, QParams::default());
+    let mut q = QLearning::new(64, 3, QParams::default()).unwrap();
     let mut b = BayesRl::new(64, 3, BayesRlParams::default()).unwrap();
     for _ in 0..20 {
         for d in 1..4 {
@@ -76,14 +76,11 @@ fn controllers_share_the_trait() {
     let (w, q, b) = trained();
     let st = w.structure().clone();
     let scaled = ScaledAgent::new(w.clone(), &q, ScaledParams::default()).unwrap();
-    let always = ScaledAgent::new(
-        w.clone(),
-        &q,
-        ScaledParams {
-            reasoning: ReasoningMode::Always,
-            ..Default::default()
-        },
-    )
+    let always = ScaledAgent::new(w.clone(), &q, {
+        let mut p = ScaledParams::default();
+        p.scaling.reasoning = ReasoningMode::Always;
+        p
+    })
     .unwrap();
     let factored = BayesRl::new(
         64,
@@ -152,17 +149,14 @@ fn scaled_agent_learns_and_surprise_drops() {
 fn bad_parameters_are_errors() {
     let (w, q, _) = trained();
     assert!(
-        ScaledAgent::new(
-            w.clone(),
-            &q,
-            ScaledParams {
-                gamma: 0.0,
-                ..Default::default()
-            }
-        )
+        ScaledAgent::new(w.clone(), &q, {
+            let mut p = ScaledParams::default();
+            p.planning.gamma = 0.0;
+            p
+        })
         .is_err()
     );
-    let small = QLearning::new(10, 3, QParams::default());
+    let small = QLearning::new(10, 3, QParams::default()).unwrap();
     assert!(ScaledAgent::new(w, &small, ScaledParams::default()).is_err());
     assert!(
         QLearning::try_new(
@@ -186,6 +180,34 @@ fn bad_parameters_are_errors() {
         )
         .is_err()
     );
+}
+
+/// `QLearning::new` checks what the params module doc promises: the ranges of
+/// [`QParams::check`], the sizes and `bias_action < n_actions`.
+#[test]
+fn q_learning_new_rejects_bad_params() {
+    let bad = |params: QParams, n_actions: usize| match QLearning::new(8, n_actions, params) {
+        Err(AgentError::Param(e)) => e.name,
+        other => panic!("expected a parameter error, got {other:?}"),
+    };
+    let alpha = QParams {
+        alpha: 0.0,
+        ..Default::default()
+    };
+    assert_eq!(bad(alpha, 3), "alpha");
+    let floor = QParams {
+        epsilon: 0.1,
+        epsilon_min: 0.5,
+        ..Default::default()
+    };
+    assert_eq!(bad(floor, 3), "epsilon_min");
+    let bias = QParams {
+        bias_action: Some(3),
+        ..Default::default()
+    };
+    assert_eq!(bad(bias, 3), "bias_action");
+    assert_eq!(bad(QParams::default(), 0), "n_actions");
+    assert!(QLearning::new(8, 3, QParams::default()).is_ok());
 }
 
 #[test]

@@ -1,0 +1,160 @@
+//! `--set` overrides and the scaled agent's parameter table (issue 19): every key is
+//! settable and reads back, bad keys and values name what is allowed, the typed entry
+//! point agrees with the text one, `scaling_mode=closed-form` reaches the closed form of
+//! Theorem 1, and a sweep counts equal values once.
+
+use crate::common;
+use serde_json::{Value, json};
+use unforeseen::batch::sweep;
+use unforeseen::overrides::{apply, keys, set_one, set_value};
+use unforeseen_agent::controller::Controller;
+use unforeseen_agent::param_table;
+use unforeseen_agent::params::{ScaledParams, ScalingMode};
+
+/// A value other than the default for each key, as `--set` text and as JSON.
+fn other_value(key: &str) -> (String, Value) {
+    match ScaledParams::default().get(key).unwrap() {
+        Value::Bool(b) => ((!b).to_string(), json!(!b)),
+        Value::Number(n) if n.is_u64() => ("2".into(), json!(if n.as_u64() == Some(2) { 1 } else { 2 })),
+        Value::Number(n) => {
+            let x = n.as_f64().unwrap() / 4.0;
+            (x.to_string(), json!(x))
+        }
+        Value::String(_) if key == "gate_factor" => ("v".into(), json!("v")),
+        Value::String(_) if key == "persistence_ignores" => ("L".into(), json!("L")),
+        Value::String(s) => {
+            let e = apply(ScaledParams::default(), &[format!("{key}=?")])
+                .unwrap_err()
+                .to_string();
+            let allowed = e.split("one of: ").nth(1).unwrap_or_else(|| panic!("{key}: {e}"));
+            let x = allowed.split(", ").find(|v| **v != *s).unwrap().to_string();
+            (x.clone(), json!(x))
+        }
+        other => panic!("{key}: {other}"),
+    }
+}
+
+#[test]
+fn every_key_round_trips_and_the_json_entry_point_agrees() {
+    assert!(keys().len() >= 25, "{:?}", keys());
+    for key in keys() {
+        let (text, value) = other_value(key);
+        let (text, value) = if key == "horizon" || value == json!(1) {
+            ("1".to_string(), json!(1))
+        } else {
+            (text, value)
+        };
+        let set = apply(ScaledParams::default(), &[format!("{key}={text}")]).unwrap();
+        assert_ne!(set, ScaledParams::default(), "{key}={text} changed nothing");
+        assert_eq!(set.get(key).unwrap(), value, "{key} reads back");
+        let mut typed = ScaledParams::default();
+        set_value(&mut typed, key, value.clone()).unwrap();
+        assert_eq!(typed, set, "{key}: JSON and text differ");
+        let dotted = param_table::lookup(key).unwrap().dotted();
+        let mut by_dotted = ScaledParams::default();
+        set_one(&mut by_dotted, &dotted, &text).unwrap();
+        assert_eq!(by_dotted, set, "{dotted}");
+    }
+}
+
+#[test]
+fn unknown_keys_and_bad_values_name_the_key_and_the_allowed_values() {
+    let err = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        apply(ScaledParams::default(), &sets).unwrap_err().to_string()
+    };
+    let e = err(&["colour=red"]);
+    assert!(
+        e.contains("--set colour") && e.contains("omega") && e.contains("vmp_max_iters"),
+        "{e}"
+    );
+    let e = err(&["scaling_mode=closed"]);
+    assert!(
+        e.contains("scaling_mode=closed") && e.contains("iterative, closed-form"),
+        "{e}"
+    );
+    let e = err(&["gate=both"]);
+    assert!(e.contains("state, one-step"), "{e}");
+    let e = err(&["vmp_kappa=0"]);
+    assert!(e.contains("vmp_kappa") && e.contains("(0, 1]"), "{e}");
+    let e = err(&["vmp_max_iters=lots"]);
+    assert!(
+        e.contains("vmp_max_iters") && e.contains("whole number") && e.contains("1..=10000"),
+        "{e}"
+    );
+    let e = err(&["horizon=9"]);
+    assert!(e.contains("horizon") && e.contains("1..=8"), "{e}");
+    let mut p = ScaledParams::default();
+    let e = set_value(&mut p, "vmp_tol", json!("small")).unwrap_err().to_string();
+    assert!(e.contains("vmp_tol") && e.contains("finite and > 0"), "{e}");
+    let e = set_value(&mut p, "no_such", json!(1)).unwrap_err().to_string();
+    assert!(e.contains("no_such") && e.contains("scaling_mode"), "{e}");
+}
+
+/// `--set gate_factor` naming no factor of the model is refused when the agent is built
+/// from the model, naming the key and the model's factors.
+#[test]
+fn factor_names_are_checked_against_the_model() {
+    let bundle = common::bundle();
+    let p = apply(ScaledParams::default(), &["gate_factor=x".into()]).unwrap();
+    let e = unforeseen::methods::scaled_agent(bundle, p).unwrap_err().to_string();
+    assert!(e.contains("gate_factor") && e.contains("d, v, L, p"), "{e}");
+    let p = apply(ScaledParams::default(), &["persistence_ignores=v".into()]).unwrap();
+    let e = unforeseen::methods::scaled_agent(bundle, p).unwrap_err().to_string();
+    assert!(
+        e.contains("persistence_ignores") && e.contains("next-time parents of `p`"),
+        "{e}"
+    );
+}
+
+/// `--set scaling_mode=closed-form` reaches Theorem 1's closed form: on every reasoning
+/// tick the policy acted upon is `π_o ψ^θ`, normalised.
+#[test]
+fn scaling_mode_closed_form_reaches_the_closed_form_and_acts() {
+    let p = apply(
+        ScaledParams::default(),
+        &["scaling_mode=closed-form".into(), "reasoning=always".into()],
+    )
+    .unwrap();
+    assert_eq!(p.scaling.scaling_mode, ScalingMode::ClosedForm);
+    let bundle = common::bundle();
+    let mut agent = unforeseen::methods::scaled_agent(bundle, p).unwrap();
+    let n = bundle.world_model.n_states();
+    agent.begin_episode(3);
+    let mut reasoned = 0;
+    for s in (0..n).step_by(5).take(8) {
+        let d = agent.act(s);
+        assert!(d.action < 3);
+        assert_eq!(d.scaling_iters, 0, "the closed form does not iterate");
+        if !d.reasoned {
+            continue;
+        }
+        reasoned += 1;
+        let (th, tr) = (d.theta.unwrap(), agent.last_reasoning());
+        let raw: Vec<f64> = tr.pi_o.iter().zip(&tr.psi).map(|(o, p)| o * p.powf(th)).collect();
+        let z: f64 = raw.iter().sum();
+        for (got, want) in d.policy.iter().zip(&raw) {
+            assert!((got - want / z).abs() < 1e-9, "{:?} vs {raw:?}/{z}", d.policy);
+        }
+    }
+    assert!(reasoned > 0);
+}
+
+#[test]
+fn sweeps_count_equal_values_once_in_first_occurrence_order() {
+    let sets = sweep(&["omega=0.5,5e-1,0.25,0.50".into(), "horizon=2,1,2".into()]).unwrap();
+    let labels: Vec<String> = sets.iter().map(|s| s.label()).collect();
+    assert_eq!(
+        labels,
+        [
+            "omega=0.5,horizon=2",
+            "omega=0.5,horizon=1",
+            "omega=0.25,horizon=2",
+            "omega=0.25,horizon=1"
+        ]
+    );
+    let e = sweep(&["epsilon=0.1".into(), "gate.epsilon=0.2".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("set twice"), "{e}");
+}
