@@ -36,9 +36,8 @@ pub mod world;
 
 pub use light::{LightPhase, light_at};
 pub use load::{Diagnostic, MAX_BASE_DEPTH, MAX_FILE_BYTES, MAX_NESTING, MapError};
-pub use map::ProtocolName;
 pub use map::{
-    Bins, Crosswalk, Episode, Expectation, Light, LightCondition, Map, MethodName, Offset, Pause, Phase, Reward, Road,
+    Bins, Crosswalk, Episode, Expectation, Light, LightCondition, Map, Offset, Pause, Phase, Reward, Road,
     Side, SpawnRule, Trigger, Vehicle,
 };
 pub use validate::{

@@ -74,7 +74,9 @@ pub struct MapError {
 }
 
 impl MapError {
-    pub(crate) fn new(diagnostics: Vec<Diagnostic>) -> Self {
+    /// An error of the given diagnostics (at least one), e.g. for checks a harness makes
+    /// on a loaded map (the names in its expectations).
+    pub fn new(diagnostics: Vec<Diagnostic>) -> Self {
         debug_assert!(!diagnostics.is_empty());
         MapError { diagnostics }
     }
@@ -690,6 +692,34 @@ mod doc_tests {
             assert!(s.contains(needle), "summary lacks {needle:?}:\n{s}");
         }
         assert_eq!(m.crosswalk_distance_to_goal(), (26.0, 22.0));
+    }
+
+    /// Expectations keep their names as written (the harness checks them); a name that
+    /// is not a bare identifier is a type error at its line and column.
+    #[test]
+    fn expectation_names_are_plain_data() {
+        let m = Map::from_str_named(
+            "e.ron",
+            "Map(expect: [(method: Anything, protocol: Whatever), (method: Scaled, protocol: None)])",
+            &|_| None,
+        )
+        .unwrap();
+        assert_eq!(
+            (m.expect[0].method.as_str(), m.expect[0].protocol.as_deref()),
+            ("Anything", Some("Whatever"))
+        );
+        assert_eq!((m.expect[1].method.as_str(), m.expect[1].protocol.as_deref()), ("Scaled", None));
+        assert!(m.summary().contains("expect Anything (Whatever): "), "{}", m.summary());
+        for bad in [
+            "Map(expect: [\n  (method: \"Scaled\")])",
+            "Map(expect: [\n  (method: Scaled(1))])",
+            "Map(expect: [\n  (method: Scaled, protocol: \"Continual\")])",
+        ] {
+            let e = Map::from_str_named("e.ron", bad, &|_| None).unwrap_err();
+            let d = &e.diagnostics()[0];
+            assert_eq!(d.position.map(|(line, _)| line), Some(2), "{bad}: {e}");
+            assert!(d.path.starts_with("expect[0]."), "{bad}: {e}");
+        }
     }
 
     #[test]

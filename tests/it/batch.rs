@@ -129,9 +129,9 @@ fn expectations_pass_and_fail_as_declared() {
     let mut scenarios = scenarios();
     scenarios.truncate(1); // jaywalk
     let map = &mut scenarios[0].map;
-    use unforeseen_sim::{Expectation, MethodName, ProtocolName};
+    use unforeseen_sim::Expectation;
     let none = Expectation {
-        method: MethodName::QLearning,
+        method: "QLearning".into(),
         min_success: None,
         max_success: None,
         min_reward: None,
@@ -151,13 +151,13 @@ fn expectations_pass_and_fail_as_declared() {
             ..none.clone()
         },
         Expectation {
-            method: MethodName::BayesRl,
+            method: "BayesRl".into(),
             max_inference_rate: Some(1.0),
             ..none.clone()
         },
         Expectation {
-            method: MethodName::BayesRl,
-            protocol: Some(ProtocolName::Continual),
+            method: "BayesRl".into(),
+            protocol: Some("Continual".into()),
             min_success: Some(0.0),
             ..none.clone()
         },
@@ -200,7 +200,7 @@ fn expectations_pass_and_fail_as_declared() {
     // is still checked once.
     scenarios[0].map.expect = vec![
         Expectation {
-            method: MethodName::Scaled,
+            method: "Scaled".into(),
             min_success: Some(1.1),
             ..none.clone()
         },

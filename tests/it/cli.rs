@@ -124,6 +124,19 @@ fn missing_and_bad_maps_exit_2_naming_the_file() {
     let out = unforeseen(&["eval", "--map", bad.to_str().unwrap(), "--method", "never-brake"]);
     assert_bad_input(&out, &["bad.ron", "\"nowhere\" not found"]);
     assert_eq!(text(&out).matches("not found").count(), 1, "{}", text(&out));
+    // Expectations name this program's methods and protocols; check-map and batch say
+    // which field is wrong and what it may be.
+    std::fs::write(
+        &bad,
+        "Map(expect: [(method: Scaled), (method: Scaled), (method: Scald, protocol: Continual)])",
+    )
+    .unwrap();
+    let expect_error = ["bad.ron", "expect[2].method", "unknown method `Scald`", "QLearning, BayesRl"];
+    assert_bad_input(&unforeseen(&["check-map", bad.to_str().unwrap()]), &expect_error);
+    assert_bad_input(
+        &unforeseen(&["batch", bad.to_str().unwrap(), "--episodes", "1"]),
+        &expect_error,
+    );
 }
 
 #[test]
