@@ -105,7 +105,9 @@ mod tests {
         let lines: Vec<String> = err.diagnostics().iter().map(ToString::to_string).collect();
         assert_eq!(lines.len(), 2, "{lines:?}");
         assert!(
-            lines[0].starts_with("bad.ron: expect[1].method: unknown method `Scald` (hint: expected one of: QLearning, BayesRl, Scaled,"),
+            lines[0].starts_with(
+                "bad.ron: expect[1].method: unknown method `Scald` (hint: expected one of: QLearning, BayesRl, Scaled,"
+            ),
             "{}",
             lines[0]
         );

@@ -143,7 +143,7 @@ impl Map {
                 }
             }
             let name = base.strip_suffix(".ron").unwrap_or(base);
-            crate::embedded::source(name).map(|text| {
+            crate::shipped::source(name).map(|text| {
                 let origin = format!("{EMBEDDED_PREFIX}{name}");
                 Resolved {
                     text: check_text(&origin, text).map(|()| text.to_string()),
@@ -402,7 +402,7 @@ fn build(origin: &str, src: &str, resolve: &Resolver, chain: &mut Vec<String>) -
                     format!("base map {base_name:?} not found"),
                     Some(format!(
                         "a base is a file name relative to this map's folder, e.g. \"intersection.ron\", or an embedded map ({})",
-                        crate::embedded::names().join(", ")
+                        crate::shipped::names().join(", ")
                     )),
                 )));
             };
@@ -678,7 +678,8 @@ mod doc_tests {
 
     #[test]
     fn summary_mentions_the_essentials() {
-        let m = crate::embedded::load("jaywalk").unwrap();
+        let shipped = |base: &str| crate::shipped::source(base).map(|s| (base.to_string(), s.to_string()));
+        let m = Map::from_str_named("jaywalk.ron", crate::shipped::JAYWALK, &shipped).unwrap();
         let s = m.summary();
         for needle in [
             "map jaywalk",
@@ -708,7 +709,10 @@ mod doc_tests {
             (m.expect[0].method.as_str(), m.expect[0].protocol.as_deref()),
             ("Anything", Some("Whatever"))
         );
-        assert_eq!((m.expect[1].method.as_str(), m.expect[1].protocol.as_deref()), ("Scaled", None));
+        assert_eq!(
+            (m.expect[1].method.as_str(), m.expect[1].protocol.as_deref()),
+            ("Scaled", None)
+        );
         assert!(m.summary().contains("expect Anything (Whatever): "), "{}", m.summary());
         for bad in [
             "Map(expect: [\n  (method: \"Scaled\")])",

@@ -8,8 +8,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::light::LightPhase;
-
 /// Defines a configuration struct with documented defaults, plus a crate-private
 /// "patch" twin whose fields are all optional: a scenario built on a base map
 /// only sets the fields that differ, and `apply` copies them over the base.
@@ -78,6 +76,34 @@ config_struct! {
         x: f64 = 66.0,
         /// Width of the crosswalk along the road, m. Default 4.0 (so it spans x 64–68).
         width: f64 = 4.0,
+    }
+}
+
+/// The colour the light shows. The discretizer maps amber to red.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum LightPhase {
+    /// Go.
+    Green,
+    /// About to turn red (counts as red for the agent).
+    Amber,
+    /// Stop; pedestrians may cross.
+    Red,
+}
+
+impl LightPhase {
+    /// True for green only.
+    pub fn is_green(self) -> bool {
+        self == LightPhase::Green
+    }
+}
+
+impl std::fmt::Display for LightPhase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LightPhase::Green => "green",
+            LightPhase::Amber => "amber",
+            LightPhase::Red => "red",
+        })
     }
 }
 

@@ -131,7 +131,12 @@ fn missing_and_bad_maps_exit_2_naming_the_file() {
         "Map(expect: [(method: Scaled), (method: Scaled), (method: Scald, protocol: Continual)])",
     )
     .unwrap();
-    let expect_error = ["bad.ron", "expect[2].method", "unknown method `Scald`", "QLearning, BayesRl"];
+    let expect_error = [
+        "bad.ron",
+        "expect[2].method",
+        "unknown method `Scald`",
+        "QLearning, BayesRl",
+    ];
     assert_bad_input(&unforeseen(&["check-map", bad.to_str().unwrap()]), &expect_error);
     assert_bad_input(
         &unforeseen(&["batch", bad.to_str().unwrap(), "--episodes", "1"]),
