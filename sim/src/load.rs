@@ -565,25 +565,12 @@ fn walk(v: &ron::Value, kind: Kind, path: &str, origin: &str, out: &mut Vec<Diag
 fn suggest(name: &str, known: &[&str]) -> String {
     let best = known
         .iter()
-        .map(|k| (edit_distance(name, k), *k))
+        .map(|k| (strsim::levenshtein(name, k), *k))
         .min_by_key(|(d, _)| *d);
     match best {
         Some((d, k)) if d <= 2 => format!("did you mean `{k}`?"),
         _ => format!("expected one of: {}", known.join(", ")),
     }
-}
-
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, cb) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
-        }
-        prev = cur;
-    }
-    prev[b.len()]
 }
 
 /// The field names serde's derive gives a struct, captured by a deserializer
