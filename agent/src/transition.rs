@@ -14,6 +14,13 @@
 //!
 //! Terminal states (absorbing in the planning model, see `WorldModel::set_terminal_states`)
 //! are handled exactly: their mass bypasses the factor steps and stays where it is.
+//!
+//! Two types: [`FactoredTransition`] applies `B[u]` (the prediction `B[u] x`, above);
+//! [`FactoredLogB`] works with `ln B[u]`, a sum of per-factor log-CPT tables, for VMP's
+//! messages: the forward message `(ln B[u]) q`, the backward message `(ln B[u])ᵀ q` and
+//! the transition term `q_nextᵀ (ln B[u]) q_prev` of `F`, without the dense matrix
+//! (used when every entry of `B` is above the log floor, so that it equals the dense
+//! floored logarithm up to rounding).
 
 use crate::structure::{Parent, Structure};
 

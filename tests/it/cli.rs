@@ -277,9 +277,9 @@ fn only_regular_files_are_read_or_replaced() {
     assert!(out.is_dir());
 }
 
-/// Issue 12: flags and maps that asked for more memory than any machine has aborted
-/// (exit 134): a VMP window of 99999999999 ticks (2.4 TB), a map of 64 x 64 bin edges
-/// (which check-map accepted). Both are refused up front with the bound and its reason.
+/// Flags and maps that ask for more memory than any machine has, e.g. a VMP window of
+/// 99999999999 ticks (2.4 TB) or a map of 64 x 64 bin edges, are refused up front with
+/// the bound and its reason (not an allocation abort).
 #[test]
 fn allocation_bounds_are_stated_and_enforced() {
     assert_bad_input(
