@@ -322,7 +322,7 @@ impl ResultLine {
 /// only if `covers` includes it; one naming none applies to every protocol.
 pub fn check_expectations(map: &Map, method: Method, covers: &[Protocol], agg: &Aggregate) -> Vec<Check> {
     let mut checks = Vec::new();
-    // Names were checked when the map was loaded ([`crate::maps::check_expectations`]).
+    // Names were checked when the map was loaded ([`crate::maps::check_expectation_names`]).
     let applies = |p: &Option<String>| {
         p.as_deref()
             .is_none_or(|p| Protocol::from_map_name(p).is_some_and(|p| covers.contains(&p)))

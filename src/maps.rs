@@ -1,7 +1,7 @@
 //! Finding a map: a file path, or the name of a map embedded in the binary
 //! (`intersection`, `jaywalk`, ...), so the default run needs no files at all. Every
 //! map loaded here has its expectations' names checked against this program's
-//! [`Method`]s and [`Protocol`]s ([`check_expectations`]).
+//! [`Method`]s and [`Protocol`]s ([`check_expectation_names`]).
 
 use std::path::Path;
 use unforeseen_sim::{Diagnostic, Map, MapError, embedded};
@@ -37,7 +37,7 @@ pub fn load(arg: &str) -> Result<Map, MapLookupError> {
     let name = arg.strip_suffix(".ron").unwrap_or(arg);
     if embedded::names().contains(&name) {
         let map = embedded::load(name)?;
-        check_expectations(&map, &format!("embedded:{name}"))?;
+        check_expectation_names(&map, &format!("embedded:{name}"))?;
         return Ok(map);
     }
     Err(MapLookupError::NotFound {
@@ -47,10 +47,10 @@ pub fn load(arg: &str) -> Result<Map, MapLookupError> {
 }
 
 /// Loads a map file ([`Map::load`]) and checks its expectations' names
-/// ([`check_expectations`]).
+/// ([`check_expectation_names`]).
 pub fn load_file(path: &Path) -> Result<Map, MapError> {
     let map = Map::load(path)?;
-    check_expectations(&map, &path.display().to_string())?;
+    check_expectation_names(&map, &path.display().to_string())?;
     Ok(map)
 }
 
@@ -58,7 +58,7 @@ pub fn load_file(path: &Path) -> Result<Map, MapError> {
 /// it names one, a protocol ([`Protocol::map_name`]) of this program. `file` names the
 /// map in the diagnostics (one per bad name, with its field, e.g. `expect[2].method`,
 /// and the allowed names).
-pub fn check_expectations(map: &Map, file: &str) -> Result<(), MapError> {
+pub fn check_expectation_names(map: &Map, file: &str) -> Result<(), MapError> {
     let diagnostic = |path: String, what: &str, name: &str, allowed: Vec<&str>| Diagnostic {
         file: file.to_string(),
         position: None,
@@ -97,11 +97,11 @@ mod tests {
     #[test]
     fn expectation_names_are_checked_against_methods_and_protocols() {
         let map = parse("Map(expect: [(method: Scaled), (method: NeverBrake, protocol: Continual)])");
-        assert_eq!(check_expectations(&map, "bad.ron"), Ok(()));
+        assert_eq!(check_expectation_names(&map, "bad.ron"), Ok(()));
         let map = parse(
             "Map(expect: [(method: Scaled), (method: Scald, min_success: 0.5), (method: QLearning, protocol: Continuous)])",
         );
-        let err = check_expectations(&map, "bad.ron").unwrap_err();
+        let err = check_expectation_names(&map, "bad.ron").unwrap_err();
         let lines: Vec<String> = err.diagnostics().iter().map(ToString::to_string).collect();
         assert_eq!(lines.len(), 2, "{lines:?}");
         assert!(
