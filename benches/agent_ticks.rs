@@ -1,5 +1,5 @@
-//! Micro-benchmarks of the scaled agent's ticks (issue 5): one reasoning tick per
-//! horizon `H`, the reasoning ticks of real episodes replayed (issue 13), a feed-forward
+//! Micro-benchmarks of the scaled agent's ticks: one reasoning tick per
+//! horizon `H`, the reasoning ticks of real episodes replayed (`unforeseen::tick_replay`), a feed-forward
 //! tick, the end-of-episode test-time learning update, and the reasoning tick as the
 //! joint state space grows.
 //!

@@ -1,4 +1,4 @@
-//! Whole-system benchmarks (issue 5): one physics decision step, one jaywalk episode,
+//! Whole-system benchmarks: one physics decision step, one jaywalk episode,
 //! training throughput, and the closed loop (world + discretizer + scaled agent) at
 //! 10 Hz decisions / 60 Hz physics.
 //!

@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use unforeseen_agent::param_table;
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_sim::{Map, MethodName};
+use unforeseen_sim::Map;
 
 use crate::agents::Agent;
 use crate::error::Error;
@@ -330,26 +330,20 @@ impl ResultLine {
     }
 }
 
-fn method_name(m: Method) -> Option<MethodName> {
-    match m {
-        Method::QLearning => Some(MethodName::QLearning),
-        Method::BayesRl => Some(MethodName::BayesRl),
-        Method::Scaled => Some(MethodName::Scaled),
-        Method::BrakeOnPedestrian => Some(MethodName::BrakeOnPedestrian),
-        _ => None,
-    }
-}
-
 /// Checks a map's expectations for `method` against an aggregate of a unit whose
 /// results hold for the protocols `covers`: an expectation naming a protocol applies
 /// only if `covers` includes it; one naming none applies to every protocol.
 pub fn check_expectations(map: &Map, method: Method, covers: &[Protocol], agg: &Aggregate) -> Vec<Check> {
     let mut checks = Vec::new();
-    let applies = |p: Option<unforeseen_sim::ProtocolName>| p.is_none_or(|p| covers.contains(&Protocol::from_map(p)));
+    // Names were checked when the map was loaded ([`crate::maps::check_expectation_names`]).
+    let applies = |p: &Option<String>| {
+        p.as_deref()
+            .is_none_or(|p| Protocol::from_map_name(p).is_some_and(|p| covers.contains(&p)))
+    };
     for e in map
         .expect
         .iter()
-        .filter(|e| Some(e.method) == method_name(method) && applies(e.protocol))
+        .filter(|e| e.method == method.map_name() && applies(&e.protocol))
     {
         let mut add = |figure: &str, bound: &str, limit: Option<f64>, value: f64| {
             if let Some(limit) = limit {
@@ -1022,13 +1016,13 @@ fn read_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
             found.sort();
             for f in found {
                 scenarios.push(Scenario {
-                    map: Map::load(&f)?,
+                    map: crate::maps::load_file(&f)?,
                     source: f.display().to_string(),
                 });
             }
         } else if p.exists() {
             scenarios.push(Scenario {
-                map: Map::load(p)?,
+                map: crate::maps::load_file(p)?,
                 source: p.display().to_string(),
             });
         } else {

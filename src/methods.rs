@@ -75,6 +75,33 @@ impl Method {
         }
     }
 
+    /// The name map files give the method in an expectation (`method: Scaled`):
+    /// the variant's name.
+    pub fn map_name(self) -> &'static str {
+        match self {
+            Method::QLearning => "QLearning",
+            Method::BayesRl => "BayesRl",
+            Method::Scaled => "Scaled",
+            Method::BayesRlFactored => "BayesRlFactored",
+            Method::ScaledAlways => "ScaledAlways",
+            Method::ScaledNoLearning => "ScaledNoLearning",
+            Method::ScaledOneStepGate => "ScaledOneStepGate",
+            Method::ScaledGateLearnsAll => "ScaledGateLearnsAll",
+            Method::BrakeOnPedestrian => "BrakeOnPedestrian",
+            Method::NeverBrake => "NeverBrake",
+        }
+    }
+
+    /// The method a map file names ([`Method::map_name`]), if any.
+    pub fn from_map_name(name: &str) -> Option<Method> {
+        Method::all().iter().copied().find(|m| m.map_name() == name)
+    }
+
+    /// Every method, in declaration order.
+    pub fn all() -> &'static [Method] {
+        <Method as clap::ValueEnum>::value_variants()
+    }
+
     /// The paper's reported figures for this method (§VI, Fig. 8), where it reports them.
     pub fn paper(self) -> Option<PaperFigures> {
         match self {

@@ -11,7 +11,6 @@
 
 use serde::{Deserialize, Serialize};
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_sim::ProtocolName;
 
 use crate::methods::Method;
 
@@ -47,12 +46,17 @@ impl Protocol {
         }
     }
 
-    /// The protocol as map files name it (`ZeroShot`, `Continual`).
-    pub fn from_map(p: ProtocolName) -> Self {
-        match p {
-            ProtocolName::ZeroShot => Protocol::ZeroShot,
-            ProtocolName::Continual => Protocol::Continual,
+    /// The name map files give the protocol in an expectation (`protocol: Continual`).
+    pub fn map_name(self) -> &'static str {
+        match self {
+            Protocol::ZeroShot => "ZeroShot",
+            Protocol::Continual => "Continual",
         }
+    }
+
+    /// The protocol a map file names ([`Protocol::map_name`]), if any.
+    pub fn from_map_name(name: &str) -> Option<Protocol> {
+        Protocol::ALL.into_iter().find(|p| p.map_name() == name)
     }
 
     /// The protocol `method` really needs: a method that does not learn across episodes

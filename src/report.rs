@@ -1,12 +1,13 @@
 //! Writing results: atomically (temporary file, then rename), so a killed run never
-//! leaves a half-written file behind.
+//! leaves a half-written file behind, and a failed write leaves no temporary file.
 
 use anyhow::Context;
 use std::io::Write;
 use std::path::Path;
 
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename,
-/// then syncs the folder so the rename itself is durable.
+/// Writes `bytes` to `path` through a temporary file in the same folder
+/// ([`tempfile::NamedTempFile`], removed if anything fails, a panic included) and a
+/// rename, then syncs the folder so the rename itself is durable.
 /// Refuses a `path` that exists and is not a regular file (a device such as `/dev/full`,
 /// a folder, a pipe): the rename would replace it.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
@@ -23,16 +24,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         _ => Path::new("."),
     };
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
     let result = (|| -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)?;
+        let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+        tmp.write_all(bytes)?;
+        tmp.as_file().sync_all()?;
+        tmp.persist(path).map_err(|e| e.error)?;
         // Make the rename durable (a folder can be opened and synced on Unix; elsewhere
         // this is best effort).
         if let Ok(d) = std::fs::File::open(dir) {
@@ -40,9 +36,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         }
         Ok(())
     })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
     result.with_context(|| format!("cannot write {}", path.display()))
 }
 
@@ -69,27 +62,21 @@ impl Csv {
         }
     }
 
-    /// Appends a row; cells containing commas or quotes are quoted.
+    /// Appends a row (cells containing commas, quotes or line breaks are quoted in the text).
     pub fn row(&mut self, cells: Vec<String>) {
         debug_assert_eq!(cells.len(), self.header.len());
         self.rows.push(cells);
     }
 
-    /// The table as CSV text.
+    /// The table as CSV text (the `csv` crate's writer: a cell is quoted when it holds
+    /// a comma, a quote or a line break; lines end in `\n`).
     pub fn to_text(&self) -> String {
-        let quote = |c: &String| {
-            if c.contains([',', '"', '\n']) {
-                format!("\"{}\"", c.replace('"', "\"\""))
-            } else {
-                c.clone()
-            }
-        };
-        let mut out = String::new();
+        let mut w = csv::WriterBuilder::new().flexible(true).from_writer(Vec::new());
         for line in std::iter::once(&self.header).chain(&self.rows) {
-            out.push_str(&line.iter().map(quote).collect::<Vec<_>>().join(","));
-            out.push('\n');
+            w.write_record(line).expect("writing CSV to memory cannot fail");
         }
-        out
+        let bytes = w.into_inner().expect("writing CSV to memory cannot fail");
+        String::from_utf8(bytes).expect("CSV of UTF-8 cells is UTF-8")
     }
 
     /// Writes the table to `path`, atomically.
@@ -126,6 +113,24 @@ mod tests {
     fn csv_quotes_cells_that_need_it() {
         let mut csv = Csv::new(&["a", "b"]);
         csv.row(vec!["1".into(), "x,y".into()]);
-        assert_eq!(csv.to_text(), "a,b\n1,\"x,y\"\n");
+        csv.row(vec!["say \"hi\"".into(), "two\nlines".into()]);
+        csv.row(vec!["".into(), "-0.5000".into()]);
+        assert_eq!(
+            csv.to_text(),
+            "a,b\n1,\"x,y\"\n\"say \"\"hi\"\"\",\"two\nlines\"\n,-0.5000\n"
+        );
+    }
+
+    #[test]
+    fn a_refused_write_leaves_nothing_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.csv");
+        std::fs::create_dir(&target).unwrap();
+        assert!(write_atomic(&target, b"x").is_err());
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(left, ["out.csv"], "{left:?}");
     }
 }

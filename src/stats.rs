@@ -5,58 +5,21 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Two-sided 95% quantiles t_{0.975, df} of Student's t for df = 1..=30 (computed by
-/// integrating the t density numerically to 1e-9; they agree with the printed tables).
-const T_975: [f64; 30] = [
-    12.706_204_736,
-    4.302_652_730,
-    3.182_446_305,
-    2.776_445_105,
-    2.570_581_836,
-    2.446_911_851,
-    2.364_624_252,
-    2.306_004_135,
-    2.262_157_163,
-    2.228_138_852,
-    2.200_985_160,
-    2.178_812_830,
-    2.160_368_656,
-    2.144_786_688,
-    2.131_449_546,
-    2.119_905_299,
-    2.109_815_578,
-    2.100_922_040,
-    2.093_024_054,
-    2.085_963_447,
-    2.079_613_845,
-    2.073_873_068,
-    2.068_657_610,
-    2.063_898_562,
-    2.059_538_553,
-    2.055_529_439,
-    2.051_830_516,
-    2.048_407_142,
-    2.045_229_642,
-    2.042_272_456,
-];
+/// Degrees of freedom beyond which [`t_975`] uses this many: `statrs`' inverse CDF
+/// loses accuracy past about 10^5 (1.95985 instead of 1.95997 at 10^6), while the
+/// quantile at 10^4 is within 2.4e-4 above every quantile beyond it (the normal
+/// quantile 1.959964 is their limit), so intervals err on the wide side by at most that.
+pub const T_MAX_DF: usize = 10_000;
 
-/// The 0.975 quantile of the standard normal distribution.
-const Z_975: f64 = 1.959_963_984_540_054;
-
-/// t_{0.975, df}: the half-width multiplier of a two-sided 95% interval. `df` must be at
-/// least 1. Beyond 30 degrees of freedom, the Cornish-Fisher expansion of t in powers of
-/// 1/df around the normal quantile (error below 1e-7 there).
+/// t_{0.975, df}: the half-width multiplier of a two-sided 95% interval, the 0.975
+/// quantile of Student's t with `df` degrees of freedom (`statrs`' inverse CDF; at most
+/// [`T_MAX_DF`] degrees of freedom). `df` must be at least 1.
 pub fn t_975(df: usize) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
     assert!(df >= 1, "Student's t needs at least one degree of freedom");
-    if df <= T_975.len() {
-        return T_975[df - 1];
-    }
-    let (z, v) = (Z_975, df as f64);
-    let g1 = (z.powi(3) + z) / 4.0;
-    let g2 = (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / 96.0;
-    let g3 = (3.0 * z.powi(7) + 19.0 * z.powi(5) + 17.0 * z.powi(3) - 15.0 * z) / 384.0;
-    let g4 = (79.0 * z.powi(9) + 776.0 * z.powi(7) + 1482.0 * z.powi(5) - 1920.0 * z.powi(3) - 945.0 * z) / 92160.0;
-    z + g1 / v + g2 / v.powi(2) + g3 / v.powi(3) + g4 / v.powi(4)
+    StudentsT::new(0.0, 1.0, df.min(T_MAX_DF) as f64)
+        .expect("a standard t with at least one degree of freedom")
+        .inverse_cdf(0.975)
 }
 
 /// A figure over training seeds: its mean, a 95% interval for that mean, and its range.
@@ -162,21 +125,29 @@ mod tests {
     }
 
     #[test]
-    fn t_quantiles_match_tables_and_the_expansion_joins_them() {
-        assert_eq!(t_975(1), 12.706_204_736);
-        assert_eq!(t_975(9), 2.262_157_163);
-        // Printed tables: df 40 -> 2.021075, 60 -> 2.000298, 120 -> 1.979930.
+    fn t_quantiles_match_printed_tables() {
+        // Printed tables to 9 decimals (df 1, 9, 30) and 6 decimals (40, 60, 120), and
+        // the normal quantile 1.959964 in the limit.
+        for (df, t) in [(1, 12.706_204_736), (9, 2.262_157_163), (30, 2.042_272_456)] {
+            assert!(close(t_975(df), t, 1e-9), "df {df}: {}", t_975(df));
+        }
         assert!(close(t_975(40), 2.021_075_390, 1e-7));
         assert!(close(t_975(60), 2.000_297_822, 1e-7));
         assert!(close(t_975(120), 1.979_930_405, 1e-7));
         assert!(t_975(31) < t_975(30) && t_975(31) > t_975(32));
-        assert!(close(t_975(1_000_000), Z_975, 1e-5));
+        // Past T_MAX_DF, the quantile at T_MAX_DF: above the normal limit, within 2.4e-4.
+        let z = 1.959_963_984_540_054;
+        for df in [T_MAX_DF, 100_000, 1_000_000, 10_000_000] {
+            assert!(t_975(df) > z && t_975(df) < z + 2.4e-4, "df {df}: {}", t_975(df));
+        }
+        let dfs = [1, 2, 3, 5, 10, 30, 31, 100, 1000, T_MAX_DF, T_MAX_DF + 1];
+        assert!(dfs.windows(2).all(|w| t_975(w[0]) >= t_975(w[1])));
     }
 
     #[test]
-    fn t_table_matches_the_density_integral() {
-        // Oracle: integrate the t density from 0 to t_{0.975, df} by Simpson's rule; the
-        // result must be 0.475. Gamma ratios of half-integers by the recursion
+    fn t_quantiles_match_the_density_integral() {
+        // Oracle independent of statrs: integrate the t density from 0 to t_{0.975, df}
+        // by Simpson's rule; the result must be 0.475. Gamma ratios of half-integers by the recursion
         // Gamma(x + 1) = x Gamma(x) from Gamma(1/2) = sqrt(pi) and Gamma(1) = 1.
         fn gamma_half(k: usize) -> f64 {
             // Gamma(k / 2)
@@ -189,7 +160,7 @@ mod tests {
             }
             g
         }
-        for df in [1usize, 2, 5, 9, 17, 30] {
+        for df in [1usize, 2, 5, 9, 17, 30, 31, 45, 100] {
             let v = df as f64;
             let c = gamma_half(df + 1) / gamma_half(df) / (v * std::f64::consts::PI).sqrt();
             let pdf = |t: f64| c * (1.0 + t * t / v).powf(-(v + 1.0) / 2.0);

@@ -1,4 +1,4 @@
-//! Recorded reasoning ticks (issue 13): the ticks the scaled agent really reasons on, as
+//! Recorded reasoning ticks: the ticks the scaled agent really reasons on, as
 //! they occur in evaluation episodes, kept so that they can be replayed and timed alone.
 //!
 //! [`record`] runs zero-shot evaluation episodes (a fresh agent per episode, the seeds of

@@ -28,6 +28,8 @@ pub mod bayes_rl;
 mod check;
 pub mod controller;
 pub mod error;
+#[cfg(test)]
+mod factored_checks;
 pub mod gate;
 pub mod inspect;
 pub mod learning;

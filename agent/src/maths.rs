@@ -116,8 +116,9 @@ const LN_TABLE: [[f64; 3]; LN_TABLE_STEPS + 1] = {
 /// `r = m/2 - 1`) with `ln(1 + r)` by its Taylor series to `r^6/6`
 /// (the next term is below 3e-18). Plain IEEE operations and a constant table (no FMA,
 /// no run-time dispatch): every x86-64 machine computes the same bits, scalar or
-/// vectorised. Max error against `std`'s `ln` ~2 ulp of `max(|ln x|, 1)` (test
-/// `fast_ln_matches_std`). Not for zero, subnormal, negative or non-finite `x`:
+/// vectorised. Max error ~2 ulp of `max(|ln x|, 1)`, against `std`'s `ln` (test
+/// `fast_ln_matches_std`) and against musl's `log` through the `libm` crate, a
+/// reference independent of the platform (tests `fast_ln_matches_libm_*`). Not for zero, subnormal, negative or non-finite `x`:
 /// callers floor first.
 #[inline(always)]
 pub fn ln_fast(x: f64) -> f64 {
@@ -299,6 +300,7 @@ pub fn nats_to_bits(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     #[test]
     fn softmax_and_log_softmax_agree() {
@@ -377,6 +379,95 @@ mod tests {
         assert_eq!(got[2], 0.0);
         assert!((got[3] - (1.0f64 - 1e-12).ln()).abs() < 1e-27);
         assert!((got[4] - (1.0f64 + 1e-12).ln()).abs() < 1e-27);
+    }
+
+    /// `|got - want|` in units of `EPSILON · max(|want|, 1)`: the error measure of the
+    /// bounds in the docs of [`ln_fast`] and [`ln_series`].
+    fn ulps(got: f64, want: f64) -> f64 {
+        (got - want).abs() / want.abs().max(1.0) / f64::EPSILON
+    }
+
+    /// Inputs where a table-and-polynomial logarithm is most likely to slip: every
+    /// power of two of the normal range (`r = 0`, the exponent alone) and its
+    /// neighbours, both sides of every table point `1 + i/128` in several binades,
+    /// values within a few ulp and within 1e-k of 1, the log floor 1e-16 and around it,
+    /// and the largest values.
+    fn edge_inputs() -> Vec<f64> {
+        let mut xs = Vec::new();
+        let next = |x: f64, by: i64| f64::from_bits((x.to_bits() as i64 + by) as u64);
+        for e in -1022..=1023 {
+            let p = 2f64.powi(e);
+            xs.extend([p, next(p, 1), next(p, 2)]);
+            if e > -1022 {
+                xs.extend([next(p, -1), next(p, -2)]);
+            }
+        }
+        for scale in [2f64.powi(-60), 0.5, 1.0, 2.0, 1024.0, 2f64.powi(700)] {
+            for i in 0..=128 {
+                let c = (1.0 + f64::from(i) / 128.0) * scale;
+                xs.extend([
+                    c,
+                    next(c, -1),
+                    next(c, 1),
+                    c * (1.0 - 1.0 / 512.0),
+                    c * (1.0 + 1.0 / 512.0),
+                ]);
+            }
+        }
+        for k in 1..=64 {
+            xs.extend([next(1.0, k), next(1.0, -k)]);
+        }
+        for k in 1..=15 {
+            let d = 10f64.powi(-k);
+            xs.extend([1.0 + d, 1.0 - d]);
+        }
+        xs.extend([LN_FLOOR, next(LN_FLOOR, 1), next(LN_FLOOR, -1), 1e-15, 1e-17]);
+        xs.extend([1e300, 1e308, f64::MAX, next(f64::MAX, -1), f64::MIN_POSITIVE]);
+        xs.extend([std::f64::consts::E, 10.0, 0.1, 0.3, 0.7, 1.5, 3.0]);
+        xs
+    }
+
+    /// `ln_fast` (and the series that builds its table) within the documented bounds of
+    /// musl's `log` (the `libm` crate: not the platform's `std`), on the edge inputs and
+    /// on 400,000 points spread log-uniformly over the whole normal range.
+    #[test]
+    fn fast_ln_matches_libm_on_edges_and_the_whole_range() {
+        let mut xs = edge_inputs();
+        let n = 400_000;
+        xs.extend((0..=n).map(|i| 2f64.powf(-1022.0 + 2045.0 * f64::from(i) / f64::from(n))));
+        assert!(xs.iter().all(|x| x.is_normal() && *x > 0.0));
+        let mut got = vec![0.0; xs.len()];
+        // Through the vectorised loop as the agent uses it (inputs at or above the
+        // floor are unchanged by it), and one by one for those below the floor.
+        ln_into(&xs, &mut got);
+        let (mut worst, mut worst_series): (f64, f64) = (0.0, 0.0);
+        for (x, g) in xs.iter().zip(&got) {
+            let want = libm::log(*x);
+            let g = if *x >= LN_FLOOR { *g } else { ln_fast(*x) };
+            worst = worst.max(ulps(g, want));
+            assert!(ulps(g, want) <= 2.0, "ln_fast({x:e}) = {g:e}, libm {want:e}");
+            worst_series = worst_series.max(ulps(ln_series(*x), want));
+        }
+        eprintln!("ln_fast: worst {worst} eps; ln_series: worst {worst_series} eps (vs libm)");
+        assert!(worst_series <= 1.5, "ln_series: {worst_series} eps");
+        // Exactly 0 at 1, and exactly the floor's logarithm below the floor.
+        assert_eq!(ln_fast(1.0), 0.0);
+        let mut floored = [0.0; 2];
+        ln_into(&[1e-300, 0.0], &mut floored);
+        assert_eq!(floored, [ln_fast(LN_FLOOR); 2]);
+        assert!(ulps(floored[0], libm::log(LN_FLOOR)) <= 2.0);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+        /// Any positive normal double (every exponent and mantissa equally likely):
+        /// `ln_fast` within 2 ulp of `max(|ln x|, 1)` of musl's `log`.
+        #[test]
+        fn fast_ln_matches_libm_on_any_normal(exponent in 1u64..2047, mantissa in 0u64..(1u64 << 52)) {
+            let x = f64::from_bits((exponent << 52) | mantissa);
+            let (got, want) = (ln_fast(x), libm::log(x));
+            prop_assert!(ulps(got, want) <= 2.0, "ln_fast({x:e}) = {got:e}, libm {want:e}");
+        }
     }
 
     /// The risk with the table `ln` agrees with the `std` form to rounding, for lengths

@@ -78,7 +78,7 @@ impl GenerativeModel {
         let n = self.n_states();
         match &self.factored {
             Some(ft) if x.iter().filter(|v| **v != 0.0).count() * n > ft.cost() => ft.apply(u, x, out, scratch),
-            _ => crate::surprise::matvec_sparse_x(self.b[u].as_slice(), n, x, out),
+            _ => crate::maths::axpy_columns(self.b[u].as_slice(), n, x, out),
         }
     }
 

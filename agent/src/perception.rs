@@ -219,7 +219,7 @@ pub fn neg_log_evidence(gm: &GenerativeModel, s_hat: &[f64], obs: &[usize], acti
     let mut total = 0.0;
     for (tau, o) in obs.iter().enumerate() {
         if tau > 0 {
-            crate::surprise::matvec_sparse_x(gm.b[actions[tau - 1]].as_slice(), n, &q, &mut pred);
+            crate::maths::axpy_columns(gm.b[actions[tau - 1]].as_slice(), n, &q, &mut pred);
         }
         let z = crate::surprise::bayes_step(gm, *o, &pred, &mut q);
         total -= z.ln();

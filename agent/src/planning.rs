@@ -17,9 +17,8 @@
 //! prefixes: `U + U^2 + ... + U^H` mat-vecs instead of `H U^H`. Policies are ordered
 //! lexicographically (first action most significant): `[0,0], [0,1], ...`.
 
-use crate::maths::{ln, risk_sum, softmax_in_place};
+use crate::maths::{axpy_columns, ln, risk_sum, softmax_in_place};
 use crate::model::GenerativeModel;
-use crate::surprise::matvec_sparse_x;
 
 /// Risk and ambiguity of one future step with predicted state belief `s`
 /// (Prop. 1: `risk = KL[A s || c]`, `ambiguity = s·H_A`). `obuf` is scratch of size n_obs.
@@ -27,7 +26,7 @@ pub fn step_efe(gm: &GenerativeModel, s: &[f64], obuf: &mut [f64]) -> (f64, f64)
     let o: &[f64] = if gm.a_identity {
         s
     } else {
-        matvec_sparse_x(gm.a.as_slice(), gm.n_obs(), s, obuf);
+        axpy_columns(gm.a.as_slice(), gm.n_obs(), s, obuf);
         obuf
     };
     // Zero entries add exactly 0 (the floored log and C are finite): no branch needed.
@@ -81,7 +80,7 @@ pub fn efe_brute_force(gm: &GenerativeModel, q_t: &[f64], policy: &[usize]) -> f
     let mut obuf = vec![0.0; gm.n_obs()];
     let mut g = 0.0;
     for u in policy {
-        matvec_sparse_x(gm.b[*u].as_slice(), n, &s, &mut next);
+        axpy_columns(gm.b[*u].as_slice(), n, &s, &mut next);
         std::mem::swap(&mut s, &mut next);
         let (r, a) = step_efe(gm, &s, &mut obuf);
         g += r + a;

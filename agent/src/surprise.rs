@@ -6,18 +6,11 @@
 
 use crate::model::GenerativeModel;
 
-/// Column-major mat-vec `out = M x` for a square or rectangular dense matrix stored
-/// column-major in `m` (`rows` rows), skipping zero entries of `x` (exact; exploits one-hot beliefs).
-#[inline]
-pub(crate) fn matvec_sparse_x(m: &[f64], rows: usize, x: &[f64], out: &mut [f64]) {
-    crate::maths::axpy_columns(m, rows, x, out);
-}
-
 /// State prediction `ŝ_t = B[a_{t-1}] q_{t-1}`, or `D` when `prev` is `None` (§II; docs/ARCHITECTURE.md §4.4).
 pub fn predict_into(gm: &GenerativeModel, prev: Option<(&[f64], usize)>, out: &mut [f64]) {
     match prev {
         None => out.copy_from_slice(&gm.d),
-        Some((q, u)) => matvec_sparse_x(gm.b[u].as_slice(), gm.n_states(), q, out),
+        Some((q, u)) => crate::maths::axpy_columns(gm.b[u].as_slice(), gm.n_states(), q, out),
     }
 }
 

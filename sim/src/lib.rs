@@ -31,15 +31,15 @@ pub mod embedded;
 pub mod light;
 mod load;
 pub mod map;
+mod shipped;
 mod validate;
 pub mod world;
 
 pub use light::{LightPhase, light_at};
 pub use load::{Diagnostic, MAX_BASE_DEPTH, MAX_FILE_BYTES, MAX_NESTING, MapError};
-pub use map::ProtocolName;
 pub use map::{
-    Bins, Crosswalk, Episode, Expectation, Light, LightCondition, Map, MethodName, Offset, Pause, Phase, Reward, Road,
-    Side, SpawnRule, Trigger, Vehicle,
+    Bins, Crosswalk, Episode, Expectation, Light, LightCondition, Map, Offset, Pause, Phase, Reward, Road, Side,
+    SpawnRule, Trigger, Vehicle,
 };
 pub use validate::{
     DECISION_DT, MAX_EPISODE_SUBSTEPS, MAX_JOINT_STATES, MAX_LIST, MAX_METRES, MAX_PEDESTRIANS, MAX_SPAWN_RULES,

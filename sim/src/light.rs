@@ -1,36 +1,8 @@
-//! The traffic light: a fixed cycle of phases with an offset.
-
-use serde::{Deserialize, Serialize};
+//! The traffic light over time: the phase a map's cycle ([`Light`]) shows at a given
+//! time. The phases themselves ([`LightPhase`]) are map data, defined in [`crate::map`].
 
 use crate::map::Light;
-
-/// The colour the light shows. The discretizer maps amber to red.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum LightPhase {
-    /// Go.
-    Green,
-    /// About to turn red (counts as red for the agent).
-    Amber,
-    /// Stop; pedestrians may cross.
-    Red,
-}
-
-impl LightPhase {
-    /// True for green only.
-    pub fn is_green(self) -> bool {
-        self == LightPhase::Green
-    }
-}
-
-impl std::fmt::Display for LightPhase {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            LightPhase::Green => "green",
-            LightPhase::Amber => "amber",
-            LightPhase::Red => "red",
-        })
-    }
-}
+pub use crate::map::LightPhase;
 
 /// Phase shown at episode time `t` (s) with cycle offset `offset` (s), and the
 /// seconds left in that phase. The map must have a non-empty cycle of positive

@@ -74,7 +74,9 @@ pub struct MapError {
 }
 
 impl MapError {
-    pub(crate) fn new(diagnostics: Vec<Diagnostic>) -> Self {
+    /// An error of the given diagnostics (at least one), e.g. for checks a harness makes
+    /// on a loaded map (the names in its expectations).
+    pub fn new(diagnostics: Vec<Diagnostic>) -> Self {
         debug_assert!(!diagnostics.is_empty());
         MapError { diagnostics }
     }
@@ -141,7 +143,7 @@ impl Map {
                 }
             }
             let name = base.strip_suffix(".ron").unwrap_or(base);
-            crate::embedded::source(name).map(|text| {
+            crate::shipped::source(name).map(|text| {
                 let origin = format!("{EMBEDDED_PREFIX}{name}");
                 Resolved {
                     text: check_text(&origin, text).map(|()| text.to_string()),
@@ -400,7 +402,7 @@ fn build(origin: &str, src: &str, resolve: &Resolver, chain: &mut Vec<String>) -
                     format!("base map {base_name:?} not found"),
                     Some(format!(
                         "a base is a file name relative to this map's folder, e.g. \"intersection.ron\", or an embedded map ({})",
-                        crate::embedded::names().join(", ")
+                        crate::shipped::names().join(", ")
                     )),
                 )));
             };
@@ -563,25 +565,12 @@ fn walk(v: &ron::Value, kind: Kind, path: &str, origin: &str, out: &mut Vec<Diag
 fn suggest(name: &str, known: &[&str]) -> String {
     let best = known
         .iter()
-        .map(|k| (edit_distance(name, k), *k))
+        .map(|k| (strsim::levenshtein(name, k), *k))
         .min_by_key(|(d, _)| *d);
     match best {
         Some((d, k)) if d <= 2 => format!("did you mean `{k}`?"),
         _ => format!("expected one of: {}", known.join(", ")),
     }
-}
-
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, cb) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
-        }
-        prev = cur;
-    }
-    prev[b.len()]
 }
 
 /// The field names serde's derive gives a struct, captured by a deserializer
@@ -676,7 +665,8 @@ mod doc_tests {
 
     #[test]
     fn summary_mentions_the_essentials() {
-        let m = crate::embedded::load("jaywalk").unwrap();
+        let shipped = |base: &str| crate::shipped::source(base).map(|s| (base.to_string(), s.to_string()));
+        let m = Map::from_str_named("jaywalk.ron", crate::shipped::JAYWALK, &shipped).unwrap();
         let s = m.summary();
         for needle in [
             "map jaywalk",
@@ -690,6 +680,37 @@ mod doc_tests {
             assert!(s.contains(needle), "summary lacks {needle:?}:\n{s}");
         }
         assert_eq!(m.crosswalk_distance_to_goal(), (26.0, 22.0));
+    }
+
+    /// Expectations keep their names as written (the harness checks them); a name that
+    /// is not a bare identifier is a type error at its line and column.
+    #[test]
+    fn expectation_names_are_plain_data() {
+        let m = Map::from_str_named(
+            "e.ron",
+            "Map(expect: [(method: Anything, protocol: Whatever), (method: Scaled, protocol: None)])",
+            &|_| None,
+        )
+        .unwrap();
+        assert_eq!(
+            (m.expect[0].method.as_str(), m.expect[0].protocol.as_deref()),
+            ("Anything", Some("Whatever"))
+        );
+        assert_eq!(
+            (m.expect[1].method.as_str(), m.expect[1].protocol.as_deref()),
+            ("Scaled", None)
+        );
+        assert!(m.summary().contains("expect Anything (Whatever): "), "{}", m.summary());
+        for bad in [
+            "Map(expect: [\n  (method: \"Scaled\")])",
+            "Map(expect: [\n  (method: Scaled(1))])",
+            "Map(expect: [\n  (method: Scaled, protocol: \"Continual\")])",
+        ] {
+            let e = Map::from_str_named("e.ron", bad, &|_| None).unwrap_err();
+            let d = &e.diagnostics()[0];
+            assert_eq!(d.position.map(|(line, _)| line), Some(2), "{bad}: {e}");
+            assert!(d.path.starts_with("expect[0]."), "{bad}: {e}");
+        }
     }
 
     #[test]

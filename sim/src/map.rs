@@ -8,8 +8,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::light::LightPhase;
-
 /// Defines a configuration struct with documented defaults, plus a crate-private
 /// "patch" twin whose fields are all optional: a scenario built on a base map
 /// only sets the fields that differ, and `apply` copies them over the base.
@@ -78,6 +76,34 @@ config_struct! {
         x: f64 = 66.0,
         /// Width of the crosswalk along the road, m. Default 4.0 (so it spans x 64–68).
         width: f64 = 4.0,
+    }
+}
+
+/// The colour the light shows. The discretizer maps amber to red.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum LightPhase {
+    /// Go.
+    Green,
+    /// About to turn red (counts as red for the agent).
+    Amber,
+    /// Stop; pedestrians may cross.
+    Red,
+}
+
+impl LightPhase {
+    /// True for green only.
+    pub fn is_green(self) -> bool {
+        self == LightPhase::Green
+    }
+}
+
+impl std::fmt::Display for LightPhase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LightPhase::Green => "green",
+            LightPhase::Amber => "amber",
+            LightPhase::Red => "red",
+        })
     }
 }
 
@@ -294,27 +320,16 @@ impl Default for SpawnRule {
     }
 }
 
-/// Methods the runner compares (names as written in maps).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum MethodName {
-    /// Tabular Q-learning.
-    QLearning,
-    /// Model-based Bayesian RL.
-    BayesRl,
-    /// The paper's method: surprise-triggered reasoning and test-time scaling.
-    Scaled,
-    /// The scripted reference driver (not a method of the paper): slows down while a
-    /// pedestrian is on the crosswalk and the car has not arrived, else speeds up. A
-    /// `min_success` bound on it says the scenario is survivable.
-    BrakeOnPedestrian,
-}
-
-/// Expected outcome of a batch run of one method on this map (checked by the runner).
+/// Expected outcome of a batch run of one method on this map. Plain data: the loader
+/// reads the names as written and checks only their shape (a bare identifier such as
+/// `Scaled`); the harness that runs the batch checks them against its own methods and
+/// protocols.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Expectation {
-    /// Which method.
-    pub method: MethodName,
+    /// Which method, as written in the map (e.g. `"Scaled"`).
+    #[serde(deserialize_with = "names::identifier")]
+    pub method: String,
     /// Lowest acceptable success rate, in [0, 1].
     #[serde(default)]
     pub min_success: Option<f64>,
@@ -333,20 +348,87 @@ pub struct Expectation {
     /// Highest acceptable share of ticks that ran planning, in [0, 1].
     #[serde(default)]
     pub max_inference_rate: Option<f64>,
-    /// The evaluation protocol the bounds apply to; absent: every protocol the batch
-    /// ran the method under.
-    #[serde(default)]
-    pub protocol: Option<ProtocolName>,
+    /// The evaluation protocol the bounds apply to, as written in the map (e.g.
+    /// `"Continual"`); absent: every protocol the batch ran the method under.
+    #[serde(default, deserialize_with = "names::optional_identifier")]
+    pub protocol: Option<String>,
 }
 
-/// Evaluation protocols (names as written in maps): `ZeroShot`, every test episode starts
-/// from the trained state; `Continual`, learning carries over between test episodes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum ProtocolName {
-    /// Every test episode starts from the trained state.
-    ZeroShot,
-    /// What a method learns carries over from one test episode to the next.
-    Continual,
+/// Reading a name written as a bare RON identifier (`method: Scaled`) into a string,
+/// whatever the name: RON parses such an identifier as a unit enum variant, so the
+/// name is taken as the variant's name.
+mod names {
+    use serde::Deserializer;
+    use serde::de::{self, EnumAccess, VariantAccess, Visitor};
+    use std::fmt;
+
+    struct Identifier;
+
+    impl<'de> Visitor<'de> for Identifier {
+        type Value = String;
+
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str("a name such as `Scaled`")
+        }
+
+        fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<String, A::Error> {
+            let (VariantName(name), variant) = data.variant()?;
+            variant.unit_variant()?;
+            Ok(name)
+        }
+    }
+
+    /// A variant's name: deserializers hand it over as an identifier (RON's refuses
+    /// `deserialize_string` there).
+    struct VariantName(String);
+
+    impl<'de> serde::Deserialize<'de> for VariantName {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            d.deserialize_identifier(VariantNameVisitor).map(VariantName)
+        }
+    }
+
+    struct VariantNameVisitor;
+
+    impl Visitor<'_> for VariantNameVisitor {
+        type Value = String;
+
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str("a name")
+        }
+
+        fn visit_str<E: de::Error>(self, v: &str) -> Result<String, E> {
+            Ok(v.to_string())
+        }
+    }
+
+    /// A bare identifier, as its name.
+    pub(super) fn identifier<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+        d.deserialize_enum("Name", &[], Identifier)
+    }
+
+    struct Optional;
+
+    impl<'de> Visitor<'de> for Optional {
+        type Value = Option<String>;
+
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str("an optional name such as `Continual`")
+        }
+
+        fn visit_none<E: de::Error>(self) -> Result<Option<String>, E> {
+            Ok(None)
+        }
+
+        fn visit_some<D: Deserializer<'de>>(self, d: D) -> Result<Option<String>, D::Error> {
+            identifier(d).map(Some)
+        }
+    }
+
+    /// `None`, or a bare identifier (implicitly or explicitly `Some`), as its name.
+    pub(super) fn optional_identifier<'de, D: Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
+        d.deserialize_option(Optional)
+    }
 }
 
 /// A complete scenario. `Map::default()` is the training intersection without
@@ -588,8 +670,8 @@ impl Map {
                     parts.push(format!("{label} {v}"));
                 }
             }
-            let protocol = x.protocol.map(|p| format!(" ({p:?})")).unwrap_or_default();
-            let _ = writeln!(s, "expect {:?}{protocol}: {}", x.method, parts.join(", "));
+            let protocol = x.protocol.as_ref().map(|p| format!(" ({p})")).unwrap_or_default();
+            let _ = writeln!(s, "expect {}{protocol}: {}", x.method, parts.join(", "));
         }
         s
     }

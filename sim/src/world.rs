@@ -180,7 +180,7 @@ impl World {
         let mut phys = PhysicsWorld::new();
         phys.gravity = Vector::ZERO;
         phys.integration_parameters.dt = (1.0 / map.episode.physics_hz) as Real;
-        // What the scene does not need (issue 13): no CCD (a 4.5 m car at 60 Hz would
+        // What the scene does not need: no CCD (a 4.5 m car at 60 Hz would
         // tunnel only above ~290 m/s), and no position-stabilisation
         // passes (they correct penetrations of solid contacts and joints; the scene has
         // neither: pedestrians are sensors), and one solver iteration instead of 4: the
@@ -302,8 +302,8 @@ impl World {
     /// test Rapier's narrow phase runs on a sensor pair (parry's `intersection_test`),
     /// run after every sub-step, so a collision is reported on the sub-step the shapes
     /// first overlap. (Rapier's own sensor events arrive one sub-step late with four
-    /// solver iterations and two with one, measured in session 5 on the scene of the
-    /// test `collision_is_reported_when_the_shapes_touch`.)
+    /// solver iterations and two with one, as measured on the scene of the test
+    /// `collision_is_reported_when_the_shapes_touch`.)
     fn car_touches_pedestrian(&self) -> bool {
         let car = &self.phys.colliders[self.car_collider];
         self.peds.iter().any(|p| {

@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use crate::error::Error;
 use crate::survivability;
-use unforeseen_sim::Map;
 
 /// Arguments of `check-map`.
 #[derive(Debug, Clone, Args)]
@@ -29,7 +28,7 @@ pub struct CheckMapArgs {
 pub fn run(args: CheckMapArgs) -> anyhow::Result<()> {
     let mut bad = 0;
     for file in &args.files {
-        match Map::load(file) {
+        match crate::maps::load_file(file) {
             Ok(map) => {
                 println!("{}: ok\n{}\n", file.display(), map.summary());
                 for warning in survivability::check(&map, args.survivability_episodes, args.seed)? {

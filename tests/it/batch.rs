@@ -129,9 +129,9 @@ fn expectations_pass_and_fail_as_declared() {
     let mut scenarios = scenarios();
     scenarios.truncate(1); // jaywalk
     let map = &mut scenarios[0].map;
-    use unforeseen_sim::{Expectation, MethodName, ProtocolName};
+    use unforeseen_sim::Expectation;
     let none = Expectation {
-        method: MethodName::QLearning,
+        method: "QLearning".into(),
         min_success: None,
         max_success: None,
         min_reward: None,
@@ -151,13 +151,13 @@ fn expectations_pass_and_fail_as_declared() {
             ..none.clone()
         },
         Expectation {
-            method: MethodName::BayesRl,
+            method: "BayesRl".into(),
             max_inference_rate: Some(1.0),
             ..none.clone()
         },
         Expectation {
-            method: MethodName::BayesRl,
-            protocol: Some(ProtocolName::Continual),
+            method: "BayesRl".into(),
+            protocol: Some("Continual".into()),
             min_success: Some(0.0),
             ..none.clone()
         },
@@ -200,7 +200,7 @@ fn expectations_pass_and_fail_as_declared() {
     // is still checked once.
     scenarios[0].map.expect = vec![
         Expectation {
-            method: MethodName::Scaled,
+            method: "Scaled".into(),
             min_success: Some(1.1),
             ..none.clone()
         },
@@ -269,11 +269,10 @@ fn the_cli_fails_when_an_expectation_fails_and_names_it() {
     );
 }
 
-/// Issue 12: resume matched lines on (map name, method, parameters) only, so another
-/// --episodes, --seed, --agent or --set sweep kept the old lines, and kept lines were
-/// rewritten with last-digit float changes. Now a results file names its run, a file
-/// of another run is refused saying what differs (and left as it was), and a resume
-/// with nothing to do leaves the file byte for byte.
+/// A results file names its run (episodes, seed, agents, sweep, ...), so `--resume`
+/// of another run is refused saying what differs (and the file is left as it was), and
+/// a resume with nothing to do leaves the file byte for byte (kept lines are not
+/// rewritten, not even in their last float digits).
 #[test]
 fn resume_refuses_another_runs_file_and_keeps_its_own_byte_for_byte() {
     let scenarios = scenarios();
@@ -364,8 +363,8 @@ fn resume_refuses_another_runs_file_and_keeps_its_own_byte_for_byte() {
     }
 }
 
-/// Issue 12: two maps with one name in different folders shared result keys (the
-/// second map's units were skipped on resume without a warning).
+/// Two maps with one name in different folders would share result keys (a resume
+/// would skip the second map's units): the batch refuses them.
 #[test]
 fn two_maps_with_one_name_are_refused() {
     let dir = tempfile::tempdir().unwrap();

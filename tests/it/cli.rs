@@ -144,6 +144,24 @@ fn missing_and_bad_maps_exit_2_naming_the_file() {
     let out = unforeseen(&["eval", "--map", bad.to_str().unwrap(), "--method", "never-brake"]);
     assert_bad_input(&out, &["bad.ron", "\"nowhere\" not found"]);
     assert_eq!(text(&out).matches("not found").count(), 1, "{}", text(&out));
+    // Expectations name this program's methods and protocols; check-map and batch say
+    // which field is wrong and what it may be.
+    std::fs::write(
+        &bad,
+        "Map(expect: [(method: Scaled), (method: Scaled), (method: Scald, protocol: Continual)])",
+    )
+    .unwrap();
+    let expect_error = [
+        "bad.ron",
+        "expect[2].method",
+        "unknown method `Scald`",
+        "QLearning, BayesRl",
+    ];
+    assert_bad_input(&unforeseen(&["check-map", bad.to_str().unwrap()]), &expect_error);
+    assert_bad_input(
+        &unforeseen(&["batch", bad.to_str().unwrap(), "--episodes", "1"]),
+        &expect_error,
+    );
 }
 
 #[test]
@@ -279,9 +297,9 @@ fn only_regular_files_are_read_or_replaced() {
     assert!(out.is_dir());
 }
 
-/// Issue 12: flags and maps that asked for more memory than any machine has aborted
-/// (exit 134): a VMP window of 99999999999 ticks (2.4 TB), a map of 64 x 64 bin edges
-/// (which check-map accepted). Both are refused up front with the bound and its reason.
+/// Flags and maps that ask for more memory than any machine has, e.g. a VMP window of
+/// 99999999999 ticks (2.4 TB) or a map of 64 x 64 bin edges, are refused up front with
+/// the bound and its reason (not an allocation abort).
 #[test]
 fn allocation_bounds_are_stated_and_enforced() {
     assert_bad_input(

@@ -1,9 +1,9 @@
-//! Issue 12: a corrupt agent file used to panic eval, batch and compare (exit 101: a
-//! Q-table one entry short, `n_actions: 5`, Bayes-RL `visits: []`, `counts: []`,
-//! `n_states: 65`, `reward_sum: []`), or load silently with NaN, infinite or negative
-//! values, an out-of-range discount, tolerance, epsilon or terminal state, a table one
-//! entry too long, or unknown fields (a NaN in A turned scaled's success from 67% to 0%
-//! without a word, and export-model then wrote `null`).
+//! Corrupt agent files are refused by eval, batch and compare with a bad-input error,
+//! never a panic (a Q-table one entry short, `n_actions: 5`, Bayes-RL `visits: []`,
+//! `counts: []`, `n_states: 65`, `reward_sum: []`) and never loaded silently (NaN,
+//! infinite or negative values, an out-of-range discount, tolerance, epsilon or terminal
+//! state, a table one entry too long, unknown fields: a NaN in A would turn scaled's
+//! success to 0% without a word, and export-model would write `null`).
 //!
 //! A corpus of damaged files, each made from a small valid agent by one edit: every one
 //! is refused as bad input (exit code 2) with a message naming the file, the field and

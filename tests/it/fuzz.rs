@@ -1,4 +1,4 @@
-//! Issue 12: a fuzz test over the library API (no processes, so it is fast). Valid maps
+//! A fuzz test over the library API (no processes, so it is fast). Valid maps
 //! (every shipped scenario) and a valid agent file are mutated by a seeded mutator —
 //! numbers replaced by NaN, infinities, negatives, huge and tiny values, lines deleted
 //! or repeated, unknown fields inserted, characters changed, files cut short — and each

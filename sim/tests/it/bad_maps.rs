@@ -285,8 +285,8 @@ proptest! {
     }
 }
 
-/// Issue 12: maps that passed check-map but ran for hours, asked for terabytes, or made
-/// no physical sense. Each is refused with the field, the limit and its reason.
+/// Maps that would run for hours, ask for terabytes, or make no physical sense are
+/// refused, each with the field, the limit and its reason.
 #[test]
 fn runaway_and_absurd_maps_are_refused_with_the_limit() {
     let edges = |n: usize, step: f64| {

@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+# Usage: python3 scripts/module_cycles.py .   (exit status 1 if any crate has a cycle)
+"""Module-level dependency cycles inside each crate of the workspace: an edge a -> b
+when a's code (comments stripped) names `crate::b...` (also inside `use crate::{...}`
+groups) or `super::b...`. Reports strongly connected components with more than one file."""
+import os, re, sys
+root = sys.argv[1]
+crates = {'unforeseen': 'src', 'sim': 'sim/src', 'agent': 'agent/src', 'discretizer': 'discretizer/src'}
+for extra in sys.argv[2:]:
+    crates[extra] = extra + '/src'
+def strip(text):
+    text = re.sub(r'/\*.*?\*/', '', text, flags=re.S)
+    text = re.sub(r'"(\\.|[^"\\])*"', '""', text)
+    return re.sub(r'//[^\n]*', '', text)
+def mod_of(rel):
+    rel = rel[:-3]
+    if rel in ('lib', 'main'): return ''
+    if rel.endswith('/mod'): rel = rel[:-4]
+    return rel.replace('/', '::')
+def paths_in_group(prefix, body):
+    # split a `{a, b::{c, d}, e::f}` group at top level
+    out, depth, cur = [], 0, ''
+    for ch in body:
+        if ch == '{': depth += 1
+        elif ch == '}': depth -= 1
+        if ch == ',' and depth == 0:
+            out.append(cur); cur = ''
+        else:
+            cur += ch
+    out.append(cur)
+    res = []
+    for p in out:
+        p = p.strip()
+        if not p: continue
+        m = re.match(r'([\w:]*?)::\{(.*)\}$', p, re.S)
+        if m: res += paths_in_group(prefix + [x for x in m.group(1).split('::') if x], m.group(2))
+        else: res.append(prefix + [x for x in p.split(' as ')[0].strip().split('::') if x])
+    return res
+total = 0
+for name, src in crates.items():
+    d = os.path.join(root, src)
+    if not os.path.isdir(d): continue
+    files = {}
+    for dp, _, fs in os.walk(d):
+        for f in fs:
+            if f.endswith('.rs'):
+                rel = os.path.relpath(os.path.join(dp, f), d)
+                files[mod_of(rel)] = strip(open(os.path.join(dp, f)).read())
+    mods = set(files)
+    def resolve(segs):
+        best = None
+        for i in range(1, len(segs) + 1):
+            cand = '::'.join(segs[:i])
+            if cand in mods: best = cand
+        return best
+    edges = {m: set() for m in mods}
+    for m, text in files.items():
+        refs = []
+        for g in re.finditer(r'\bcrate::\{(.*?)\};', text, re.S):
+            refs += paths_in_group([], g.group(1))
+        for g in re.finditer(r'\bcrate((?:::\w+)+)', text):
+            refs.append([x for x in g.group(1).split('::') if x])
+        parent = m.rsplit('::', 1)[0] if '::' in m else ''
+        for g in re.finditer(r'\bsuper((?:::\w+)+)', text):
+            segs = [x for x in g.group(1).split('::') if x]
+            refs.append(([parent] if parent else []) + segs)
+            if not resolve(refs[-1]): refs[-1] = [parent] if parent else []
+        for r in refs:
+            t = resolve(r) if r else None
+            if t is None and r and parent == '' and False: pass
+            if t is not None and t != m and t != '':
+                edges[m].add(t)
+    # Tarjan
+    index, low, stack, on, sccs, i = {}, {}, [], set(), [], [0]
+    sys.setrecursionlimit(10000)
+    def visit(v):
+        index[v] = low[v] = i[0]; i[0] += 1; stack.append(v); on.add(v)
+        for w in edges[v]:
+            if w not in index: visit(w); low[v] = min(low[v], low[w])
+            elif w in on: low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop(); on.discard(w); comp.append(w)
+                if w == v: break
+            if len(comp) > 1: sccs.append(comp)
+    for v in sorted(mods):
+        if v not in index: visit(v)
+    print(f'{name}: {len(mods)} files, {sum(map(len, edges.values()))} edges, cycles: {sccs or "none"}')
+    for c in sccs:
+        for a in c:
+            print('   ', a, '->', sorted(e for e in edges[a] if e in c))
+    total += len(sccs)
+sys.exit(1 if total else 0)
