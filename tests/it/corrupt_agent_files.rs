@@ -278,7 +278,7 @@ fn every_damaged_agent_file_is_refused_naming_the_field() {
         let message = format!("{err:#}");
         assert_eq!(unforeseen::cli::exit_code(&err), 2, "{}: {message}", c.name);
         assert!(
-            matches!(err.downcast_ref::<Error>(), Some(Error::AgentFile { .. })),
+            matches!(err, Error::AgentFile { .. }),
             "{}: {message}",
             c.name
         );
