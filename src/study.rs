@@ -361,7 +361,6 @@ mod tests {
             protocols: &Protocol::ALL,
             episodes: 1,
             seed: 0,
-            quiet: true,
         };
         let jobs = jobs(&setup, 2);
         // Per agent: q-learning zero-shot on 2 maps, scaled zero-shot and continual on 2 maps.

@@ -499,5 +499,5 @@ fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
             }
         })
         .collect();
-    grouped_bars(path, &rows)
+    Ok(grouped_bars(path, &rows)?)
 }

@@ -213,7 +213,7 @@ pub fn load_or_train(
     quiet: bool,
 ) -> anyhow::Result<AgentBundle> {
     match agent {
-        Some(path) => crate::agent_file::load(path),
+        Some(path) => Ok(crate::agent_file::load(path)?),
         None => {
             let map = crate::maps::load(map)?;
             progress::phase(

@@ -43,7 +43,7 @@ pub fn tiny_map() -> unforeseen_sim::Map {
 pub fn tiny_agent_text() -> &'static str {
     static TEXT: OnceLock<String> = OnceLock::new();
     TEXT.get_or_init(|| {
-        let mut cfg = TrainConfig::new(30, 3);
+        let cfg = TrainConfig::new(30, 3);
             train(&tiny_map(), &cfg).expect("training").0.to_ron_string()
     })
 }

@@ -73,7 +73,7 @@ fn brake_on_pedestrian_survives_the_jaywalker_and_never_brake_does_not() {
 fn the_method_factory_builds_the_references_from_an_agent_file_too() {
     // One training episode is enough: the references read only the model's factor sizes.
     let intersection = unforeseen::maps::load("intersection").unwrap();
-    let mut cfg = TrainConfig::new(1, 7);
+    let cfg = TrainConfig::new(1, 7);
     let bundle = train(&intersection, &cfg).unwrap().0;
     let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
     for method in Method::REFERENCE {
@@ -135,7 +135,7 @@ fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
     let dir = tempfile::tempdir().unwrap();
     let harmless = harmless(dir.path());
     let intersection = unforeseen::maps::load("intersection").unwrap();
-    let mut cfg = TrainConfig::new(1, 7);
+    let cfg = TrainConfig::new(1, 7);
     let agent = dir.path().join("agent.ron");
     unforeseen::agent_file::save(&agent, &train(&intersection, &cfg).unwrap().0).unwrap();
     let results = dir.path().join("r.jsonl");
