@@ -12,6 +12,11 @@
 //! version, agents, map contents, methods, parameter sets, protocols, training seeds,
 //! episodes, seed). `--resume` refuses a file of another run, saying what differs, and
 //! keeps the lines it reuses byte for byte.
+//!
+//! [`BatchConfig::plan`] computes once what a run does (its units, its shard of them, its
+//! identity and the lines `--resume` keeps) before any agent is needed, so a caller can
+//! train only the agents the units still to run use ([`Plan::train_seeds_to_run`]), then
+//! [`run_plan`] runs it.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
