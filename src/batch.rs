@@ -845,12 +845,7 @@ fn to_line(r: &ResultLine) -> String {
 }
 
 /// Plans the batch ([`BatchConfig::plan`]) and runs it ([`run_plan`]).
-pub fn run(
-    cfg: &BatchConfig<'_>,
-    out: &Path,
-    resume: bool,
-    progress: &dyn Progress,
-) -> Result<Vec<ResultLine>, Error> {
+pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, progress: &dyn Progress) -> Result<Vec<ResultLine>, Error> {
     run_plan(cfg, &cfg.plan(out, resume)?, out, progress)
 }
 

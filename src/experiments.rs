@@ -12,9 +12,9 @@ use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::{Action, Map};
 
 use crate::agent_file::check_compatible;
+use crate::error::Error;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
-use crate::error::Error;
 use crate::progress::Progress;
 use crate::protocol::Protocol;
 use crate::runner::{EpisodeResult, EpisodeSeeds, Tick, run_episode};
@@ -124,11 +124,9 @@ pub fn evaluate_scripted(
 ) -> Result<Vec<EpisodeResult>, Error> {
     let sizes = Discretizer::new(&map.bins)?.factor_sizes();
     let make = || {
-        method
-            .scripted_controller(&sizes)?
-            .ok_or_else(|| Error::NotScripted {
-                method: method.to_string(),
-            })
+        method.scripted_controller(&sizes)?.ok_or_else(|| Error::NotScripted {
+            method: method.to_string(),
+        })
     };
     evaluate_with(
         Protocol::ZeroShot,

@@ -129,7 +129,13 @@ mod tests {
             [Protocol::Continual]
         );
         assert_eq!("continual".parse::<Protocol>(), Ok(Protocol::Continual));
-        assert!("both".parse::<Protocol>().unwrap_err().to_string().contains("zero-shot, continual"));
+        assert!(
+            "both"
+                .parse::<Protocol>()
+                .unwrap_err()
+                .to_string()
+                .contains("zero-shot, continual")
+        );
         assert_eq!(serde_json::to_string(&Protocol::ZeroShot).unwrap(), "\"zero-shot\"");
     }
 }

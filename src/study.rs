@@ -10,10 +10,10 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::{Map, Reward};
 
 use crate::agents::Agent;
+use crate::error::Error;
 use crate::experiments::{MethodRow, evaluate_under, method_row};
 use crate::methods::Method;
 use crate::metrics::Aggregate;
-use crate::error::Error;
 use crate::progress::{Message, Progress};
 use crate::protocol::Protocol;
 use crate::stats::Stat;

@@ -16,8 +16,8 @@
 
 use unforeseen_sim::Map;
 
-use crate::experiments::evaluate_scripted;
 use crate::error::Error;
+use crate::experiments::evaluate_scripted;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
 use crate::progress::NoProgress;

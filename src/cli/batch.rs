@@ -113,11 +113,9 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             })?;
             let identity = match &args.agent {
                 Some(_) => agent_file_identity(&bundle),
-                None => trained_agents_identity(
-                    &maps::load(DEFAULT_TRAIN_MAP)?,
-                    &[Some(args.seed)],
-                    args.train_episodes,
-                )?,
+                None => {
+                    trained_agents_identity(&maps::load(DEFAULT_TRAIN_MAP)?, &[Some(args.seed)], args.train_episodes)?
+                }
             };
             let agent = Agent::from_bundle(bundle);
             let axis = vec![agent.train_seed];

@@ -6,13 +6,13 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use unforeseen_sim::Map;
 
+use super::ProtocolChoice;
 use super::table::{cell, print_grid, range_cell, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
 use crate::agents::Agent;
 use crate::methods::{Method, PaperFigures};
 use crate::plots::{BarPanel, BarRow, bar_key, grouped_bars};
-use super::ProtocolChoice;
 use crate::protocol::Protocol;
 use crate::report::{Csv, num, write_json};
 use crate::study::{METRICS, MethodSummary, ProtocolTable, RewardPair, StudySetup, run_study};

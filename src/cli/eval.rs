@@ -3,12 +3,12 @@
 use clap::Args;
 use std::path::PathBuf;
 
+use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
 use crate::experiments::{evaluate_scripted, evaluate_under};
 use crate::maps;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
-use super::progress::{self, Bars};
 use crate::progress::Progress;
 use crate::protocol::Protocol;
 use crate::report::write_json;

@@ -105,7 +105,9 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
 pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
     let mut cause = Some(err);
     while let Some(e) = cause {
-        let bad_input = e.downcast_ref::<crate::error::Error>().is_some_and(crate::error::Error::is_user_input)
+        let bad_input = e
+            .downcast_ref::<crate::error::Error>()
+            .is_some_and(crate::error::Error::is_user_input)
             || e.is::<crate::maps::MapLookupError>()
             || e.is::<unforeseen_sim::MapError>();
         if bad_input {

@@ -42,7 +42,11 @@ fn bar(len: u64, what: &str, unit: &str, quiet: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(len);
-    let unit = if unit.is_empty() { String::new() } else { format!(" {unit}") };
+    let unit = if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {unit}")
+    };
     let template = format!("{{prefix:>18}} [{{bar:40}}] {{pos}}/{{len}}{unit} {{per_sec}} eta {{eta}}");
     let style = ProgressStyle::with_template(&template)
         .map(|s| s.progress_chars("=> "))
@@ -75,7 +79,10 @@ impl Bars {
 
     /// Bars whose counts are in `unit` (e.g. `episodes`).
     pub fn counting(quiet: bool, unit: &'static str) -> Self {
-        Self { unit, ..Self::new(quiet) }
+        Self {
+            unit,
+            ..Self::new(quiet)
+        }
     }
 
     fn current(&self) -> ProgressBar {

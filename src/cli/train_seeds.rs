@@ -47,6 +47,12 @@ impl TrainSeedArgs {
             ),
         );
         let bars = Bars::counting(quiet, "episodes");
-        Ok(train_agents(&map, seeds, &TrainConfig::new(episodes, 0), self.cache_dir(), &bars)?)
+        Ok(train_agents(
+            &map,
+            seeds,
+            &TrainConfig::new(episodes, 0),
+            self.cache_dir(),
+            &bars,
+        )?)
     }
 }

@@ -7,9 +7,9 @@ use crate::common;
 use std::path::Path;
 use std::sync::OnceLock;
 use unforeseen::agents::Agent;
-use unforeseen::progress::NoProgress;
 use unforeseen::batch::{BatchConfig, ParamSet, ResultLine, Scenario, Shard, load_scenarios, read_lines, run, sweep};
 use unforeseen::methods::Method;
+use unforeseen::progress::NoProgress;
 use unforeseen::protocol::Protocol;
 
 fn scenarios() -> Vec<Scenario> {

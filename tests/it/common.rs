@@ -44,6 +44,6 @@ pub fn tiny_agent_text() -> &'static str {
     static TEXT: OnceLock<String> = OnceLock::new();
     TEXT.get_or_init(|| {
         let cfg = TrainConfig::new(30, 3);
-            train(&tiny_map(), &cfg).expect("training").0.to_ron_string()
+        train(&tiny_map(), &cfg).expect("training").0.to_ron_string()
     })
 }

@@ -5,9 +5,9 @@
 use crate::common;
 
 use unforeseen::experiments::{evaluate, learn, trace};
-use unforeseen::progress::NoProgress;
 use unforeseen::methods::Method;
 use unforeseen::metrics::Aggregate;
+use unforeseen::progress::NoProgress;
 use unforeseen::protocol::Protocol;
 use unforeseen_agent::params::ScaledParams;
 

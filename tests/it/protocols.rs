@@ -4,9 +4,9 @@
 
 use crate::common;
 
-use unforeseen::progress::NoProgress;
 use unforeseen::experiments::{evaluate, evaluate_under};
 use unforeseen::methods::Method;
+use unforeseen::progress::NoProgress;
 use unforeseen::protocol::Protocol;
 use unforeseen::runner::EpisodeResult;
 use unforeseen_agent::params::ScaledParams;

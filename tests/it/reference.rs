@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use unforeseen::experiments::evaluate;
-use unforeseen::progress::NoProgress;
 use unforeseen::methods::Method;
 use unforeseen::metrics::Aggregate;
+use unforeseen::progress::NoProgress;
 use unforeseen::survivability::witness;
 use unforeseen::training::{TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
