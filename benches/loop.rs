@@ -86,7 +86,7 @@ fn training_throughput(c: &mut Criterion) {
 /// `decision_throughput`: the closed loop on the intersection map with
 /// `decision_dt = 0.1` (10 Hz decisions, 6 Rapier sub-steps per decision at 60 Hz) and
 /// `max_steps = 400` (same 40 s horizon): `Env::step` (world step, snapshot, discretizer)
-/// + `ScaledAgent::act` (surprise-triggered reasoning, default parameters). One element
+/// plus `ScaledAgent::act` (surprise-triggered reasoning, default parameters). One element
 /// is one decision tick; episode restarts (`Env::reset`, `begin_episode`) are untimed and
 /// no test-time learning runs.
 fn decision_throughput(c: &mut Criterion, bundle: &AgentBundle) {

@@ -23,9 +23,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use unforeseen::agent_file;
-use unforeseen::cli::compare::DEFAULT_TRAIN_EPISODES;
 use unforeseen::tick_replay::{Recording, ReplayOutcome, TickTimes, jaywalk_family, record};
-use unforeseen::training::{TrainConfig, train};
+use unforeseen::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_sim::embedded;
@@ -70,16 +69,12 @@ fn main() -> anyhow::Result<()> {
         Some(p) => agent_file::load(p)?,
         None => {
             let map = embedded::load("intersection")?;
-            let cfg = TrainConfig {
-                quiet: true,
-                ..TrainConfig::new(DEFAULT_TRAIN_EPISODES, 7)
-            };
-            train(&map, &cfg)?.0
+            train(&map, &TrainConfig::new(DEFAULT_TRAIN_EPISODES, 7))?.0
         }
     };
     let mut base = ScaledParams::default();
     base.planning.horizon = horizon;
-    let params = unforeseen::cli::params::apply(base, &sets)?;
+    let params = unforeseen::overrides::apply(base, &sets)?;
     let maps = jaywalk_family()?;
     let started = Instant::now();
     let rec = record(&bundle, &params, &maps, episodes, seed)?;

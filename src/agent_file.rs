@@ -15,7 +15,7 @@ use crate::error::Error;
 use crate::report::write_atomic;
 
 /// Saves `bundle` to `path` (temporary file + rename).
-pub fn save(path: &Path, bundle: &AgentBundle) -> anyhow::Result<()> {
+pub fn save(path: &Path, bundle: &AgentBundle) -> Result<(), Error> {
     let text = bundle.to_ron_string();
     write_atomic(path, text.as_bytes())
 }
@@ -24,18 +24,17 @@ fn retrain(path: &Path) -> String {
     format!("retrain it with `unforeseen train --out {}`", path.display())
 }
 
-fn bad(path: &Path, field: Option<String>, problem: impl Into<String>, fix: String) -> anyhow::Error {
+fn bad(path: &Path, field: Option<String>, problem: impl Into<String>, fix: String) -> Error {
     Error::AgentFile {
         path: path.to_path_buf(),
         field,
         problem: problem.into(),
         fix,
     }
-    .into()
 }
 
 /// Loads and checks an agent file; every failure is an [`Error::AgentFile`].
-pub fn load(path: &Path) -> anyhow::Result<AgentBundle> {
+pub fn load(path: &Path) -> Result<AgentBundle, Error> {
     let create = format!("create one with `unforeseen train --out {}`", path.display());
     if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
         return Err(bad(path, None, "not a regular file", create));
@@ -57,7 +56,7 @@ pub fn load(path: &Path) -> anyhow::Result<AgentBundle> {
 }
 
 /// Parses and checks the text of an agent file; `path` names it in errors.
-pub fn parse(path: &Path, text: &str) -> anyhow::Result<AgentBundle> {
+pub fn parse(path: &Path, text: &str) -> Result<AgentBundle, Error> {
     let bundle = AgentBundle::from_ron_str(text).map_err(|e| match e {
         PersistError::Invalid(f) => bad(
             path,
@@ -106,7 +105,7 @@ fn check_intersection(bundle: &AgentBundle) -> Result<(), (String, String)> {
 
 /// Checks that `bundle` can drive `map`: the world model's factor sizes are the ones the
 /// map's bins give (the same joint state space, factor by factor).
-pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> anyhow::Result<()> {
+pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> Result<(), Error> {
     let disc = Discretizer::new(&map.bins)?;
     let agent = bundle.world_model.structure().sizes();
     let map_sizes = disc.factor_sizes();
@@ -119,8 +118,7 @@ pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> anyhow::Result<()> {
                 disc.n_states()
             ),
             fix: "its bins differ from the training map's: train an agent on a map with the same bins".into(),
-        }
-        .into());
+        });
     }
     Ok(())
 }

@@ -4,16 +4,16 @@
 //! configuration, crate version and a fingerprint of the training code), so a rerun
 //! loads instead of retraining and a changed input never reuses a stale agent.
 
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_sim::Map;
 
 use crate::agent_file::check_compatible;
-use crate::training::{TrainConfig, train_with_bar};
+use crate::error::Error;
+use crate::progress::{Message, Progress};
+use crate::training::{TrainConfig, train_with_progress};
 
 /// Most training seeds one run accepts (each agent takes seconds to train).
 pub const MAX_TRAIN_SEEDS: usize = 1000;
@@ -91,7 +91,7 @@ impl Agent {
 /// The cache key of the agent `cfg` trains on `map`: a hash of the map's contents, the
 /// training configuration (episodes, seed, Q-learning, priors, Bayesian RL, tau_c), the
 /// crate version and the fingerprint of the training code (build.rs).
-pub fn cache_key(map: &Map, cfg: &TrainConfig) -> anyhow::Result<String> {
+pub fn cache_key(map: &Map, cfg: &TrainConfig) -> Result<String, Error> {
     let parts = serde_json::json!({
         "map": map,
         "episodes": cfg.episodes,
@@ -109,7 +109,7 @@ pub fn cache_key(map: &Map, cfg: &TrainConfig) -> anyhow::Result<String> {
 }
 
 /// Where the cache keeps that agent: `DIR/<map>-seed<S>-<episodes>ep-<key>.ron`.
-pub fn cache_path(dir: &Path, map: &Map, cfg: &TrainConfig) -> anyhow::Result<PathBuf> {
+pub fn cache_path(dir: &Path, map: &Map, cfg: &TrainConfig) -> Result<PathBuf, Error> {
     let safe: String = map
         .name
         .chars()
@@ -126,50 +126,30 @@ pub fn cache_path(dir: &Path, map: &Map, cfg: &TrainConfig) -> anyhow::Result<Pa
 }
 
 /// Loads a cached agent if present and valid: it parses, was stored under the same key,
-/// and fits the map's state space. Anything else is a miss (reported, then retrained).
-fn load_cached(path: &Path, map: &Map, key: &str) -> Option<AgentBundle> {
+/// and fits the map's state space. Anything else is a miss (reported as a warning to
+/// `progress`, then retrained).
+fn load_cached(path: &Path, map: &Map, key: &str, progress: &dyn Progress) -> Option<AgentBundle> {
     if !path.exists() {
         return None;
     }
-    let checked = crate::agent_file::load(path).and_then(|bundle| {
-        if bundle.meta.get("cache_key").map(String::as_str) != Some(key) {
-            anyhow::bail!("its cache key differs from its file name");
-        }
-        check_compatible(&bundle, map)?;
-        Ok(bundle)
-    });
+    let checked = crate::agent_file::load(path)
+        .map_err(|e| e.full_message())
+        .and_then(|bundle| {
+            if bundle.meta.get("cache_key").map(String::as_str) != Some(key) {
+                return Err("its cache key differs from its file name".to_string());
+            }
+            check_compatible(&bundle, map).map_err(|e| e.full_message())?;
+            Ok(bundle)
+        });
     match checked {
         Ok(bundle) => Some(bundle),
         Err(e) => {
-            eprintln!("agent cache: ignoring {} ({e:#}); retraining", path.display());
+            progress.message(
+                Message::Warning,
+                &format!("agent cache: ignoring {} ({e}); retraining", path.display()),
+            );
             None
         }
-    }
-}
-
-/// One bar over all agents' training episodes on a terminal; hidden otherwise.
-fn agents_bar(total: u64, quiet: bool) -> ProgressBar {
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total);
-    let style = ProgressStyle::with_template("{prefix:>18} [{bar:40}] {pos}/{len} episodes {per_sec} eta {eta} {msg}")
-        .map(|s| s.progress_chars("=> "))
-        .unwrap_or_else(|_| ProgressStyle::default_bar());
-    bar.set_style(style);
-    bar
-}
-
-/// Reports one finished agent: a line above the bar on a terminal, a plain line on
-/// stderr otherwise (CI logs), nothing when quiet.
-fn report_agent(bar: &ProgressBar, quiet: bool, line: String) {
-    if quiet {
-        return;
-    }
-    if bar.is_hidden() {
-        eprintln!("{line}");
-    } else {
-        bar.println(line);
     }
 }
 
@@ -177,37 +157,36 @@ fn report_agent(bar: &ProgressBar, quiet: bool, line: String) {
 /// in parallel on the current rayon pool, or loads it from `cache` when a valid copy is
 /// there (and stores fresh ones there, atomically). Agents come back in seed order, and
 /// each depends only on its own seed, so results do not depend on the thread count.
+/// One phase of `progress` (`training N agents`, one step per training episode, a loaded
+/// agent counting all of its episodes), with one [`Message::Item`] per agent.
 pub fn train_agents(
     map: &Map,
     seeds: &[u64],
     base: &TrainConfig,
     cache: Option<&Path>,
-    quiet: bool,
-) -> anyhow::Result<Vec<Agent>> {
-    let bar = agents_bar(base.episodes * seeds.len() as u64, quiet);
-    bar.set_prefix(format!("training {} agents", seeds.len()));
+    progress: &dyn Progress,
+) -> Result<Vec<Agent>, Error> {
+    progress.phase(
+        &format!("training {} agents", seeds.len()),
+        base.episodes * seeds.len() as u64,
+    );
     let agents = seeds
         .par_iter()
         .map(|&seed| {
-            let cfg = TrainConfig {
-                seed,
-                quiet: true,
-                ..base.clone()
-            };
+            let cfg = TrainConfig { seed, ..base.clone() };
             let key = cache_key(map, &cfg)?;
             let path = cache.map(|dir| cache_path(dir, map, &cfg)).transpose()?;
-            if let Some(bundle) = path.as_deref().and_then(|p| load_cached(p, map, &key)) {
-                bar.inc(cfg.episodes);
+            if let Some(bundle) = path.as_deref().and_then(|p| load_cached(p, map, &key, progress)) {
+                progress.advance(cfg.episodes);
                 let from = path.as_deref().map(Path::display);
-                report_agent(
-                    &bar,
-                    quiet,
-                    format!("agent seed {seed}: loaded {}", from.expect("cached")),
+                progress.message(
+                    Message::Item,
+                    &format!("agent seed {seed}: loaded {}", from.expect("cached")),
                 );
                 return Ok(Agent::from_bundle(bundle));
             }
             let started = Instant::now();
-            let (mut bundle, _) = train_with_bar(map, &cfg, &bar)?;
+            let (mut bundle, _) = train_with_progress(map, &cfg, progress)?;
             bundle.meta.insert("cache_key".into(), key);
             let saved = match &path {
                 Some(p) => {
@@ -216,10 +195,9 @@ pub fn train_agents(
                 }
                 None => String::new(),
             };
-            report_agent(
-                &bar,
-                quiet,
-                format!(
+            progress.message(
+                Message::Item,
+                &format!(
                     "agent seed {seed}: trained {} episodes on '{}' in {:.1} s{saved}",
                     cfg.episodes,
                     map.name,
@@ -228,8 +206,8 @@ pub fn train_agents(
             );
             Ok(Agent::from_bundle(bundle))
         })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    bar.finish_and_clear();
+        .collect::<Result<Vec<_>, Error>>()?;
+    progress.finish();
     Ok(agents)
 }
 
@@ -275,11 +253,6 @@ mod tests {
         let cfg = TrainConfig::new(100, 1);
         let key = cache_key(&map, &cfg).unwrap();
         assert_eq!(key, cache_key(&map, &cfg).unwrap());
-        let quiet = TrainConfig {
-            quiet: true,
-            ..cfg.clone()
-        };
-        assert_eq!(key, cache_key(&map, &quiet).unwrap(), "quiet does not change the agent");
         assert_ne!(key, cache_key(&map, &TrainConfig::new(101, 1)).unwrap());
         assert_ne!(key, cache_key(&map, &TrainConfig::new(100, 2)).unwrap());
         let mut q = cfg.clone();

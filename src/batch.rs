@@ -12,23 +12,30 @@
 //! version, agents, map contents, methods, parameter sets, protocols, training seeds,
 //! episodes, seed). `--resume` refuses a file of another run, saying what differs, and
 //! keeps the lines it reuses byte for byte.
+//!
+//! [`BatchConfig::plan`] computes once what a run does (its units, its shard of them, its
+//! identity and the lines `--resume` keeps) before any agent is needed, so a caller can
+//! train only the agents the units still to run use ([`Plan::train_seeds_to_run`]), then
+//! [`run_plan`] runs it.
 
-use anyhow::Context;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 use std::io::Write;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use unforeseen_agent::param_table;
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_sim::Map;
+use unforeseen_agent::persist::AgentBundle;
+use unforeseen_sim::{Action, Map};
 
 use crate::agents::Agent;
 use crate::error::Error;
 use crate::experiments::evaluate_under;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
+use crate::progress::{NoProgress, Progress};
 use crate::protocol::{Protocol, covered};
 use crate::stats::Stat;
 
@@ -59,6 +66,16 @@ impl ParamSet {
         }
     }
 }
+
+/// The methods a batch runs unless told otherwise: the paper's three and the scripted
+/// references (so every map reports whether it is survivable and dangerous).
+pub const DEFAULT_METHODS: [Method; 5] = [
+    Method::QLearning,
+    Method::BayesRl,
+    Method::Scaled,
+    Method::BrakeOnPedestrian,
+    Method::NeverBrake,
+];
 
 /// Most parameter sets one sweep may have (the cross product of its `--set` lists).
 pub const MAX_PARAM_SETS: usize = 10_000;
@@ -131,11 +148,21 @@ pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
     Ok(out)
 }
 
+/// [`sweep`], with every parameter set checked against the scaled agent's parameters
+/// ([`ParamSet::scaled_params`]).
+pub fn checked_sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
+    let params = sweep(sets)?;
+    for p in &params {
+        p.scaled_params()?;
+    }
+    Ok(params)
+}
+
 impl ParamSet {
     /// The scaled agent's parameters with these overrides applied (checked).
-    pub fn scaled_params(&self) -> anyhow::Result<ScaledParams> {
+    pub fn scaled_params(&self) -> Result<ScaledParams, Error> {
         let sets: Vec<String> = self.0.iter().map(|(k, v)| format!("{k}={v}")).collect();
-        Ok(crate::overrides::apply(ScaledParams::default(), &sets)?)
+        crate::overrides::apply(ScaledParams::default(), &sets)
     }
 }
 
@@ -181,7 +208,7 @@ pub fn units(
     params: &[ParamSet],
     protocols: &[Protocol],
     train_seeds: &[Option<u64>],
-) -> anyhow::Result<Vec<Unit>> {
+) -> Result<Vec<Unit>, Error> {
     let mut out = Vec::new();
     // Parameter sets change only the scaled agent: every other method runs once, with the
     // defaults, instead of repeating identical rows for every point of a sweep.
@@ -395,8 +422,8 @@ pub struct BatchConfig<'a> {
     /// Optional shard.
     pub shard: Option<Shard>,
     /// What determines the agents, for the run's identity: an agent file's content hash
-    /// or the training recipe (see [`crate::cli::batch`]). Two runs with the same text
-    /// here run the same agents.
+    /// ([`agent_file_identity`]) or the training recipe ([`trained_agents_identity`]).
+    /// Two runs with the same text here run the same agents.
     pub agents_identity: String,
 }
 
@@ -416,7 +443,7 @@ impl BatchConfig<'_> {
     }
 
     /// All units of the run, in canonical order.
-    pub fn units(&self) -> anyhow::Result<Vec<Unit>> {
+    pub fn units(&self) -> Result<Vec<Unit>, Error> {
         units(
             self.scenarios.len(),
             self.methods,
@@ -426,27 +453,103 @@ impl BatchConfig<'_> {
         )
     }
 
-    /// The units of this run's shard (all units without one).
-    pub fn shard_units(&self) -> anyhow::Result<Vec<Unit>> {
-        let all = self.units()?;
-        let range = self.shard.map_or(0..all.len(), |s| s.range(all.len()));
-        Ok(all[range].to_vec())
+    /// Plans the run into results file `out` (reading the lines `resume` keeps, see
+    /// [`resume_lines`]). Uses everything but [`BatchConfig::agents`], so it can say
+    /// which agents are needed before they are trained ([`Plan::train_seeds_to_run`]).
+    pub fn plan(&self, out: &Path, resume: bool) -> Result<Plan, Error> {
+        let units = self.units()?;
+        let shard = self.shard.map_or(0..units.len(), |s| s.range(units.len()));
+        let identity = self.identity();
+        let kept = if resume {
+            resume_lines(out, &identity, &units, self.scenarios)?
+        } else {
+            Vec::new()
+        };
+        Ok(Plan {
+            identity,
+            units,
+            shard,
+            kept,
+        })
     }
+}
+
+/// A batch run planned before anything runs ([`BatchConfig::plan`]).
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The run's identity (the first line of its results file).
+    pub identity: RunIdentity,
+    /// Every unit of the run, in canonical order.
+    pub units: Vec<Unit>,
+    /// The positions of the units this run's shard takes (all of them without a shard).
+    pub shard: Range<usize>,
+    /// The lines of the results file that `--resume` keeps, in file order.
+    pub kept: Vec<KeptLine>,
+}
+
+impl Plan {
+    /// The units still to run: the shard's, less those whose lines are kept.
+    pub fn todo(&self) -> Vec<&Unit> {
+        let done: BTreeSet<usize> = self.kept.iter().map(|l| l.parsed.unit).collect();
+        self.units[self.shard.clone()]
+            .iter()
+            .filter(|u| !done.contains(&u.index))
+            .collect()
+    }
+
+    /// The training seeds of the units still to run, in the order of the run's training
+    /// seeds: the agents the run needs.
+    pub fn train_seeds_to_run(&self) -> Vec<u64> {
+        let todo = self.todo();
+        self.identity
+            .train_seeds
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&s| todo.iter().any(|u| u.train_seed == Some(s)))
+            .collect()
+    }
+}
+
+/// What determines agents trained on `train_map` for `episodes` episodes with each of
+/// `seeds` and the default training configuration, for a run's identity: their cache
+/// keys (training map contents, episodes, seed, training configuration, version and
+/// training code; [`crate::agents::cache_key`]).
+pub fn trained_agents_identity(train_map: &Map, seeds: &[Option<u64>], episodes: u64) -> Result<String, Error> {
+    let keys = seeds
+        .iter()
+        .flatten()
+        .map(|&seed| crate::agents::cache_key(train_map, &crate::training::TrainConfig::new(episodes, seed)))
+        .collect::<Result<Vec<_>, Error>>()?;
+    Ok(format!(
+        "trained on {} for {episodes} episodes, agents {}",
+        train_map.name,
+        crate::seeds::content_hash(keys.join(",").as_bytes())
+    ))
+}
+
+/// What determines an agent read from a file, for a run's identity: its contents.
+pub fn agent_file_identity(bundle: &AgentBundle) -> String {
+    format!(
+        "agent file with contents {}",
+        crate::seeds::content_hash(bundle.to_ron_string().as_bytes())
+    )
 }
 
 /// Runs one unit: `episodes` episodes of its method on its scenario with its agent,
 /// under its protocol ([`evaluate_under`]: zero-shot episodes in parallel, each from a
 /// fresh controller; continual ones in order on one controller).
-pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine> {
+pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error> {
     let scenario = &cfg.scenarios[unit.scenario];
     let map = &scenario.map;
     let agent = cfg
         .agents
         .iter()
         .find(|a| a.train_seed == unit.train_seed)
-        .ok_or_else(|| anyhow::anyhow!("no agent with training seed {:?} was given", unit.train_seed))?;
+        .ok_or(Error::MissingAgent {
+            train_seed: unit.train_seed,
+        })?;
     let params = unit.params.scaled_params()?;
-    let hidden = indicatif::ProgressBar::hidden();
     let results = evaluate_under(
         unit.protocol,
         map,
@@ -455,10 +558,11 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> anyhow::Result<ResultLine
         unit.method,
         cfg.episodes,
         cfg.seed,
-        &hidden,
+        &NoProgress,
     )?;
     let agg = Aggregate::of(&results);
-    let tree: usize = (1..=params.planning.horizon).map(|k| 3usize.pow(k as u32)).sum();
+    let actions = Action::ALL.len();
+    let tree: usize = (1..=params.planning.horizon).map(|k| actions.pow(k as u32)).sum();
     let plans_by_efe = unit.method.is_scaled();
     Ok(ResultLine {
         unit: unit.index,
@@ -619,28 +723,26 @@ pub struct ResultsFile {
     pub lines: Vec<KeptLine>,
 }
 
-fn results_error(path: &Path, problem: String) -> anyhow::Error {
+fn results_error(path: &Path, problem: String) -> Error {
     Error::Results {
         path: path.to_path_buf(),
         problem,
     }
-    .into()
 }
 
 /// Reads the complete lines of a results file (a missing file has none; a truncated last
 /// line from a killed run is dropped, so that unit runs again).
-pub fn read_results(path: &Path) -> anyhow::Result<ResultsFile> {
+pub fn read_results(path: &Path) -> Result<ResultsFile, Error> {
     match std::fs::metadata(path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(ResultsFile::default()),
         Ok(m) if !m.is_file() => {
             return Err(Error::NotRegularFile {
                 path: path.to_path_buf(),
-            }
-            .into());
+            });
         }
         _ => {}
     }
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io("read", path, e))?;
     let mut file = ResultsFile::default();
     for (i, raw) in text.split_inclusive('\n').enumerate() {
         if !raw.ends_with('\n') {
@@ -676,7 +778,7 @@ pub fn read_results(path: &Path) -> anyhow::Result<ResultsFile> {
 }
 
 /// The result lines of a results file (see [`read_results`]).
-pub fn read_lines(path: &Path) -> anyhow::Result<Vec<ResultLine>> {
+pub fn read_lines(path: &Path) -> Result<Vec<ResultLine>, Error> {
     Ok(read_results(path)?.lines.into_iter().map(|l| l.parsed).collect())
 }
 
@@ -688,7 +790,7 @@ pub fn resume_lines(
     identity: &RunIdentity,
     units: &[Unit],
     scenarios: &[Scenario],
-) -> anyhow::Result<Vec<KeptLine>> {
+) -> Result<Vec<KeptLine>, Error> {
     let file = read_results(out)?;
     let fix = "give another --out, or leave out --resume to start it over (the file is replaced)";
     let Some((first_line, first)) = file.identities.first() else {
@@ -749,32 +851,35 @@ fn to_line(r: &ResultLine) -> String {
     s
 }
 
-/// Runs the batch, streaming each finished unit to `out` after the run's identity and
-/// the lines kept by `resume` (see [`resume_lines`]), then rewrites `out` in canonical
-/// order (kept lines byte for byte). Returns all lines of the file in canonical order.
-pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, quiet: bool) -> anyhow::Result<Vec<ResultLine>> {
-    let all = cfg.units()?;
-    let range = cfg.shard.map_or(0..all.len(), |s| s.range(all.len()));
-    let identity = cfg.identity();
-    let kept: Vec<KeptLine> = if resume {
-        resume_lines(out, &identity, &all, cfg.scenarios)?
-    } else {
-        Vec::new()
-    };
-    let done: BTreeSet<usize> = kept.iter().map(|l| l.parsed.unit).collect();
-    let todo: Vec<&Unit> = all[range].iter().filter(|u| !done.contains(&u.index)).collect();
+/// Plans the batch ([`BatchConfig::plan`]) and runs it ([`run_plan`]).
+pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, progress: &dyn Progress) -> Result<Vec<ResultLine>, Error> {
+    run_plan(cfg, &cfg.plan(out, resume)?, out, progress)
+}
+
+/// Runs a planned batch, streaming each finished unit to `out` after the run's identity
+/// and the lines the plan keeps, then rewrites `out` in canonical order (kept lines byte
+/// for byte). Returns all lines of the file in canonical order. One phase of `progress`
+/// (`batch units`, one step per unit).
+pub fn run_plan(
+    cfg: &BatchConfig<'_>,
+    plan: &Plan,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Vec<ResultLine>, Error> {
+    let identity = &plan.identity;
+    let todo = plan.todo();
 
     // The identity and the kept lines, then the new lines as they finish.
     let head: String = std::iter::once(identity.to_line())
-        .chain(kept.iter().map(|l| l.raw.clone()))
+        .chain(plan.kept.iter().map(|l| l.raw.clone()))
         .collect();
     crate::report::write_atomic(out, head.as_bytes())?;
     let file = std::fs::OpenOptions::new()
         .append(true)
         .open(out)
-        .with_context(|| format!("cannot append to {}", out.display()))?;
+        .map_err(|e| Error::io("append to", out, e))?;
     let sink = Mutex::new(file);
-    let bar = crate::progress::bar(todo.len() as u64, "batch units", quiet);
+    progress.phase("batch units", todo.len() as u64);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(cfg.jobs.max(1)).build()?;
     let fresh: Vec<KeptLine> = pool.install(|| {
         todo.par_iter()
@@ -782,19 +887,20 @@ pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, quiet: bool) -> anyh
                 let line = run_unit(cfg, u)?;
                 let raw = to_line(&line);
                 let mut f = sink.lock().expect("result file lock");
-                f.write_all(raw.as_bytes())?;
-                f.flush()?;
-                bar.inc(1);
+                f.write_all(raw.as_bytes())
+                    .and_then(|()| f.flush())
+                    .map_err(|e| Error::io("write", out, e))?;
+                progress.advance(1);
                 Ok(KeptLine {
                     line: 0,
                     raw,
                     parsed: line,
                 })
             })
-            .collect::<anyhow::Result<Vec<_>>>()
+            .collect::<Result<Vec<_>, Error>>()
     })?;
-    bar.finish_and_clear();
-    let mut lines: Vec<KeptLine> = kept.into_iter().chain(fresh).collect();
+    progress.finish();
+    let mut lines: Vec<KeptLine> = plan.kept.iter().cloned().chain(fresh).collect();
     lines.sort_by_key(|l| l.parsed.unit);
     let text: String = std::iter::once(identity.to_line())
         .chain(lines.iter().map(|l| l.raw.clone()))
@@ -977,7 +1083,7 @@ pub fn summary_path(out: &Path) -> PathBuf {
 /// embedded maps when none are given. Two scenarios with one name (the same map listed
 /// twice, or maps named alike in different folders) are an [`Error::DuplicateScenario`]:
 /// results and `--resume` tell scenarios apart by name.
-pub fn load_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
+pub fn load_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
     let scenarios = read_scenarios(paths)?;
     for (i, s) in scenarios.iter().enumerate() {
         if let Some(first) = scenarios[..i].iter().find(|f| f.map.name == s.map.name) {
@@ -985,15 +1091,14 @@ pub fn load_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
                 name: s.map.name.clone(),
                 first: first.source.clone(),
                 second: s.source.clone(),
-            }
-            .into());
+            });
         }
     }
     Ok(scenarios)
 }
 
 /// The scenarios of `paths`, in order, possibly with repeated names.
-fn read_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
+fn read_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
     if paths.is_empty() {
         return unforeseen_sim::embedded::names()
             .iter()
@@ -1009,7 +1114,7 @@ fn read_scenarios(paths: &[PathBuf]) -> anyhow::Result<Vec<Scenario>> {
     for p in paths {
         if p.is_dir() {
             let mut found: Vec<PathBuf> = std::fs::read_dir(p)
-                .with_context(|| format!("cannot list {}", p.display()))?
+                .map_err(|e| Error::io("list", p, e))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|f| f.extension().is_some_and(|x| x == "ron"))
                 .collect();

@@ -1,12 +1,15 @@
-//! The library's typed errors. Every variant is something the user can fix by changing
-//! an input (an agent file, a map set, a flag, a results file); the library says what is
-//! wrong and how to fix it, and only the command line ([`crate::cli`]) turns an error
-//! into a message and an exit code. Map errors keep their own types
-//! ([`crate::maps::MapLookupError`], [`unforeseen_sim::MapError`]).
+//! The library's typed error: every public function of this crate returns
+//! `Result<_, Error>`. Some variants are input the user can fix by changing it (an agent
+//! file, a map, a flag, a results file), and say what is wrong and how to fix it; the
+//! others are failures of the machine or of a component (a file that cannot be written,
+//! an episode the env refused, a learner that cannot be built). [`Error::is_user_input`]
+//! tells them apart; only the command line ([`crate::cli`]) turns an error into a message
+//! and an exit code. The errors of other crates keep their own types and messages inside
+//! it (map errors, [`unforeseen_env::EnvError`], [`unforeseen_agent::error::AgentError`], ...).
 
 use std::path::PathBuf;
 
-/// An input the user can fix.
+/// Why a function of this crate failed.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -83,9 +86,112 @@ pub enum Error {
         /// How many were checked.
         total: usize,
     },
+    /// No map of that name or path, or a map that does not validate.
+    #[error(transparent)]
+    Map(#[from] crate::maps::MapLookupError),
+    /// A map file that does not validate (every diagnostic).
+    #[error(transparent)]
+    MapFile(#[from] unforeseen_sim::MapError),
+    /// A file or folder could not be read, written, created or listed.
+    #[error("cannot {action} {}", path.display())]
+    Io {
+        /// What was attempted: `read`, `write`, `create folder`, `list`, `append to`.
+        action: &'static str,
+        /// The file or folder.
+        path: PathBuf,
+        /// What the system said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The env could not be built or stepped.
+    #[error(transparent)]
+    Env(#[from] unforeseen_env::EnvError),
+    /// An episode could not run (the controller chose an action the env refused).
+    #[error(transparent)]
+    Episode(#[from] crate::runner::EpisodeError),
+    /// A learner or an agent could not be built from its parameters and sizes.
+    #[error(transparent)]
+    Learner(#[from] unforeseen_agent::error::AgentError),
+    /// A map's bins cannot make a discretizer.
+    #[error(transparent)]
+    Bins(#[from] unforeseen_discretizer::DiscretizerError),
+    /// A value could not be written as JSON.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// A figure could not be drawn.
+    #[error("{message}")]
+    Plot {
+        /// What the plotting library said.
+        message: String,
+    },
+    /// The worker threads could not be started.
+    #[error(transparent)]
+    Threads(#[from] rayon::ThreadPoolBuildError),
+    /// A batch unit names a training seed none of the agents given has.
+    #[error("no agent with training seed {train_seed:?} was given")]
+    MissingAgent {
+        /// The unit's training seed.
+        train_seed: Option<u64>,
+    },
+    /// A method that needs a trained agent was asked to run as a scripted reference.
+    #[error("{method} is not a scripted method")]
+    NotScripted {
+        /// The method's name.
+        method: String,
+    },
 }
 
 impl Error {
+    /// Whether the error is input the user can fix (an agent file, a map, a flag, a
+    /// results file, an output path), rather than a failure of the machine or of a
+    /// component. An [`Error::Io`] is not; what it wraps is only an I/O error.
+    pub fn is_user_input(&self) -> bool {
+        match self {
+            Error::AgentFile { .. }
+            | Error::Agent { .. }
+            | Error::Flag { .. }
+            | Error::Results { .. }
+            | Error::NotRegularFile { .. }
+            | Error::DuplicateScenario { .. }
+            | Error::ModelFile { .. }
+            | Error::MapsFailed { .. }
+            | Error::Map(_)
+            | Error::MapFile(_) => true,
+            Error::Io { .. }
+            | Error::Env(_)
+            | Error::Episode(_)
+            | Error::Learner(_)
+            | Error::Bins(_)
+            | Error::Json(_)
+            | Error::Plot { .. }
+            | Error::Threads(_)
+            | Error::MissingAgent { .. }
+            | Error::NotScripted { .. } => false,
+        }
+    }
+
+    /// An [`Error::Io`]: `action` (`read`, `write`, ...) on `path` failed with `source`.
+    pub fn io(action: &'static str, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            action,
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// The message with every cause after it, `outer: inner: ...` (as the command line
+    /// prints errors).
+    pub fn full_message(&self) -> String {
+        let mut text = self.to_string();
+        let mut cause = std::error::Error::source(self);
+        while let Some(e) = cause {
+            text.push_str(": ");
+            text.push_str(&e.to_string());
+            cause = e.source();
+        }
+        text
+    }
+
     /// A [`Error::Flag`].
     pub fn flag(flag: impl Into<String>, problem: impl Into<String>) -> Self {
         Error::Flag {

@@ -1,7 +1,6 @@
 //! The experiments of §VI: evaluation of a method on a map, the comparison table
 //! (Fig. 8), one traced episode (Figs. 6-7) and test-time learning curves (Fig. 9).
 
-use indicatif::ProgressBar;
 use rayon::prelude::*;
 use serde::Serialize;
 use unforeseen_agent::controller::Controller;
@@ -13,9 +12,10 @@ use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::{Action, Map};
 
 use crate::agent_file::check_compatible;
+use crate::error::Error;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
-use crate::progress;
+use crate::progress::Progress;
 use crate::protocol::Protocol;
 use crate::runner::{EpisodeResult, EpisodeSeeds, Tick, run_episode};
 use crate::seeds::episode_seed;
@@ -32,29 +32,29 @@ pub fn eval_seeds(seed: u64, map: &Map, method: Method, episode: u64) -> Episode
 
 /// Runs `episodes` episodes of `controller` on `map` in order (test-time learning
 /// carries over from one episode to the next: the continual protocol on a controller
-/// the caller built).
+/// the caller built), as one phase of `progress` (`METHOD MAP`, one step per episode).
 pub fn evaluate(
     map: &Map,
     controller: &mut dyn Controller,
     method: Method,
     episodes: u64,
     seed: u64,
-    quiet: bool,
-) -> anyhow::Result<Vec<EpisodeResult>> {
+    progress: &dyn Progress,
+) -> Result<Vec<EpisodeResult>, Error> {
     let mut env = Env::new(map, EnvConfig::default())?;
-    let bar = progress::bar(episodes, &format!("{} {}", method.name(), map.name), quiet);
+    progress.phase(&format!("{} {}", method.name(), map.name), episodes);
     let results = (0..episodes)
         .map(|ep| {
-            bar.inc(1);
+            progress.advance(1);
             Ok(run_episode(&mut env, controller, eval_seeds(seed, map, method, ep), false)?.0)
         })
         .collect();
-    bar.finish_and_clear();
+    progress.finish();
     results
 }
 
 /// Runs `episodes` evaluation episodes of `method` on `map` under `protocol`, advancing
-/// `bar` by one per episode. Zero-shot: a fresh controller per episode, episodes in
+/// `progress` by one per episode (the caller announces and finishes the phase). Zero-shot: a fresh controller per episode, episodes in
 /// parallel (rayon); continual: one controller, episodes in order. A method that does
 /// not learn across episodes always runs zero-shot (identical results, in parallel).
 /// Seeds derive from (seed, map, method, episode), so results do not depend on the
@@ -68,15 +68,15 @@ pub fn evaluate_under(
     method: Method,
     episodes: u64,
     seed: u64,
-    bar: &ProgressBar,
-) -> anyhow::Result<Vec<EpisodeResult>> {
+    progress: &dyn Progress,
+) -> Result<Vec<EpisodeResult>, Error> {
     check_compatible(bundle, map)?;
     let make = || method.controller(bundle, params);
-    evaluate_with(protocol, map, method, params, &make, episodes, seed, bar)
+    evaluate_with(protocol, map, method, params, &make, episodes, seed, progress)
 }
 
 /// Makes a fresh controller of the method being evaluated.
-pub type MakeController<'a> = dyn Fn() -> anyhow::Result<Box<dyn Controller>> + Sync + 'a;
+pub type MakeController<'a> = dyn Fn() -> Result<Box<dyn Controller>, Error> + Sync + 'a;
 
 /// [`evaluate_under`] with the controllers made by `make` (e.g. a scripted reference,
 /// which needs no trained agent).
@@ -89,12 +89,12 @@ pub fn evaluate_with(
     make: &MakeController<'_>,
     episodes: u64,
     seed: u64,
-    bar: &ProgressBar,
-) -> anyhow::Result<Vec<EpisodeResult>> {
+    progress: &dyn Progress,
+) -> Result<Vec<EpisodeResult>, Error> {
     let new_env = || Env::new(map, EnvConfig::default());
-    let run = |env: &mut Env, controller: &mut dyn Controller, ep: u64| -> anyhow::Result<EpisodeResult> {
+    let run = |env: &mut Env, controller: &mut dyn Controller, ep: u64| -> Result<EpisodeResult, Error> {
         let result = run_episode(env, controller, eval_seeds(seed, map, method, ep), false)?.0;
-        bar.inc(1);
+        progress.advance(1);
         Ok(result)
     };
     match protocol.effective(method, params) {
@@ -120,13 +120,13 @@ pub fn evaluate_scripted(
     method: Method,
     episodes: u64,
     seed: u64,
-    bar: &ProgressBar,
-) -> anyhow::Result<Vec<EpisodeResult>> {
+    progress: &dyn Progress,
+) -> Result<Vec<EpisodeResult>, Error> {
     let sizes = Discretizer::new(&map.bins)?.factor_sizes();
     let make = || {
-        method
-            .scripted_controller(&sizes)?
-            .ok_or_else(|| anyhow::anyhow!("{method} is not a scripted method"))
+        method.scripted_controller(&sizes)?.ok_or_else(|| Error::NotScripted {
+            method: method.to_string(),
+        })
     };
     evaluate_with(
         Protocol::ZeroShot,
@@ -136,7 +136,7 @@ pub fn evaluate_scripted(
         &make,
         episodes,
         seed,
-        bar,
+        progress,
     )
 }
 
@@ -194,7 +194,7 @@ pub fn trace(
     seed: u64,
     protocol: Protocol,
     episode: u64,
-) -> anyhow::Result<(EpisodeResult, Vec<Tick>)> {
+) -> Result<(EpisodeResult, Vec<Tick>), Error> {
     let mut env = Env::new(map, EnvConfig::default())?;
     check_compatible(bundle, map)?;
     let mut controller = method.controller(bundle, params)?;
@@ -238,15 +238,16 @@ pub struct LearnPoint {
 }
 
 /// Runs the scaled agent (with test-time learning, the continual protocol) for `episodes`
-/// episodes on `map`, recording the quantities of Fig. 9 in the paper's units.
+/// episodes on `map`, recording the quantities of Fig. 9 in the paper's units, as one
+/// phase of `progress` (`learning`, one step per episode).
 pub fn learn(
     bundle: &AgentBundle,
     params: &ScaledParams,
     map: &Map,
     episodes: u64,
     seed: u64,
-    quiet: bool,
-) -> anyhow::Result<Vec<LearnPoint>> {
+    progress: &dyn Progress,
+) -> Result<Vec<LearnPoint>, Error> {
     let mut env = Env::new(map, EnvConfig::default())?;
     let disc = env.discretizer().clone();
     check_compatible(bundle, map)?;
@@ -255,7 +256,7 @@ pub fn learn(
         p.learning.enabled = true;
         p
     })?;
-    let bar = progress::bar(episodes, "learning", quiet);
+    progress.phase("learning", episodes);
     let mut event_state: Option<usize> = None;
     let mut points = Vec::new();
     let slow = Action::SlowDown.index();
@@ -294,9 +295,9 @@ pub fn learn(
             success: result.success,
             reward: result.ret,
         });
-        bar.inc(1);
+        progress.advance(1);
     }
-    bar.finish_and_clear();
+    progress.finish();
     Ok(points)
 }
 

@@ -27,9 +27,13 @@
 //!   writes an episode as a self-contained HTML page that plays it;
 //! * [`tick_replay`] records the scaled agent's reasoning ticks in episodes and replays
 //!   them (the benches' in-loop reasoning tick);
-//! * [`batch`] runs scenario suites and sweeps headless, in parallel and in shards;
-//! * [`error`] is the library's typed error (what the user can fix);
-//! * [`cli`] is the command line, and alone decides messages and exit codes.
+//! * [`batch`] plans and runs scenario suites and sweeps headless, in parallel and in
+//!   shards;
+//! * [`error`] is the library's typed error, which every public function returns;
+//! * [`progress`] is how long runs report progress ([`progress::Progress`]); the library
+//!   itself prints nothing;
+//! * [`cli`] is the command line (arguments, progress bars), and alone prints and
+//!   decides messages and exit codes.
 //!
 //! `docs/ARCHITECTURE.md` in the repository describes the layout, the data flow and the
 //! equations, with the paper's sections.

@@ -17,10 +17,10 @@ fn main() {
         }
         default_hook(info);
     }));
-    unforeseen::progress::start_clock();
+    unforeseen::cli::progress::start_clock();
     let cli = Cli::parse();
     if let Err(err) = run(cli) {
         eprintln!("error: {err:#}");
-        std::process::exit(exit_code(&err));
+        std::process::exit(exit_code(&*err));
     }
 }

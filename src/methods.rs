@@ -10,9 +10,7 @@ use crate::error::Error;
 use crate::reference::{BrakeOnPedestrian, NeverBrake};
 
 /// A method (or ablation) the runner can drive.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Tabular Q-learning, greedy on its Q-table; never reasons.
@@ -45,6 +43,19 @@ pub enum Method {
 }
 
 impl Method {
+    /// Every method, in the order listings show them.
+    pub const ALL: [Method; 10] = [
+        Method::QLearning,
+        Method::BayesRl,
+        Method::Scaled,
+        Method::BayesRlFactored,
+        Method::ScaledAlways,
+        Method::ScaledNoLearning,
+        Method::ScaledOneStepGate,
+        Method::ScaledGateLearnsAll,
+        Method::BrakeOnPedestrian,
+        Method::NeverBrake,
+    ];
     /// The three methods of the paper's table.
     pub const PAPER: [Method; 3] = [Method::QLearning, Method::BayesRl, Method::Scaled];
     /// The ablations (docs/ARCHITECTURE.md §5).
@@ -99,7 +110,37 @@ impl Method {
 
     /// Every method, in declaration order.
     pub fn all() -> &'static [Method] {
-        <Method as clap::ValueEnum>::value_variants()
+        &Method::ALL
+    }
+
+    /// One line saying what the method is (for listings such as `--help`).
+    pub fn summary(self) -> &'static str {
+        match self {
+            Method::QLearning => "Tabular Q-learning, greedy on its Q-table; never reasons",
+            Method::BayesRl => {
+                "Model-based Bayesian RL on a flat Dirichlet joint-transition posterior; plans every tick"
+            }
+            Method::Scaled => {
+                "The paper's agent: Q-learning policy as pi_o, surprise-triggered reasoning, test-time scaling and test-time learning"
+            }
+            Method::BayesRlFactored => {
+                "Ablation: Bayesian RL planning on the factored world model instead of the flat one"
+            }
+            Method::ScaledAlways => "Ablation: the scaled agent reasoning on every tick",
+            Method::ScaledNoLearning => "Ablation: the scaled agent without test-time learning",
+            Method::ScaledOneStepGate => {
+                "Ablation: the scaled agent gated by the one-step surprise of the joint transition instead of the surprise on the state"
+            }
+            Method::ScaledGateLearnsAll => {
+                "Ablation: the scaled agent whose gate learns every tick as familiar, whether or not reasoning endorses what the habit would do there"
+            }
+            Method::BrakeOnPedestrian => {
+                "Scripted reference (not a method of the paper): slows down while a pedestrian is on the crosswalk and the car has not arrived, else speeds up; never reasons, never learns. Whether it survives a map says whether the map is survivable"
+            }
+            Method::NeverBrake => {
+                "Scripted reference: always speeds up. Whether it is hit says whether a map is dangerous"
+            }
+        }
     }
 
     /// The paper's reported figures for this method (§VI, Fig. 8), where it reports them.
@@ -162,7 +203,7 @@ impl Method {
     /// [`Method::controller`] builds its scripted methods here, with the sizes of the
     /// bundle's world model; callers without an agent (`check-map`, `eval` without
     /// `--agent`) pass the map discretizer's sizes.
-    pub fn scripted_controller(self, sizes: &[usize]) -> anyhow::Result<Option<Box<dyn Controller>>> {
+    pub fn scripted_controller(self, sizes: &[usize]) -> Result<Option<Box<dyn Controller>>, Error> {
         Ok(match self {
             Method::BrakeOnPedestrian => Some(Box::new(BrakeOnPedestrian::new(sizes)?)),
             Method::NeverBrake => Some(Box::new(NeverBrake)),
@@ -172,8 +213,8 @@ impl Method {
 
     /// Builds a fresh controller of this method from the trained bundle (the scripted
     /// references take only the factor sizes of its world model).
-    pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> anyhow::Result<Box<dyn Controller>> {
-        let scaled = |params: ScaledParams| -> anyhow::Result<Box<dyn Controller>> {
+    pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> Result<Box<dyn Controller>, Error> {
+        let scaled = |params: ScaledParams| -> Result<Box<dyn Controller>, Error> {
             Ok(Box::new(scaled_agent(bundle, params)?))
         };
         // An ablation: the given parameters with one changed.
@@ -215,6 +256,25 @@ pub fn scaled_agent(bundle: &AgentBundle, params: ScaledParams) -> Result<Scaled
 impl std::fmt::Display for Method {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+/// A method name that is none of [`Method::ALL`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("'{given}' is not a method; expected one of {}", Method::ALL.map(Method::name).join(", "))]
+pub struct UnknownMethod {
+    /// The name given.
+    pub given: String,
+}
+
+impl std::str::FromStr for Method {
+    type Err = UnknownMethod;
+    /// Parses a method by [`Method::name`].
+    fn from_str(s: &str) -> Result<Self, UnknownMethod> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| UnknownMethod { given: s.to_string() })
     }
 }
 

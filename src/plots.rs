@@ -7,13 +7,16 @@
 //! ([`text_width`]), and the integration tests check every figure for overlapping or
 //! clipped text (`tests/it/figures.rs`).
 
-use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
+use crate::error::Error;
 use crate::report::write_atomic;
+
+/// What the drawing functions return.
+type Result<T> = std::result::Result<T, Error>;
 
 /// A drawing area in pixels on the SVG backend.
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
@@ -28,16 +31,18 @@ pub fn render_svg(size: (u32, u32), draw: impl FnOnce(&Area<'_>) -> Result<()>) 
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        root.fill(&WHITE).map_err(|e| Error::Plot { message: e.to_string() })?;
         draw(&root)?;
-        root.present().map_err(|e| anyhow!("{e}"))?;
+        root.present().map_err(|e| Error::Plot { message: e.to_string() })?;
     }
     Ok(svg)
 }
 
-/// Turns any plotters error into an anyhow error.
-pub fn plot_err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("plotting failed: {e:?}")
+/// Turns any plotters error into an [`Error::Plot`].
+pub fn plot_err<E: std::fmt::Debug>(e: E) -> Error {
+    Error::Plot {
+        message: format!("plotting failed: {e:?}"),
+    }
 }
 
 /// Font size of keys and small labels (plotters' size; the SVG gets size / 1.24).

@@ -1,48 +1,46 @@
-//! Progress: bars drawn on a terminal; elsewhere (CI logs, pipes, files) one plain line
-//! on stderr per phase of a run (training, evaluating each method, writing), with the
-//! seconds since the program started, so a long run is never silent. `--quiet` turns
-//! both off.
+//! Progress of long runs, through the [`Progress`] trait: the library announces a phase
+//! (a name and a number of steps), advances it, finishes it, and passes on the lines it
+//! has for the user (what it is doing, one finished item, a warning). It draws and prints
+//! nothing itself; [`NoProgress`] ignores everything, and the command line draws bars or
+//! prints lines.
+//!
+//! Functions that run a whole phase (training several agents, a study, a batch, learning
+//! curves) announce it and finish it; the building blocks they share
+//! ([`crate::training::train_with_progress`], [`crate::experiments::evaluate_under`] and
+//! its siblings) only advance, so several of them running in parallel share one phase.
 
-use indicatif::{ProgressBar, ProgressStyle};
-use std::fmt::Display;
-use std::io::IsTerminal;
-use std::sync::OnceLock;
-use std::time::Instant;
-
-/// When the clock of the phase lines started.
-static START: OnceLock<Instant> = OnceLock::new();
-
-/// Starts the clock of the phase lines (the first phase line starts it otherwise).
-pub fn start_clock() {
-    START.get_or_init(Instant::now);
+/// What a line for the user is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Message {
+    /// What the run is doing now, e.g. `evaluating q-learning, scaled on ...` or
+    /// `evaluated scaled`.
+    Status,
+    /// One finished item of the phase, e.g. `agent seed 3: loaded ...`.
+    Item,
+    /// Something the user should know whether or not they asked for progress, e.g. a
+    /// cache entry that could not be used.
+    Warning,
 }
 
-/// Whether phase lines are printed: not quiet, and stderr is not a terminal (where the
-/// bars show progress instead).
-pub fn phase_lines(quiet: bool) -> bool {
-    !quiet && !std::io::stderr().is_terminal()
+/// Receives the progress of a run. Shared between the worker threads of a phase.
+pub trait Progress: Sync {
+    /// A phase of `total` steps starts, labelled `name` (e.g. `training`, `evaluating`).
+    fn phase(&self, name: &str, total: u64);
+    /// `n` more steps of the current phase are done.
+    fn advance(&self, n: u64);
+    /// The current phase is over.
+    fn finish(&self);
+    /// A line for the user.
+    fn message(&self, kind: Message, line: &str);
 }
 
-/// Prints one phase line on stderr, `[   9.4 s] training 6000 episodes on 'intersection'`,
-/// when stderr is not a terminal and `quiet` is not set.
-pub fn phase(quiet: bool, what: impl Display) {
-    if phase_lines(quiet) {
-        let t = START.get_or_init(Instant::now).elapsed().as_secs_f64();
-        eprintln!("[{t:>6.1} s] {what}");
-    }
-}
+/// Ignores all progress.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoProgress;
 
-/// A progress bar over `len` items labelled `what`; hidden when stderr is not a
-/// terminal or when `quiet` is set (see [`phase`] for what is printed then).
-pub fn bar(len: u64, what: &str, quiet: bool) -> ProgressBar {
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(len);
-    let style = ProgressStyle::with_template("{prefix:>18} [{bar:40}] {pos}/{len} {per_sec} eta {eta}")
-        .map(|s| s.progress_chars("=> "))
-        .unwrap_or_else(|_| ProgressStyle::default_bar());
-    bar.set_style(style);
-    bar.set_prefix(what.to_string());
-    bar
+impl Progress for NoProgress {
+    fn phase(&self, _name: &str, _total: u64) {}
+    fn advance(&self, _n: u64) {}
+    fn finish(&self) {}
+    fn message(&self, _kind: Message, _line: &str) {}
 }

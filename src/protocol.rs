@@ -15,7 +15,7 @@ use unforeseen_agent::params::ScaledParams;
 use crate::methods::Method;
 
 /// How test episodes relate to each other.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Protocol {
     /// Every test episode starts from the trained state (fresh controller per episode).
@@ -33,6 +33,14 @@ impl Protocol {
         match self {
             Protocol::ZeroShot => "zero-shot",
             Protocol::Continual => "continual",
+        }
+    }
+
+    /// One line saying what the protocol is (for listings such as `--help`).
+    pub fn summary(self) -> &'static str {
+        match self {
+            Protocol::ZeroShot => "Every test episode starts from the trained state (fresh controller per episode)",
+            Protocol::Continual => "Learning carries over from one test episode to the next, in order",
         }
     }
 
@@ -77,26 +85,22 @@ impl std::fmt::Display for Protocol {
     }
 }
 
-/// The `--protocol` option: one protocol or both.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum ProtocolChoice {
-    /// Only zero-shot.
-    ZeroShot,
-    /// Only continual.
-    Continual,
-    /// Zero-shot, then continual.
-    #[default]
-    Both,
+/// A protocol name that is neither of [`Protocol::ALL`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("'{given}' is not a protocol; expected one of {}", Protocol::ALL.map(Protocol::name).join(", "))]
+pub struct UnknownProtocol {
+    /// The name given.
+    pub given: String,
 }
 
-impl ProtocolChoice {
-    /// The chosen protocols, zero-shot first.
-    pub fn protocols(self) -> Vec<Protocol> {
-        match self {
-            ProtocolChoice::ZeroShot => vec![Protocol::ZeroShot],
-            ProtocolChoice::Continual => vec![Protocol::Continual],
-            ProtocolChoice::Both => Protocol::ALL.to_vec(),
-        }
+impl std::str::FromStr for Protocol {
+    type Err = UnknownProtocol;
+    /// Parses a protocol by [`Protocol::name`].
+    fn from_str(s: &str) -> Result<Self, UnknownProtocol> {
+        Protocol::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| UnknownProtocol { given: s.to_string() })
     }
 }
 
@@ -128,7 +132,14 @@ mod tests {
             covered(Method::Scaled, &p, Protocol::Continual, &Protocol::ALL),
             [Protocol::Continual]
         );
-        assert_eq!(ProtocolChoice::default().protocols(), Protocol::ALL);
+        assert_eq!("continual".parse::<Protocol>(), Ok(Protocol::Continual));
+        assert!(
+            "both"
+                .parse::<Protocol>()
+                .unwrap_err()
+                .to_string()
+                .contains("zero-shot, continual")
+        );
         assert_eq!(serde_json::to_string(&Protocol::ZeroShot).unwrap(), "\"zero-shot\"");
     }
 }

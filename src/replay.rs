@@ -81,7 +81,13 @@ fn html_escape(s: &str) -> String {
 /// The replay page of an episode: `ticks` as `trace` records them (the last one is the
 /// world after the final action), titled `title`, ending in `outcome`, against the
 /// reasoning threshold `epsilon`.
-pub fn replay_html(title: &str, outcome: &str, map: &Map, ticks: &[Tick], epsilon: f64) -> anyhow::Result<String> {
+pub fn replay_html(
+    title: &str,
+    outcome: &str,
+    map: &Map,
+    ticks: &[Tick],
+    epsilon: f64,
+) -> Result<String, crate::error::Error> {
     let road_half = f64::from(map.road.lanes) * map.road.lane_width / 2.0;
     let last = ticks.len().saturating_sub(1);
     let episode = Episode {

@@ -1,29 +1,29 @@
 //! Writing results: atomically (temporary file, then rename), so a killed run never
 //! leaves a half-written file behind, and a failed write leaves no temporary file.
 
-use anyhow::Context;
 use std::io::Write;
 use std::path::Path;
+
+use crate::error::Error;
 
 /// Writes `bytes` to `path` through a temporary file in the same folder
 /// ([`tempfile::NamedTempFile`], removed if anything fails, a panic included) and a
 /// rename, then syncs the folder so the rename itself is durable.
 /// Refuses a `path` that exists and is not a regular file (a device such as `/dev/full`,
 /// a folder, a pipe): the rename would replace it.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     if let Ok(meta) = std::fs::metadata(path)
         && !meta.is_file()
     {
-        return Err(crate::error::Error::NotRegularFile {
+        return Err(Error::NotRegularFile {
             path: path.to_path_buf(),
-        }
-        .into());
+        });
     }
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
     let result = (|| -> std::io::Result<()> {
         let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
         tmp.write_all(bytes)?;
@@ -36,11 +36,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         }
         Ok(())
     })();
-    result.with_context(|| format!("cannot write {}", path.display()))
+    result.map_err(|e| Error::io("write", path, e))
 }
 
 /// Serializes `value` as pretty JSON to `path`, atomically.
-pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<(), Error> {
     let mut text = serde_json::to_string_pretty(value)?;
     text.push('\n');
     write_atomic(path, text.as_bytes())
@@ -80,7 +80,7 @@ impl Csv {
     }
 
     /// Writes the table to `path`, atomically.
-    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
+    pub fn write(&self, path: &Path) -> Result<(), Error> {
         write_atomic(path, self.to_text().as_bytes())
     }
 }

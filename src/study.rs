@@ -10,10 +10,11 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::{Map, Reward};
 
 use crate::agents::Agent;
+use crate::error::Error;
 use crate::experiments::{MethodRow, evaluate_under, method_row};
 use crate::methods::Method;
 use crate::metrics::Aggregate;
-use crate::progress;
+use crate::progress::{Message, Progress};
 use crate::protocol::Protocol;
 use crate::stats::Stat;
 
@@ -34,8 +35,6 @@ pub struct StudySetup<'a> {
     pub episodes: u64,
     /// Evaluation seed: episode seeds derive from it, the same for every agent.
     pub seed: u64,
-    /// Hide the progress bar.
-    pub quiet: bool,
 }
 
 /// The agent with the lowest test success (ties: lowest test reward, then first seed).
@@ -172,14 +171,20 @@ fn jobs(setup: &StudySetup<'_>, n_agents: usize) -> Vec<Job> {
 }
 
 /// Runs the study: every job in parallel (rayon; zero-shot episodes are parallel too),
-/// then one table per protocol. Results do not depend on the number of threads.
-pub fn run_study(setup: &StudySetup<'_>, agents: &[Agent]) -> anyhow::Result<Vec<ProtocolTable>> {
+/// then one table per protocol. Results do not depend on the number of threads. One
+/// phase of `progress` (`evaluating`, one step per episode), with a [`Message::Status`]
+/// line when it starts and one as each method's evaluations are done.
+pub fn run_study(
+    setup: &StudySetup<'_>,
+    agents: &[Agent],
+    progress: &dyn Progress,
+) -> Result<Vec<ProtocolTable>, Error> {
     let jobs = jobs(setup, agents.len());
-    let bar = progress::bar(jobs.len() as u64 * setup.episodes, "evaluating", setup.quiet);
+    progress.phase("evaluating", jobs.len() as u64 * setup.episodes);
     let names = |xs: Vec<String>| xs.join(", ");
-    progress::phase(
-        setup.quiet,
-        format_args!(
+    progress.message(
+        Message::Status,
+        &format!(
             "evaluating {} on '{}' (training map) and '{}' (test map), {}: {} runs of {} episodes",
             names(setup.methods.iter().map(|m| m.name().to_string()).collect()),
             setup.train_map.name,
@@ -189,7 +194,7 @@ pub fn run_study(setup: &StudySetup<'_>, agents: &[Agent]) -> anyhow::Result<Vec
             setup.episodes
         ),
     );
-    // Runs left per method, for one line as each method finishes (phase lines only).
+    // Runs left per method, for one line as each method finishes.
     let left: std::sync::Mutex<BTreeMap<Method, usize>> = std::sync::Mutex::new(BTreeMap::new());
     for job in &jobs {
         *left.lock().expect("progress counts").entry(job.1).or_default() += 1;
@@ -206,18 +211,18 @@ pub fn run_study(setup: &StudySetup<'_>, agents: &[Agent]) -> anyhow::Result<Vec
                 method,
                 setup.episodes,
                 setup.seed,
-                &bar,
+                progress,
             )?;
             let mut left = left.lock().expect("progress counts");
             let n = left.entry(method).or_default();
             *n = n.saturating_sub(1);
             if *n == 0 {
-                progress::phase(setup.quiet, format_args!("evaluated {method}"));
+                progress.message(Message::Status, &format!("evaluated {method}"));
             }
             Ok(((agent, method, protocol, map), Aggregate::of(&results)))
         })
-        .collect::<anyhow::Result<BTreeMap<Job, Aggregate>>>()?;
-    bar.finish_and_clear();
+        .collect::<Result<BTreeMap<Job, Aggregate>, Error>>()?;
+    progress.finish();
     Ok(setup
         .protocols
         .iter()
@@ -356,7 +361,6 @@ mod tests {
             protocols: &Protocol::ALL,
             episodes: 1,
             seed: 0,
-            quiet: true,
         };
         let jobs = jobs(&setup, 2);
         // Per agent: q-learning zero-shot on 2 maps, scaled zero-shot and continual on 2 maps.

@@ -10,16 +10,17 @@
 //!   more often than that, the map cannot show that the habit is fooled.
 //!
 //! `check-map` measures both on every map with pedestrian rules; `batch` checks its
-//! brake-on-pedestrian and never-brake units. Both print the same warnings to stderr
-//! and neither changes the exit code. Episodes use [`crate::experiments::eval_seeds`], so `check-map
+//! brake-on-pedestrian and never-brake units. Both report the same warnings (returned
+//! here; the command line prints them on stderr) and neither changes the exit code. Episodes use [`crate::experiments::eval_seeds`], so `check-map
 //! --seed S` and `batch --seed S` meet the same pedestrians and report the same figures.
 
-use indicatif::ProgressBar;
 use unforeseen_sim::Map;
 
+use crate::error::Error;
 use crate::experiments::evaluate_scripted;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
+use crate::progress::NoProgress;
 
 /// Lowest success rate of brake-on-pedestrian for a map to count as survivable.
 pub const SURVIVABLE_MIN_SUCCESS: f64 = 0.99;
@@ -67,8 +68,8 @@ impl Witness {
 
 /// Runs `episodes` episodes of a scripted `method` on `map` (in parallel; seeded by
 /// [`crate::experiments::eval_seeds`], so the result does not depend on the number of threads).
-pub fn witness(map: &Map, method: Method, episodes: u64, seed: u64) -> anyhow::Result<Witness> {
-    let results = evaluate_scripted(map, method, episodes, seed, &ProgressBar::hidden())?;
+pub fn witness(map: &Map, method: Method, episodes: u64, seed: u64) -> Result<Witness, Error> {
+    let results = evaluate_scripted(map, method, episodes, seed, &NoProgress)?;
     Ok(Witness::of(&Aggregate::of(&results)))
 }
 
@@ -99,7 +100,7 @@ pub fn warnings(name: &str, brake: Option<&Witness>, never_brake: Option<&Witnes
 
 /// Measures both witnesses on `map` and returns the warnings; none when the map has no
 /// pedestrian rules or `episodes` is 0.
-pub fn check(map: &Map, episodes: u64, seed: u64) -> anyhow::Result<Vec<String>> {
+pub fn check(map: &Map, episodes: u64, seed: u64) -> Result<Vec<String>, Error> {
     if episodes == 0 || map.pedestrians.is_empty() {
         return Ok(Vec::new());
     }

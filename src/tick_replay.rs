@@ -24,6 +24,7 @@ use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::Map;
 
+use crate::error::Error;
 use crate::experiments::eval_seeds;
 use crate::methods::Method;
 use crate::runner::run_episode;
@@ -56,7 +57,7 @@ pub struct Recording {
 
 /// The maps of the jaywalk family: every embedded test map (a pedestrian on the road when
 /// the training map never showed one there), i.e. all embedded maps but `intersection`.
-pub fn jaywalk_family() -> anyhow::Result<Vec<Map>> {
+pub fn jaywalk_family() -> Result<Vec<Map>, Error> {
     unforeseen_sim::embedded::names()
         .iter()
         .filter(|n| **n != "intersection")
@@ -102,7 +103,7 @@ pub fn record(
     maps: &[Map],
     episodes: u64,
     seed: u64,
-) -> anyhow::Result<Recording> {
+) -> Result<Recording, Error> {
     let mut out = Recording::default();
     for map in maps {
         let mut env = Env::new(map, EnvConfig::default())?;

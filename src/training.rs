@@ -2,7 +2,6 @@
 //! learn from the same episodes on the training map, driven by Q-learning's
 //! epsilon-greedy exploration.
 
-use indicatif::ProgressBar;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
@@ -16,7 +15,8 @@ use unforeseen_discretizer::Discretizer;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::{Action, Map};
 
-use crate::progress;
+use crate::error::Error;
+use crate::progress::{NoProgress, Progress};
 use crate::rewards::{state_rewards, terminal_states};
 use crate::seeds::episode_seed;
 
@@ -37,8 +37,6 @@ pub struct TrainConfig {
     pub tau_c: f64,
     /// What a time-out is to the learners (default: a truncation they bootstrap through).
     pub timeout_as: TimeoutAs,
-    /// Hide the progress bar.
-    pub quiet: bool,
 }
 
 impl TrainConfig {
@@ -55,7 +53,6 @@ impl TrainConfig {
             bayes: BayesRlParams::default(),
             tau_c: 1.0,
             timeout_as: TimeoutAs::Truncation,
-            quiet: false,
         }
     }
 }
@@ -83,17 +80,25 @@ pub struct TrainLog {
     pub timeouts: u64,
 }
 
+/// The map agents train on unless told otherwise (embedded).
+pub const DEFAULT_TRAIN_MAP: &str = "intersection";
+
+/// Training episodes by default (the paper's 6000).
+pub const DEFAULT_TRAIN_EPISODES: u64 = 6000;
+
 /// Trains all learners on `map` and bundles them (with the preferences set from the
 /// map's rewards) for evaluation or for saving as an agent file.
-pub fn train(map: &Map, cfg: &TrainConfig) -> anyhow::Result<(AgentBundle, TrainLog)> {
-    let bar = progress::bar(cfg.episodes, "training", cfg.quiet);
-    let trained = train_with_bar(map, cfg, &bar);
-    bar.finish_and_clear();
-    trained
+pub fn train(map: &Map, cfg: &TrainConfig) -> Result<(AgentBundle, TrainLog), Error> {
+    train_with_progress(map, cfg, &NoProgress)
 }
 
-/// [`train`], advancing `bar` by one per episode (several agents can share one bar).
-pub fn train_with_bar(map: &Map, cfg: &TrainConfig, bar: &ProgressBar) -> anyhow::Result<(AgentBundle, TrainLog)> {
+/// [`train`], advancing `progress` by one per episode; the caller announces and finishes
+/// the phase (several agents training in parallel can share one).
+pub fn train_with_progress(
+    map: &Map,
+    cfg: &TrainConfig,
+    progress: &dyn Progress,
+) -> Result<(AgentBundle, TrainLog), Error> {
     let disc = Discretizer::new(&map.bins)?;
     let n = disc.n_states();
     let n_actions = Action::ALL.len();
@@ -140,7 +145,7 @@ pub fn train_with_bar(map: &Map, cfg: &TrainConfig, bar: &ProgressBar) -> anyhow
         }
         q.decay_epsilon();
         log.returns.push(ret);
-        bar.inc(1);
+        progress.advance(1);
     }
     model.materialize();
     model.set_preferences(&state_rewards(map, &disc), cfg.tau_c)?;

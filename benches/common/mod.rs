@@ -2,19 +2,15 @@
 //! configuration.
 
 use std::time::Duration;
-use unforeseen::cli::compare::DEFAULT_TRAIN_EPISODES;
-use unforeseen::training::{TrainConfig, train};
+use unforeseen::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_sim::embedded;
 
-/// Quiet training configuration with the benches' seed 7.
+/// Training configuration with the benches' seed 7.
 pub fn train_cfg(episodes: u64) -> TrainConfig {
-    TrainConfig {
-        quiet: true,
-        ..TrainConfig::new(episodes, 7)
-    }
+    TrainConfig::new(episodes, 7)
 }
 
 /// The default agent: 6000 training episodes on the embedded intersection map, seed 7 —

@@ -4,18 +4,20 @@
 use clap::Args;
 use std::path::PathBuf;
 
+use super::ProtocolChoice;
+use super::progress::{self, Bars};
 use super::table::{cell, print_grid, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use crate::agents::Agent;
 use crate::batch::{
-    BatchConfig, ResultLine, RunIdentity, Scenario, Shard, SummaryRow, Unit, load_scenarios, resume_lines, run,
-    summarize, summary_path, sweep, units,
+    BatchConfig, DEFAULT_METHODS, ResultLine, Scenario, Shard, SummaryRow, agent_file_identity, checked_sweep,
+    load_scenarios, run_plan, summarize, summary_path, trained_agents_identity,
 };
+use crate::maps;
 use crate::methods::Method;
-use crate::protocol::ProtocolChoice;
 use crate::report::write_json;
 use crate::survivability::{Witness, warnings};
-use std::collections::BTreeSet;
+use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `batch`.
 #[derive(Debug, Clone, Args)]
@@ -32,7 +34,7 @@ pub struct BatchArgs {
     /// Methods to run (repeatable); default: q-learning, bayes-rl, scaled and the
     /// scripted references brake-on-pedestrian and never-brake (so every map reports
     /// whether it is survivable and dangerous).
-    #[arg(long = "method", value_enum)]
+    #[arg(long = "method", value_parser = super::method_parser())]
     pub methods: Vec<Method>,
     /// Evaluation protocol: zero-shot (every episode starts from the trained agent),
     /// continual (learning carries over between episodes, in order) or both. A method
@@ -59,7 +61,7 @@ pub struct BatchArgs {
     #[arg(long = "set", value_name = "KEY=V1,V2")]
     pub sweep: Vec<String>,
     /// Training episodes when no --agent is given.
-    #[arg(long, default_value_t = super::compare::DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
+    #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
     pub train_episodes: u64,
     /// Agent file from `unforeseen train` (default: train on the embedded intersection map).
     #[arg(long, value_name = "FILE")]
@@ -88,66 +90,45 @@ fn default_jobs() -> usize {
 pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let scenarios = load_scenarios(&args.maps)?;
     let methods = if args.methods.is_empty() {
-        Method::PAPER.iter().chain(&Method::REFERENCE).copied().collect()
+        DEFAULT_METHODS.to_vec()
     } else {
         args.methods.clone()
     };
-    let params = sweep(&args.sweep)?;
-    for p in &params {
-        p.scaled_params()?;
-    }
+    let params = checked_sweep(&args.sweep)?;
     let protocols = args.protocol.protocols();
-    let axis: Vec<Option<u64>> = match &args.seeds.train_seeds {
-        Some(seeds) => seeds.0.iter().map(|&s| Some(s)).collect(),
-        None => Vec::new(), // the single agent's seed, known once it is loaded
-    };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs.max(1)).build()?;
-    let (agents, agents_identity) = pool.install(|| -> anyhow::Result<(Vec<Agent>, String)> {
-        if args.seeds.train_seeds.is_none() {
-            let (agent, identity) = single_agent(&args)?;
-            return Ok((vec![agent], identity));
+    // Without --train-seeds, the one agent (loaded, or trained now) and what determines
+    // it; with them, what determines the agents, trained once the plan says which the
+    // units still to run need.
+    let (single, axis, agents_identity) = match &args.seeds.train_seeds {
+        None => {
+            let bundle = pool.install(|| {
+                super::load_or_train(
+                    args.agent.as_deref(),
+                    DEFAULT_TRAIN_MAP,
+                    args.train_episodes,
+                    args.seed,
+                    args.quiet,
+                )
+            })?;
+            let identity = match &args.agent {
+                Some(_) => agent_file_identity(&bundle),
+                None => {
+                    trained_agents_identity(&maps::load(DEFAULT_TRAIN_MAP)?, &[Some(args.seed)], args.train_episodes)?
+                }
+            };
+            let agent = Agent::from_bundle(bundle);
+            let axis = vec![agent.train_seed];
+            (Some(agent), axis, identity)
         }
-        let identity = seeds_identity(&axis, args.train_episodes)?;
-        // Only the seeds of this shard's units that are still to run.
-        let all = units(scenarios.len(), &methods, &params, &protocols, &axis)?;
-        let range = args.shard.map_or(0..all.len(), |s| s.range(all.len()));
-        let done: BTreeSet<usize> = if args.resume {
-            let run = RunIdentity::new(
-                &scenarios,
-                &methods,
-                &params,
-                &protocols,
-                &axis,
-                args.episodes,
-                args.seed,
-                &identity,
-            );
-            resume_lines(&args.out, &run, &all, &scenarios)?
-                .iter()
-                .map(|l| l.parsed.unit)
-                .collect()
-        } else {
-            BTreeSet::new()
-        };
-        let todo: Vec<&Unit> = all[range].iter().filter(|u| !done.contains(&u.index)).collect();
-        let used: Vec<u64> = axis
-            .iter()
-            .flatten()
-            .copied()
-            .filter(|&s| todo.iter().any(|u| u.train_seed == Some(s)))
-            .collect();
-        let agents = args
-            .seeds
-            .train(&used, "intersection", args.train_episodes, args.quiet)?;
-        Ok((agents, identity))
-    })?;
-    let axis = if axis.is_empty() {
-        vec![agents[0].train_seed]
-    } else {
-        axis
+        Some(seeds) => {
+            let axis: Vec<Option<u64>> = seeds.0.iter().map(|&s| Some(s)).collect();
+            let identity = trained_agents_identity(&maps::load(DEFAULT_TRAIN_MAP)?, &axis, args.train_episodes)?;
+            (None, axis, identity)
+        }
     };
-    let cfg = BatchConfig {
-        agents: &agents,
+    let planning = BatchConfig {
+        agents: &[],
         train_seeds: &axis,
         scenarios: &scenarios,
         methods: &methods,
@@ -159,7 +140,23 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         shard: args.shard,
         agents_identity,
     };
-    crate::progress::phase(
+    let plan = planning.plan(&args.out, args.resume)?;
+    let agents = match single {
+        Some(agent) => vec![agent],
+        None => pool.install(|| {
+            args.seeds.train(
+                &plan.train_seeds_to_run(),
+                DEFAULT_TRAIN_MAP,
+                args.train_episodes,
+                args.quiet,
+            )
+        })?,
+    };
+    let cfg = BatchConfig {
+        agents: &agents,
+        ..planning
+    };
+    progress::phase(
         args.quiet,
         format_args!(
             "running {} scenario(s) x {} method(s) x {} parameter set(s) x {} protocol(s) x {} agent(s) on {} thread(s), {} episodes each, into {}",
@@ -173,7 +170,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             args.out.display()
         ),
     );
-    let lines = run(&cfg, &args.out, args.resume, args.quiet)?;
+    let lines = run_plan(&cfg, &plan, &args.out, &Bars::new(args.quiet))?;
     let rows = summarize(&lines);
     print_summary(&rows);
     for warning in survivability_warnings(&scenarios, &lines) {
@@ -188,7 +185,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             "schema": 1,
             "results": args.out.display().to_string(),
             "shard": args.shard.map(|s| format!("{}/{}", s.index, s.count)),
-            "run": cfg.identity(),
+            "run": plan.identity,
             "checked": checked,
             "failed": failures.len(),
             "rows": rows,
@@ -209,43 +206,6 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         anyhow::bail!("{} expectation(s) failed", failures.len());
     }
     Ok(())
-}
-
-/// The one agent of a run without --train-seeds (--agent, or trained from --seed), and
-/// what determines it for the run's identity: the agent file's content, or the training
-/// recipe.
-fn single_agent(args: &BatchArgs) -> anyhow::Result<(Agent, String)> {
-    let bundle = super::load_or_train(
-        args.agent.as_deref(),
-        "intersection",
-        args.train_episodes,
-        args.seed,
-        args.quiet,
-    )?;
-    let identity = match &args.agent {
-        Some(_) => format!(
-            "agent file with contents {}",
-            crate::seeds::content_hash(bundle.to_ron_string().as_bytes())
-        ),
-        None => seeds_identity(&[Some(args.seed)], args.train_episodes)?,
-    };
-    Ok((Agent::from_bundle(bundle), identity))
-}
-
-/// What determines agents trained on the embedded intersection for `episodes` episodes
-/// with each of `seeds`: their cache keys (training map contents, episodes, seed,
-/// training configuration, version and training code).
-fn seeds_identity(seeds: &[Option<u64>], episodes: u64) -> anyhow::Result<String> {
-    let map = crate::maps::load("intersection")?;
-    let keys = seeds
-        .iter()
-        .flatten()
-        .map(|&seed| crate::agents::cache_key(&map, &crate::training::TrainConfig::new(episodes, seed)))
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    Ok(format!(
-        "trained on intersection for {episodes} episodes, agents {}",
-        crate::seeds::content_hash(keys.join(",").as_bytes())
-    ))
 }
 
 /// Prints one row per (scenario, method, parameters, protocol) over its training seeds.

@@ -6,25 +6,24 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use unforeseen_sim::Map;
 
+use super::ProtocolChoice;
 use super::table::{cell, print_grid, range_cell, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
 use crate::agents::Agent;
 use crate::methods::{Method, PaperFigures};
 use crate::plots::{BarPanel, BarRow, bar_key, grouped_bars};
-use crate::protocol::{Protocol, ProtocolChoice};
+use crate::protocol::Protocol;
 use crate::report::{Csv, num, write_json};
 use crate::study::{METRICS, MethodSummary, ProtocolTable, RewardPair, StudySetup, run_study};
+use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 use crate::{maps, rewards};
-
-/// Training episodes by default (the paper's 6000).
-pub const DEFAULT_TRAIN_EPISODES: u64 = 6000;
 
 /// Arguments of `compare`.
 #[derive(Debug, Clone, Args)]
 pub struct CompareArgs {
     /// Training map (file or embedded name).
-    #[arg(long, default_value = "intersection")]
+    #[arg(long, default_value = DEFAULT_TRAIN_MAP)]
     pub train_map: String,
     /// Test map with the unforeseen scenario (file or embedded name).
     #[arg(long, default_value = "jaywalk")]
@@ -58,7 +57,7 @@ pub struct CompareArgs {
 impl Default for CompareArgs {
     fn default() -> Self {
         Self {
-            train_map: "intersection".into(),
+            train_map: DEFAULT_TRAIN_MAP.into(),
             test_map: "jaywalk".into(),
             train_episodes: DEFAULT_TRAIN_EPISODES,
             episodes: 100,
@@ -146,9 +145,8 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         protocols: &protocols,
         episodes: args.episodes,
         seed: args.agent.seed,
-        quiet: args.agent.quiet,
     };
-    let tables = run_study(&setup, &agents)?;
+    let tables = run_study(&setup, &agents, &super::progress::Bars::new(args.agent.quiet))?;
     for table in &tables {
         print_table(table, &train_map, &test_map);
     }
@@ -179,7 +177,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let dir = &args.out;
     let files = ["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"];
     warn_replacing(dir, &files);
-    crate::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
+    super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     write_json(&dir.join("compare.json"), &report)?;
     let maps = (report.train_map.as_str(), report.test_map.as_str());
     summary_csv(&report.tables, maps).write(&dir.join("compare.csv"))?;
@@ -501,5 +499,5 @@ fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
             }
         })
         .collect();
-    grouped_bars(path, &rows)
+    Ok(grouped_bars(path, &rows)?)
 }

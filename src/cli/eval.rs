@@ -3,12 +3,13 @@
 use clap::Args;
 use std::path::PathBuf;
 
+use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
 use crate::experiments::{evaluate_scripted, evaluate_under};
 use crate::maps;
 use crate::methods::Method;
 use crate::metrics::Aggregate;
-use crate::progress;
+use crate::progress::Progress;
 use crate::protocol::Protocol;
 use crate::report::write_json;
 
@@ -20,7 +21,7 @@ pub struct EvalArgs {
     pub map: String,
     /// Method to evaluate (the scripted `brake-on-pedestrian` and `never-brake` need
     /// no agent: `--agent` is then ignored and nothing is trained).
-    #[arg(long, value_enum, default_value_t = Method::Scaled)]
+    #[arg(long, default_value_t = Method::Scaled, value_parser = super::method_parser())]
     pub method: Method,
     /// Episodes.
     #[arg(long, default_value_t = 100, value_parser = super::episodes)]
@@ -28,7 +29,7 @@ pub struct EvalArgs {
     /// Evaluation protocol: zero-shot (default; every episode starts from the trained
     /// agent, as in the paper's table) or continual (learning carries over between
     /// episodes, in order).
-    #[arg(long, value_enum, default_value_t = Protocol::ZeroShot)]
+    #[arg(long, default_value_t = Protocol::ZeroShot, value_parser = super::protocol_parser())]
     pub protocol: Protocol,
     /// Output folder for eval.json (an eval.json from an earlier run there is replaced,
     /// with a warning).
@@ -43,23 +44,22 @@ pub struct EvalArgs {
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
-    let bar = progress::bar(
-        args.episodes,
-        &format!("{} {}", args.method, map.name),
-        args.agent.quiet,
-    );
+    let bars = Bars::new(args.agent.quiet);
+    let label = format!("{} {}", args.method, map.name);
     let evaluating = format!(
         "evaluating {} on '{}' ({}, {} episodes)",
         args.method, map.name, args.protocol, args.episodes
     );
     // The scripted references need no agent: they decode the map's own observations.
     let (results, train_seed) = if args.method.is_scripted() {
-        crate::progress::phase(args.agent.quiet, &evaluating);
-        let results = evaluate_scripted(&map, args.method, args.episodes, args.agent.seed, &bar)?;
+        progress::phase(args.agent.quiet, &evaluating);
+        bars.phase(&label, args.episodes);
+        let results = evaluate_scripted(&map, args.method, args.episodes, args.agent.seed, &bars)?;
         (results, None)
     } else {
         let bundle = args.agent.bundle()?;
-        crate::progress::phase(args.agent.quiet, &evaluating);
+        progress::phase(args.agent.quiet, &evaluating);
+        bars.phase(&label, args.episodes);
         let results = evaluate_under(
             args.protocol,
             &map,
@@ -68,11 +68,11 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
             args.method,
             args.episodes,
             args.agent.seed,
-            &bar,
+            &bars,
         )?;
         (results, bundle.meta.get("seed").cloned())
     };
-    bar.finish_and_clear();
+    bars.finish();
     let agg = Aggregate::of(&results);
     println!(
         "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
@@ -89,7 +89,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     );
     let dir = &args.out;
     warn_replacing(dir, &["eval.json"]);
-    crate::progress::phase(
+    progress::phase(
         args.agent.quiet,
         format_args!("writing {}", dir.join("eval.json").display()),
     );

@@ -33,14 +33,15 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bundle = args.agent.bundle()?;
-    crate::progress::phase(
+    super::progress::phase(
         args.agent.quiet,
         format_args!(
             "test-time learning on '{}' over {} episodes (continual)",
             map.name, args.episodes
         ),
     );
-    let points = learn(&bundle, &params, &map, args.episodes, args.agent.seed, args.agent.quiet)?;
+    let bars = super::progress::Bars::new(args.agent.quiet);
+    let points = learn(&bundle, &params, &map, args.episodes, args.agent.seed, &bars)?;
     let mut csv = Csv::new(&[
         "episode",
         "event_surprise_bits",
@@ -103,7 +104,7 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     }
     let dir = &args.out;
     warn_replacing(dir, &["learn.csv", "learn.json", "learn.svg"]);
-    crate::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
+    super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     csv.write(&dir.join("learn.csv"))?;
     write_json(&dir.join("learn.json"), &points)?;
     let x = |f: &dyn Fn(&crate::experiments::LearnPoint) -> Option<f64>| -> Vec<(f64, f64)> {

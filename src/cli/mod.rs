@@ -1,14 +1,19 @@
-//! The command line (clap). Each command lives in its own file. Library errors become
-//! messages here, and only here is the exit code decided ([`exit_code`]): 2 for input
-//! the user can fix (maps, agent files, results files, flags: the library's
-//! [`crate::error::Error`] and the map errors), 1 for any other failure.
+//! The command line (clap). Each command lives in its own file; progress bars and
+//! phase lines are drawn by [`progress`]. Library errors become messages here, and only
+//! here is the exit code decided ([`exit_code`]): 2 for input the user can fix (maps,
+//! agent files, results files, flags: [`crate::error::Error::is_user_input`] and the map
+//! errors), 1 for any other failure.
 
-use clap::{Args, Parser, Subcommand};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 
-use crate::training::{TrainConfig, train};
+use crate::methods::Method;
+use crate::progress::Progress;
+use crate::protocol::Protocol;
+use crate::training::{DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
 
 pub mod batch;
 pub mod check_map;
@@ -19,6 +24,7 @@ pub mod inspect;
 pub mod learn;
 pub mod params;
 pub mod plot_sweep;
+pub mod progress;
 pub mod table;
 pub mod trace;
 pub mod train;
@@ -94,13 +100,57 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
-/// The exit code for an error: 2 when it (or anything in its chain) is input the user
-/// can fix, 1 otherwise.
-pub fn exit_code(err: &anyhow::Error) -> i32 {
-    let bad_input = err.chain().any(|e| {
-        e.is::<crate::error::Error>() || e.is::<crate::maps::MapLookupError>() || e.is::<unforeseen_sim::MapError>()
-    });
-    if bad_input { 2 } else { 1 }
+/// The exit code for an error (a library error, or an [`anyhow::Error`] as `&*err`): 2
+/// when it or anything in its chain of causes is input the user can fix, 1 otherwise.
+pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
+    let mut cause = Some(err);
+    while let Some(e) = cause {
+        let bad_input = e
+            .downcast_ref::<crate::error::Error>()
+            .is_some_and(crate::error::Error::is_user_input)
+            || e.is::<crate::maps::MapLookupError>()
+            || e.is::<unforeseen_sim::MapError>();
+        if bad_input {
+            return 2;
+        }
+        cause = e.source();
+    }
+    1
+}
+
+/// Parses a method by name (`--method`), listing every name with its summary.
+pub fn method_parser() -> impl TypedValueParser<Value = Method> {
+    let names = Method::ALL.map(|m| PossibleValue::new(m.name()).help(m.summary()));
+    PossibleValuesParser::new(names).map(|s| s.parse::<Method>().expect("a listed method name"))
+}
+
+/// Parses one protocol by name (`--protocol` of `eval` and `trace`), listing both.
+pub fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
+    let names = Protocol::ALL.map(|p| PossibleValue::new(p.name()).help(p.summary()));
+    PossibleValuesParser::new(names).map(|s| s.parse::<Protocol>().expect("a listed protocol name"))
+}
+
+/// The `--protocol` option of `compare` and `batch`: one protocol or both.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum ProtocolChoice {
+    /// Only zero-shot.
+    ZeroShot,
+    /// Only continual.
+    Continual,
+    /// Zero-shot, then continual.
+    #[default]
+    Both,
+}
+
+impl ProtocolChoice {
+    /// The chosen protocols, zero-shot first.
+    pub fn protocols(self) -> Vec<Protocol> {
+        match self {
+            ProtocolChoice::ZeroShot => vec![Protocol::ZeroShot],
+            ProtocolChoice::Continual => vec![Protocol::Continual],
+            ProtocolChoice::Both => Protocol::ALL.to_vec(),
+        }
+    }
 }
 
 /// Options shared by the commands that drive a trained agent.
@@ -125,7 +175,7 @@ pub struct AgentArgs {
 impl AgentArgs {
     /// Loads the agent file, or trains one on the embedded training map.
     pub fn bundle(&self) -> anyhow::Result<AgentBundle> {
-        self.bundle_trained_on("intersection", compare::DEFAULT_TRAIN_EPISODES)
+        self.bundle_trained_on(DEFAULT_TRAIN_MAP, crate::training::DEFAULT_TRAIN_EPISODES)
     }
 
     /// Loads the agent file, or trains one on `map` (file or embedded name).
@@ -165,18 +215,19 @@ pub fn load_or_train(
     quiet: bool,
 ) -> anyhow::Result<AgentBundle> {
     match agent {
-        Some(path) => crate::agent_file::load(path),
+        Some(path) => Ok(crate::agent_file::load(path)?),
         None => {
             let map = crate::maps::load(map)?;
-            crate::progress::phase(
+            progress::phase(
                 quiet,
                 format_args!("training {episodes} episodes on '{}' (seed {seed})", map.name),
             );
-            let cfg = TrainConfig {
-                quiet,
-                ..TrainConfig::new(episodes, seed)
-            };
-            Ok(train(&map, &cfg)?.0)
+            let cfg = TrainConfig::new(episodes, seed);
+            let bars = progress::Bars::new(quiet);
+            bars.phase("training", episodes);
+            let trained = train_with_progress(&map, &cfg, &bars);
+            bars.finish();
+            Ok(trained?.0)
         }
     }
 }

@@ -19,7 +19,7 @@ pub struct TraceArgs {
     #[arg(long, default_value = "jaywalk")]
     pub map: String,
     /// Method to trace.
-    #[arg(long, value_enum, default_value_t = Method::Scaled)]
+    #[arg(long, default_value_t = Method::Scaled, value_parser = super::method_parser())]
     pub method: Method,
     /// Output folder for trace.csv, theta.svg and filmstrip.svg (files from an earlier
     /// run there are replaced, with a warning).
@@ -36,7 +36,7 @@ pub struct TraceArgs {
     pub episode: u64,
     /// Evaluation protocol of the traced episode: zero-shot (from the trained state) or
     /// continual (after learning from the episodes before it).
-    #[arg(long, value_enum, default_value_t = Protocol::ZeroShot)]
+    #[arg(long, default_value_t = Protocol::ZeroShot, value_parser = super::protocol_parser())]
     pub protocol: Protocol,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
@@ -141,7 +141,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     );
     let dir = &args.out;
     warn_replacing(dir, &["trace.csv", "theta.svg", "filmstrip.svg"]);
-    crate::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
+    super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     csv.write(&dir.join("trace.csv"))?;
     let points: Vec<_> = decided
         .iter()

@@ -3,17 +3,19 @@
 use clap::Args;
 use std::path::PathBuf;
 
+use super::progress::{self, Bars};
 use crate::maps;
-use crate::training::{TrainConfig, train};
+use crate::progress::Progress;
+use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
 
 /// Arguments of `train`.
 #[derive(Debug, Clone, Args)]
 pub struct TrainArgs {
     /// Training map (file or embedded name).
-    #[arg(long, default_value = "intersection")]
+    #[arg(long, default_value = DEFAULT_TRAIN_MAP)]
     pub map: String,
     /// Training episodes.
-    #[arg(long, default_value_t = super::compare::DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
+    #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
     pub episodes: u64,
     /// Run seed.
     #[arg(long, default_value_t = 7)]
@@ -29,26 +31,27 @@ pub struct TrainArgs {
 /// Runs `train`.
 pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
-    let cfg = TrainConfig {
-        quiet: args.quiet,
-        ..TrainConfig::new(args.episodes, args.seed)
-    };
+    let cfg = TrainConfig::new(args.episodes, args.seed);
     let started = std::time::Instant::now();
-    crate::progress::phase(
+    progress::phase(
         args.quiet,
         format_args!(
             "training {} episodes on '{}' (seed {})",
             args.episodes, map.name, args.seed
         ),
     );
-    let (bundle, log) = train(&map, &cfg)?;
+    let bars = Bars::new(args.quiet);
+    bars.phase("training", args.episodes);
+    let trained = train_with_progress(&map, &cfg, &bars);
+    bars.finish();
+    let (bundle, log) = trained?;
     let tail = &log.returns[log.returns.len().saturating_sub(100)..];
     let mean = if tail.is_empty() {
         0.0
     } else {
         tail.iter().sum::<f64>() / tail.len() as f64
     };
-    crate::progress::phase(args.quiet, format_args!("writing {}", args.out.display()));
+    progress::phase(args.quiet, format_args!("writing {}", args.out.display()));
     super::warn_replacing_file(&args.out);
     crate::agent_file::save(&args.out, &bundle)?;
     println!(

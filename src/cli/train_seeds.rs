@@ -4,6 +4,7 @@
 use clap::Args;
 use std::path::{Path, PathBuf};
 
+use super::progress::{self, Bars};
 use crate::agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
 use crate::training::TrainConfig;
 
@@ -37,7 +38,7 @@ impl TrainSeedArgs {
     /// parallel (or loaded from the cache).
     pub fn train(&self, seeds: &[u64], train_map: &str, episodes: u64, quiet: bool) -> anyhow::Result<Vec<Agent>> {
         let map = crate::maps::load(train_map)?;
-        crate::progress::phase(
+        progress::phase(
             quiet,
             format_args!(
                 "training {} agent(s) for {episodes} episodes on '{}' (or loading them from the cache), one line each",
@@ -45,6 +46,13 @@ impl TrainSeedArgs {
                 map.name
             ),
         );
-        train_agents(&map, seeds, &TrainConfig::new(episodes, 0), self.cache_dir(), quiet)
+        let bars = Bars::counting(quiet, "episodes");
+        Ok(train_agents(
+            &map,
+            seeds,
+            &TrainConfig::new(episodes, 0),
+            self.cache_dir(),
+            &bars,
+        )?)
     }
 }

@@ -9,6 +9,7 @@ use std::sync::OnceLock;
 use unforeseen::agents::Agent;
 use unforeseen::batch::{BatchConfig, ParamSet, ResultLine, Scenario, Shard, load_scenarios, read_lines, run, sweep};
 use unforeseen::methods::Method;
+use unforeseen::progress::NoProgress;
 use unforeseen::protocol::Protocol;
 
 fn scenarios() -> Vec<Scenario> {
@@ -60,8 +61,8 @@ fn jobs_do_not_change_results_and_shards_concatenate_to_the_whole() {
     let dir = tempfile::tempdir().unwrap();
     let one = dir.path().join("one.jsonl");
     let two = dir.path().join("two.jsonl");
-    let a = run(&config(&scenarios, &params, 1, None), &one, false, true).unwrap();
-    let b = run(&config(&scenarios, &params, 2, None), &two, false, true).unwrap();
+    let a = run(&config(&scenarios, &params, 1, None), &one, false, &NoProgress).unwrap();
+    let b = run(&config(&scenarios, &params, 2, None), &two, false, &NoProgress).unwrap();
     // Per scenario: q-learning once (covers both protocols) and bayes-rl once per protocol,
     // both with the defaults only (the sweep does not affect them); scaled once per
     // protocol and parameter set.
@@ -81,7 +82,7 @@ fn jobs_do_not_change_results_and_shards_concatenate_to_the_whole() {
             &config(&scenarios, &params, 2, Some(Shard { index: i, count: 3 })),
             &part,
             false,
-            true,
+            &NoProgress,
         )
         .unwrap();
         concatenated.extend(read_lines(&part).unwrap());
@@ -95,7 +96,7 @@ fn resume_after_a_truncated_file_completes_the_set_without_duplicates() {
     let params = vec![ParamSet(Vec::new())];
     let dir = tempfile::tempdir().unwrap();
     let full = dir.path().join("full.jsonl");
-    let whole = run(&config(&scenarios, &params, 2, None), &full, false, true).unwrap();
+    let whole = run(&config(&scenarios, &params, 2, None), &full, false, &NoProgress).unwrap();
 
     // Simulate a kill: the run's identity, two complete lines and half of the third.
     let text = std::fs::read_to_string(&full).unwrap();
@@ -112,7 +113,7 @@ fn resume_after_a_truncated_file_completes_the_set_without_duplicates() {
     std::fs::write(&partial, cut).unwrap();
     assert_eq!(read_lines(&partial).unwrap().len(), 2);
 
-    let resumed = run(&config(&scenarios, &params, 2, None), &partial, true, true).unwrap();
+    let resumed = run(&config(&scenarios, &params, 2, None), &partial, true, &NoProgress).unwrap();
     assert_eq!(resumed.len(), whole.len());
     let mut keys: Vec<_> = resumed.iter().map(ResultLine::key).collect();
     keys.dedup();
@@ -168,7 +169,7 @@ fn expectations_pass_and_fail_as_declared() {
         &config(&scenarios, &params, 2, None),
         &dir.path().join("r.jsonl"),
         false,
-        true,
+        &NoProgress,
     )
     .unwrap();
     let q = lines.iter().find(|l| l.method == "q-learning").unwrap();
@@ -214,7 +215,7 @@ fn expectations_pass_and_fail_as_declared() {
         &config(&scenarios, &sweep, 2, None),
         &dir.path().join("s.jsonl"),
         false,
-        true,
+        &NoProgress,
     )
     .unwrap();
     assert!(
@@ -284,9 +285,9 @@ fn resume_refuses_another_runs_file_and_keeps_its_own_byte_for_byte() {
         methods: &methods,
         ..config(&scenarios, &params, 2, None)
     };
-    run(&base(), &out, false, true).unwrap();
+    run(&base(), &out, false, &NoProgress).unwrap();
     let before = std::fs::read_to_string(&out).unwrap();
-    run(&base(), &out, true, true).unwrap();
+    run(&base(), &out, true, &NoProgress).unwrap();
     assert_eq!(
         std::fs::read_to_string(&out).unwrap(),
         before,
@@ -297,7 +298,7 @@ fn resume_refuses_another_runs_file_and_keeps_its_own_byte_for_byte() {
     let scaled = [Method::NeverBrake, Method::Scaled];
     let one_map = &scenarios[..1];
     let refused = |cfg: BatchConfig<'_>, field: &str| {
-        let err = run(&cfg, &out, true, true).expect_err(field);
+        let err = run(&cfg, &out, true, &NoProgress).expect_err(field);
         let message = format!("{err:#}");
         assert_eq!(unforeseen::cli::exit_code(&err), 2, "{message}");
         assert!(
@@ -357,7 +358,7 @@ fn resume_refuses_another_runs_file_and_keeps_its_own_byte_for_byte() {
         ),
     ] {
         std::fs::write(&out, &text).unwrap();
-        let err = run(&base(), &out, true, true).expect_err(name);
+        let err = run(&base(), &out, true, &NoProgress).expect_err(name);
         assert!(format!("{err:#}").contains(needle), "{name}: {err:#}");
         assert_eq!(unforeseen::cli::exit_code(&err), 2);
     }
@@ -395,7 +396,7 @@ fn results_must_go_to_a_regular_file() {
         ..config(&scenarios, &params, 1, None)
     };
     for resume in [false, true] {
-        let err = run(&cfg, dir.path(), resume, true).unwrap_err();
+        let err = run(&cfg, dir.path(), resume, &NoProgress).unwrap_err();
         assert!(format!("{err:#}").contains("not a regular file"), "{err:#}");
         assert_eq!(unforeseen::cli::exit_code(&err), 2);
     }

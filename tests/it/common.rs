@@ -14,7 +14,6 @@ pub const TRAIN_EPISODES: u64 = 600;
 pub fn small_config(seed: u64) -> TrainConfig {
     let mut cfg = TrainConfig::new(TRAIN_EPISODES, seed);
     cfg.q.epsilon_decay = 0.993;
-    cfg.quiet = true;
     cfg
 }
 
@@ -44,8 +43,7 @@ pub fn tiny_map() -> unforeseen_sim::Map {
 pub fn tiny_agent_text() -> &'static str {
     static TEXT: OnceLock<String> = OnceLock::new();
     TEXT.get_or_init(|| {
-        let mut cfg = TrainConfig::new(30, 3);
-        cfg.quiet = true;
+        let cfg = TrainConfig::new(30, 3);
         train(&tiny_map(), &cfg).expect("training").0.to_ron_string()
     })
 }

@@ -277,11 +277,7 @@ fn every_damaged_agent_file_is_refused_naming_the_field() {
         let err = unforeseen::agent_file::parse(path, &c.text).expect_err(c.name);
         let message = format!("{err:#}");
         assert_eq!(unforeseen::cli::exit_code(&err), 2, "{}: {message}", c.name);
-        assert!(
-            matches!(err.downcast_ref::<Error>(), Some(Error::AgentFile { .. })),
-            "{}: {message}",
-            c.name
-        );
+        assert!(matches!(err, Error::AgentFile { .. }), "{}: {message}", c.name);
         assert!(
             message.starts_with("agent.ron: ") && message.contains(c.needle) && message.contains("unforeseen train"),
             "{}: {message}",

@@ -7,6 +7,7 @@ use crate::common;
 use unforeseen::experiments::{evaluate, learn, trace};
 use unforeseen::methods::Method;
 use unforeseen::metrics::Aggregate;
+use unforeseen::progress::NoProgress;
 use unforeseen::protocol::Protocol;
 use unforeseen_agent::params::ScaledParams;
 
@@ -58,7 +59,7 @@ fn scaled_avoids_the_jaywalker_that_q_learning_hits() {
 fn test_time_learning_makes_the_jaywalk_familiar_without_a_crash() {
     let bundle = common::bundle();
     let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
-    let points = learn(bundle, &ScaledParams::default(), &jaywalk, 30, 3, true).unwrap();
+    let points = learn(bundle, &ScaledParams::default(), &jaywalk, 30, 3, &NoProgress).unwrap();
     let (first, last) = (&points[0], points.last().unwrap());
     assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
     let surprise = |p: &unforeseen::experiments::LearnPoint| p.event_surprise_bits.unwrap();
@@ -78,7 +79,7 @@ fn over_a_few_episodes_scaled_beats_q_learning_on_the_jaywalk() {
     let params = ScaledParams::default();
     let run = |m: Method| {
         let mut c = m.controller(bundle, &params).unwrap();
-        Aggregate::of(&evaluate(&jaywalk, c.as_mut(), m, 10, 5, true).unwrap())
+        Aggregate::of(&evaluate(&jaywalk, c.as_mut(), m, 10, 5, &NoProgress).unwrap())
     };
     let q = run(Method::QLearning);
     let s = run(Method::Scaled);
@@ -96,7 +97,7 @@ fn a_traced_continual_episode_is_the_one_a_continual_run_meets() {
     let map = unforeseen::maps::load("stop_midway").unwrap();
     let params = ScaledParams::default();
     let mut agent = Method::Scaled.controller(bundle, &params).unwrap();
-    let run = evaluate(&map, agent.as_mut(), Method::Scaled, 4, 3, true).unwrap();
+    let run = evaluate(&map, agent.as_mut(), Method::Scaled, 4, 3, &NoProgress).unwrap();
     let (traced, ticks) = trace(bundle, &params, Method::Scaled, &map, 3, Protocol::Continual, 3).unwrap();
     let last = &run[3];
     assert_eq!(
@@ -115,7 +116,7 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
     let bundle = common::bundle();
     let map = unforeseen::maps::load("jaywalk_late").unwrap();
     let reasoning = |params: &ScaledParams| {
-        let points = learn(bundle, params, &map, 30, 3, true).unwrap();
+        let points = learn(bundle, params, &map, 30, 3, &NoProgress).unwrap();
         assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
         let ticks = |ps: &[unforeseen::experiments::LearnPoint]| ps.iter().map(|p| p.reasoning_ticks).sum::<u32>();
         (ticks(&points[..5]), ticks(&points[25..]))
@@ -143,7 +144,7 @@ fn scaled_waits_for_the_slow_walker() {
     let map = unforeseen::maps::load("slow_walker").unwrap();
     let success = |params: &ScaledParams| {
         let mut agent = Method::Scaled.controller(bundle, params).unwrap();
-        Aggregate::of(&evaluate(&map, agent.as_mut(), Method::Scaled, 10, 7, true).unwrap()).success_rate
+        Aggregate::of(&evaluate(&map, agent.as_mut(), Method::Scaled, 10, 7, &NoProgress).unwrap()).success_rate
     };
     assert_eq!(success(&ScaledParams::default()), 1.0);
     let mut absorbing = ScaledParams::default();

@@ -4,9 +4,9 @@
 
 use crate::common;
 
-use indicatif::ProgressBar;
 use unforeseen::experiments::{evaluate, evaluate_under};
 use unforeseen::methods::Method;
+use unforeseen::progress::NoProgress;
 use unforeseen::protocol::Protocol;
 use unforeseen::runner::EpisodeResult;
 use unforeseen_agent::params::ScaledParams;
@@ -27,7 +27,7 @@ fn zero_shot(method: Method, threads: usize) -> Vec<EpisodeResult> {
     let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let params = ScaledParams::default();
-    let hidden = ProgressBar::hidden();
+    let hidden = NoProgress;
     untimed(pool.install(|| {
         evaluate_under(
             Protocol::ZeroShot,
@@ -51,7 +51,7 @@ fn methods_that_do_not_learn_across_episodes_give_the_same_results_under_both_pr
         assert!(!method.learns_across_episodes(&params));
         // The real continual loop: one controller, episodes in order.
         let mut controller = method.controller(common::bundle(), &params).unwrap();
-        let continual = untimed(evaluate(&jaywalk, controller.as_mut(), method, 4, 5, true).unwrap());
+        let continual = untimed(evaluate(&jaywalk, controller.as_mut(), method, 4, 5, &NoProgress).unwrap());
         assert_eq!(continual, zero_shot(method, 2), "{method}");
     }
 }

@@ -8,6 +8,7 @@ use std::process::{Command, Output};
 use unforeseen::experiments::evaluate;
 use unforeseen::methods::Method;
 use unforeseen::metrics::Aggregate;
+use unforeseen::progress::NoProgress;
 use unforeseen::survivability::witness;
 use unforeseen::training::{TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
@@ -72,8 +73,7 @@ fn brake_on_pedestrian_survives_the_jaywalker_and_never_brake_does_not() {
 fn the_method_factory_builds_the_references_from_an_agent_file_too() {
     // One training episode is enough: the references read only the model's factor sizes.
     let intersection = unforeseen::maps::load("intersection").unwrap();
-    let mut cfg = TrainConfig::new(1, 7);
-    cfg.quiet = true;
+    let cfg = TrainConfig::new(1, 7);
     let bundle = train(&intersection, &cfg).unwrap().0;
     let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
     for method in Method::REFERENCE {
@@ -81,7 +81,7 @@ fn the_method_factory_builds_the_references_from_an_agent_file_too() {
         assert!(!method.learns_across_episodes(&ScaledParams::default()));
         let mut controller = method.controller(&bundle, &ScaledParams::default()).unwrap();
         assert_eq!(controller.name(), method.name());
-        let results = evaluate(&jaywalk, controller.as_mut(), method, EPISODES, 7, true).unwrap();
+        let results = evaluate(&jaywalk, controller.as_mut(), method, EPISODES, 7, &NoProgress).unwrap();
         let agg = Aggregate::of(&results);
         assert_eq!(agg.inference_rate, 0.0, "{method} never reasons");
         let alone = witness(&jaywalk, method, EPISODES, 7).unwrap();
@@ -135,8 +135,7 @@ fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
     let dir = tempfile::tempdir().unwrap();
     let harmless = harmless(dir.path());
     let intersection = unforeseen::maps::load("intersection").unwrap();
-    let mut cfg = TrainConfig::new(1, 7);
-    cfg.quiet = true;
+    let cfg = TrainConfig::new(1, 7);
     let agent = dir.path().join("agent.ron");
     unforeseen::agent_file::save(&agent, &train(&intersection, &cfg).unwrap().0).unwrap();
     let results = dir.path().join("r.jsonl");
