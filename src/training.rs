@@ -71,6 +71,31 @@ pub enum TimeoutAs {
     Termination,
 }
 
+impl TimeoutAs {
+    /// The names `--timeout-as` takes.
+    pub const NAMES: [&'static str; 2] = ["truncation", "termination"];
+}
+
+impl std::str::FromStr for TimeoutAs {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "truncation" => Ok(TimeoutAs::Truncation),
+            "termination" => Ok(TimeoutAs::Termination),
+            _ => Err(format!("'{s}' is not one of: {}", TimeoutAs::NAMES.join(", "))),
+        }
+    }
+}
+
+impl std::fmt::Display for TimeoutAs {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            TimeoutAs::Truncation => "truncation",
+            TimeoutAs::Termination => "termination",
+        })
+    }
+}
+
 /// What training recorded: the return of every episode.
 #[derive(Debug, Clone, Default)]
 pub struct TrainLog {
@@ -154,7 +179,8 @@ pub fn train_with_progress(
     meta.insert("map".into(), map.name.clone());
     meta.insert("episodes".into(), cfg.episodes.to_string());
     meta.insert("seed".into(), cfg.seed.to_string());
-    meta.insert("timeout_as".into(), format!("{:?}", cfg.timeout_as).to_lowercase());
+    meta.insert("timeout_as".into(), cfg.timeout_as.to_string());
+    meta.insert("timeouts".into(), log.timeouts.to_string());
     meta.insert("factor_sizes".into(), format!("{:?}", disc.factor_sizes()));
     meta.insert("unforeseen_version".into(), env!("CARGO_PKG_VERSION").into());
     let mut bundle = AgentBundle::new(q, model, bayes, meta);

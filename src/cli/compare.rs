@@ -68,6 +68,7 @@ impl Default for CompareArgs {
                 train_seeds: None,
                 cache: crate::agents::DEFAULT_CACHE.into(),
                 no_cache: false,
+                timeout_as: crate::training::TimeoutAs::Truncation,
             },
             agent: AgentArgs {
                 agent: None,

@@ -193,6 +193,11 @@ impl AgentArgs {
 /// here, and each episode keeps a result in memory; run more as shards or seeds.
 pub const MAX_EPISODES: u64 = 1_000_000;
 
+/// Parses `--timeout-as`.
+pub fn timeout_as(s: &str) -> Result<crate::training::TimeoutAs, String> {
+    s.parse()
+}
+
 /// Parses an episode count (`--episodes`, `--train-episodes`): a whole number in 1..=MAX_EPISODES.
 pub fn episodes(s: &str) -> Result<u64, String> {
     match s.trim().parse::<u64>() {

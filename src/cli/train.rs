@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use super::progress::{self, Bars};
 use crate::maps;
 use crate::progress::Progress;
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
+use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs, TrainConfig, train_with_progress};
 
 /// Arguments of `train`.
 #[derive(Debug, Clone, Args)]
@@ -23,6 +23,10 @@ pub struct TrainArgs {
     /// Agent file to write (RON).
     #[arg(long, value_name = "FILE", default_value = "agent.ron")]
     pub out: PathBuf,
+    /// What a training episode's time-out is to Q-learning and Bayesian RL: `truncation`
+    /// (they bootstrap through it) or `termination` (an absorbing end, the ablation).
+    #[arg(long, value_name = "KIND", default_value = "truncation", value_parser = super::timeout_as)]
+    pub timeout_as: TimeoutAs,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -31,7 +35,10 @@ pub struct TrainArgs {
 /// Runs `train`.
 pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     let map = maps::load(&args.map)?;
-    let cfg = TrainConfig::new(args.episodes, args.seed);
+    let cfg = TrainConfig {
+        timeout_as: args.timeout_as,
+        ..TrainConfig::new(args.episodes, args.seed)
+    };
     let started = std::time::Instant::now();
     progress::phase(
         args.quiet,

@@ -6,10 +6,10 @@ use std::path::{Path, PathBuf};
 
 use super::progress::{self, Bars};
 use crate::agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
-use crate::training::TrainConfig;
+use crate::training::{TimeoutAs, TrainConfig};
 
 /// Options of a training-seed study.
-#[derive(Debug, Clone, Default, Args)]
+#[derive(Debug, Clone, Args)]
 pub struct TrainSeedArgs {
     /// Train one agent per seed and report every figure as a mean with a 95% interval
     /// over them (plus min, max and the worst seed): `1..10` (inclusive), `1,3,5` or
@@ -26,6 +26,10 @@ pub struct TrainSeedArgs {
     /// Do not read or write the agent cache (train every agent afresh).
     #[arg(long)]
     pub no_cache: bool,
+    /// What a training episode's time-out is to Q-learning and Bayesian RL: `truncation`
+    /// (they bootstrap through it) or `termination` (an absorbing end, the ablation).
+    #[arg(long, value_name = "KIND", default_value = "truncation", value_parser = super::timeout_as)]
+    pub timeout_as: TimeoutAs,
 }
 
 impl TrainSeedArgs {
@@ -50,7 +54,10 @@ impl TrainSeedArgs {
         Ok(train_agents(
             &map,
             seeds,
-            &TrainConfig::new(episodes, 0),
+            &TrainConfig {
+                timeout_as: self.timeout_as,
+                ..TrainConfig::new(episodes, 0)
+            },
             self.cache_dir(),
             &bars,
         )?)
