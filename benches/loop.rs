@@ -49,6 +49,35 @@ fn physics_decision_step(c: &mut Criterion) {
     });
 }
 
+/// `env_step`: one `Env::step` on the same map and actions as `physics_decision_step`:
+/// the world's step plus the snapshot, the discretizer, the reward's terms and the info
+/// (its difference to `physics_decision_step` is what the episode API costs per tick).
+fn env_step(c: &mut Criterion) {
+    let map = embedded::load("intersection").expect("map");
+    let mut env = Env::new(&map, EnvConfig::default()).expect("env");
+    c.bench_function("env_step", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            let mut seed = 0;
+            env.reset(seed);
+            let mut k = 0;
+            for _ in 0..iters {
+                if env.is_done() {
+                    seed += 1;
+                    env.reset(seed);
+                    k = 0;
+                }
+                let action = if k == 0 { Action::SpeedUp } else { Action::Maintain };
+                let t = Instant::now();
+                black_box(env.step(black_box(action.index())).expect("action"));
+                total += t.elapsed();
+                k += 1;
+            }
+            total
+        })
+    });
+}
+
 /// `episode`: one jaywalk episode (`run_episode`, no recording) of a fresh scaled agent
 /// built from the trained bundle (construction untimed), including its end-of-episode
 /// test-time learning.
@@ -143,6 +172,7 @@ fn decision_throughput(c: &mut Criterion, bundle: &AgentBundle) {
 fn benches(c: &mut Criterion) {
     let bundle = bundle();
     physics_decision_step(c);
+    env_step(c);
     episode(c, &bundle);
     training_throughput(c);
     decision_throughput(c, &bundle);
