@@ -88,7 +88,7 @@ pub enum Error {
     },
     /// No map of that name or path, or a map that does not validate.
     #[error(transparent)]
-    Map(#[from] crate::maps::MapLookupError),
+    Map(#[from] MapLookupError),
     /// A map file that does not validate (every diagnostic).
     #[error(transparent)]
     MapFile(#[from] unforeseen_sim::MapError),
@@ -199,4 +199,22 @@ impl Error {
             problem: problem.into(),
         }
     }
+}
+
+/// Why a map could not be had.
+#[derive(Debug, thiserror::Error)]
+pub enum MapLookupError {
+    /// Neither a readable file nor an embedded map of that name.
+    #[error(
+        "{arg}: no such map file, and no embedded map of that name (embedded maps: {names}); pass a path to a .ron map file"
+    )]
+    NotFound {
+        /// What the user passed.
+        arg: String,
+        /// The embedded names, comma separated.
+        names: String,
+    },
+    /// The file or embedded map did not validate (its diagnostics, printed once).
+    #[error(transparent)]
+    Invalid(#[from] unforeseen_sim::MapError),
 }

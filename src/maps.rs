@@ -6,26 +6,9 @@
 use std::path::Path;
 use unforeseen_sim::{Diagnostic, Map, MapError, embedded};
 
+pub use crate::error::MapLookupError;
 use crate::methods::Method;
 use crate::protocol::Protocol;
-
-/// Why a map could not be had.
-#[derive(Debug, thiserror::Error)]
-pub enum MapLookupError {
-    /// Neither a readable file nor an embedded map of that name.
-    #[error(
-        "{arg}: no such map file, and no embedded map of that name (embedded maps: {names}); pass a path to a .ron map file"
-    )]
-    NotFound {
-        /// What the user passed.
-        arg: String,
-        /// The embedded names, comma separated.
-        names: String,
-    },
-    /// The file or embedded map did not validate (its diagnostics, printed once).
-    #[error(transparent)]
-    Invalid(#[from] MapError),
-}
 
 /// Loads `arg` as a map file if such a path exists, else as an embedded map name
 /// (with or without `.ron`).
