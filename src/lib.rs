@@ -4,15 +4,20 @@
 //! physics engine. This crate wires the pieces of the paper's §VI experiment:
 //!
 //! ```text
-//! map.ron -> sim::World --snapshot--> discretizer --state/obs--> agent --action--> sim
-//!                        \--events (collision, goal)--------------------> runner (reward, metrics)
+//! map.ron -> env::Env { sim::World --snapshot--> discretizer } --observation--> agent --action--> Env::step
+//!                        \--reward terms, events (collision, goal, time-out)--> runner (metrics)
 //! ```
 //!
+//! One episode steps in one place, [`unforeseen_env::Env`]; this crate's runner, training
+//! and references are loops over it.
+//!
 //! * [`maps`] finds a map by path or by embedded name;
-//! * [`rewards`] turns a map's reward section into per-tick rewards and the agent's
-//!   per-state preferences (the C vector of §IV);
+//! * [`rewards`] turns a map's reward section into the agent's per-state preferences
+//!   (the C vector of §IV) and its planning model's episode-ending states (the per-tick
+//!   reward is the env's [`unforeseen_env::RewardTerms`]);
 //! * [`training`] learns Q-learning, the world model and Bayesian RL on the same episodes;
-//! * [`runner`] drives one episode of any [`unforeseen_agent::controller::Controller`];
+//! * [`runner`] drives one episode of any [`unforeseen_agent::controller::Controller`] in an
+//!   [`unforeseen_env::Env`];
 //! * [`methods`] builds the three compared methods (§VI), their ablations and the
 //!   scripted references of [`reference`];
 //! * [`survivability`] checks with those references that a scenario is survivable and

@@ -100,6 +100,9 @@ pub enum EnvError {
         /// What is wrong with its bins.
         source: DiscretizerError,
     },
+    /// The map could not be loaded (its file, line and fix, as the loader says).
+    #[error("{0}")]
+    Map(String),
     /// A configuration value out of range.
     #[error("{field}: {problem}")]
     Config {
@@ -214,6 +217,16 @@ pub struct Env {
     info: Option<Info>,
 }
 
+impl std::fmt::Debug for Env {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Env")
+            .field("map", &self.map.name)
+            .field("config", &self.config)
+            .field("info", &self.info)
+            .finish_non_exhaustive()
+    }
+}
+
 impl Env {
     /// An env of `map` (as returned by the map loaders, so already validated) observing
     /// as `config` says. Call [`Env::reset`] before stepping.
@@ -244,6 +257,19 @@ impl Env {
             observed: zero,
             info: None,
         })
+    }
+
+    /// An env of the map file at `name_or_path` if such a file exists, else of the
+    /// embedded map of that name (`"jaywalk"`, `"intersection.ron"`, ...).
+    pub fn load(name_or_path: &str, config: EnvConfig) -> Result<Env, EnvError> {
+        let path = std::path::Path::new(name_or_path);
+        let map = if path.exists() {
+            Map::load(path)
+        } else {
+            unforeseen_sim::embedded::load(name_or_path.strip_suffix(".ron").unwrap_or(name_or_path))
+        }
+        .map_err(|e| EnvError::Map(e.to_string()))?;
+        Env::new(&map, config)
     }
 
     /// The map.
