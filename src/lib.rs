@@ -19,7 +19,7 @@
 //! * [`runner`] drives one episode of any [`unforeseen_agent::controller::Controller`] in an
 //!   [`unforeseen_env::Env`];
 //! * [`methods`] builds the three compared methods (§VI), their ablations and the
-//!   scripted references of [`reference`];
+//!   scripted references of [`reference`](mod@reference);
 //! * [`survivability`] checks with those references that a scenario is survivable and
 //!   dangerous;
 //! * [`metrics`] aggregates episodes into the paper's table;

@@ -175,7 +175,7 @@ const BLOCK: usize = 8;
 
 /// `out = M x` for `M` stored column-major with `rows` rows (`m[j * rows + r]`), skipping
 /// the zero entries of `x`: every `out[r]` starts at `+0.0` and adds `x_j M[r, j]` in `j`
-/// order (exact; cheap for one-hot beliefs). Rows are done [`BLOCK`] at a time, so the
+/// order (exact; cheap for one-hot beliefs). Rows are done `BLOCK` (8) at a time, so the
 /// partial sums stay in registers.
 pub fn axpy_columns(m: &[f64], rows: usize, x: &[f64], out: &mut [f64]) {
     let out = &mut out[..rows];
@@ -206,7 +206,7 @@ pub fn axpy_columns(m: &[f64], rows: usize, x: &[f64], out: &mut [f64]) {
 /// `acc[s] = Σ_i m_t[i * n + s] x[i]` (`m_t` is `Mᵀ` stored column-major, so `acc[s]` is
 /// column `s` of `M` dotted with `x`): each sum runs term by term in `i` order from the
 /// first term, bit for bit the serial `Σ` (which starts from `-0.0`, and `-0.0 + y = y`),
-/// but [`BLOCK`] sums advance together in registers instead of one dependent chain after
+/// but `BLOCK` sums advance together in registers instead of one dependent chain after
 /// another.
 pub fn dot_columns(m_t: &[f64], n: usize, x: &[f64], acc: &mut [f64]) {
     let acc = &mut acc[..n];
