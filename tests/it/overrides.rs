@@ -1,4 +1,4 @@
-//! `--set` overrides and the scaled agent's parameter table (issue 19): every key is
+//! `--set` overrides and the scaled agent's parameter table: every key is
 //! settable and reads back, bad keys and values name what is allowed, the typed entry
 //! point agrees with the text one, `scaling_mode=closed-form` reaches the closed form of
 //! Theorem 1, and a sweep counts equal values once.
