@@ -106,7 +106,7 @@ impl PyAgent {
         let m = self::method(method)?;
         let p = scaled_params(params)?;
         let c = m.controller(&self.bundle, &p).map_err(errors::to_py)?;
-        Ok(PyController::new(c, self.factor_sizes()))
+        Ok(PyController::new(c, self.factor_sizes(), m))
     }
 
     fn __repr__(&self) -> String {
@@ -165,7 +165,7 @@ fn scripted_controller(method: &str, map: &str) -> PyResult<PyController> {
         .scripted_controller(&sizes)
         .map_err(errors::to_py)?
         .ok_or_else(|| errors::value(format!("{method} needs a trained agent: use agent.controller('{method}')")))?;
-    Ok(PyController::new(c, sizes))
+    Ok(PyController::new(c, sizes, m))
 }
 
 /// One method's controller: `act` decides, `observe` takes the outcome, `end_episode`
@@ -178,8 +178,8 @@ pub struct PyController {
 }
 
 impl PyController {
-    fn new(c: Box<dyn Controller>, sizes: Vec<usize>) -> Self {
-        let name = c.name();
+    fn new(c: Box<dyn Controller>, sizes: Vec<usize>, method: Method) -> Self {
+        let name = method.name();
         PyController {
             inner: Mutex::new(c),
             sizes,
@@ -234,7 +234,7 @@ fn decision_dict<'py>(py: Python<'py>, d: &Decision) -> PyResult<Bound<'py, PyDi
 
 #[pymethods]
 impl PyController {
-    /// The method's name.
+    /// The method's name (as `unforeseen eval --method` spells it).
     #[getter]
     fn name(&self) -> &'static str {
         self.name

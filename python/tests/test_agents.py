@@ -13,7 +13,7 @@ import pytest
 
 import unforeseen
 
-from .conftest import REPO
+REPO = Path(__file__).resolve().parents[2]
 
 METHODS = [
     "q-learning", "bayes-rl", "scaled", "bayes-rl-factored", "scaled-always", "scaled-no-learning",

@@ -64,9 +64,9 @@ def rollout(env, seed, actions=None):
 
 @pytest.mark.parametrize("observation", ["discrete", "kinematic"])
 def test_seeded_reset_then_reset_is_reproducible(observation):
-    a = rollout(unforeseen.make_env("two_pedestrians", observation), seed=3, actions=[1, 0, 2, 1])
-    b = rollout(unforeseen.make_env("two_pedestrians", observation), seed=3, actions=[1, 0, 2, 1])
-    c = rollout(unforeseen.make_env("two_pedestrians", observation), seed=4, actions=[1, 0, 2, 1])
+    a = rollout(unforeseen.make_env("intersection", observation), seed=3, actions=[1, 0, 2, 1])
+    b = rollout(unforeseen.make_env("intersection", observation), seed=3, actions=[1, 0, 2, 1])
+    c = rollout(unforeseen.make_env("intersection", observation), seed=4, actions=[1, 0, 2, 1])
     assert a == b
     assert a != c
 
