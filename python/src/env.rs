@@ -250,13 +250,21 @@ impl PyEnv {
 
 /// Steps `steps` decision ticks of `map` in Rust alone, with the actions of `actions`
 /// in turn, starting a new episode (world seeds `stream_seed(seed, k)`) whenever one ends;
-/// the GIL is released. Returns `(ticks, seconds, episodes)`: the Rust loop's own speed,
+/// the GIL is released; `overrides` as for `Env`. Returns `(ticks, seconds, episodes)`: the Rust loop's own speed,
 /// for the benches.
 #[pyfunction]
-#[pyo3(signature = (map, actions, steps, seed = 0, observation = "discrete"))]
-pub fn rust_loop(py: Python<'_>, map: &str, actions: Vec<i64>, steps: u64, seed: u64, observation: &str) -> PyResult<(u64, f64, u64)> {
+#[pyo3(signature = (map, actions, steps, seed = 0, observation = "discrete", overrides = None))]
+pub fn rust_loop(
+    py: Python<'_>,
+    map: &str,
+    actions: Vec<i64>,
+    steps: u64,
+    seed: u64,
+    observation: &str,
+    overrides: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(u64, f64, u64)> {
     let form = observation_form(observation)?;
-    let map = crate::maps::load(map, None)?;
+    let map = crate::maps::load(map, overrides)?;
     let mut env = new_env(&map, form, 4)?;
     let actions = actions.into_iter().map(action_index).collect::<PyResult<Vec<_>>>()?;
     if actions.is_empty() {

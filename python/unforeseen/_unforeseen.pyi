@@ -41,7 +41,12 @@ def stream_seed(key: int, episode: int) -> int:
     """World seed of episode ``episode`` of the episode stream keyed ``key``."""
 
 def rust_loop(
-    map: str, actions: Sequence[int], steps: int, seed: int = 0, observation: str = "discrete"
+    map: str,
+    actions: Sequence[int],
+    steps: int,
+    seed: int = 0,
+    observation: str = "discrete",
+    overrides: dict[str, Any] | None = None,
 ) -> tuple[int, float, int]:
     """Steps ``map`` ``steps`` ticks in Rust alone with ``actions`` in turn (GIL released):
     ``(ticks, seconds, episodes)``."""
