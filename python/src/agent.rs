@@ -111,7 +111,12 @@ impl PyAgent {
 
     fn __repr__(&self) -> String {
         let g = |k: &str| self.bundle.meta.get(k).cloned().unwrap_or_else(|| "?".into());
-        format!("Agent(map={}, episodes={}, seed={})", g("map"), g("episodes"), g("seed"))
+        format!(
+            "Agent(map={}, episodes={}, seed={})",
+            g("map"),
+            g("episodes"),
+            g("seed")
+        )
     }
 }
 
@@ -161,10 +166,11 @@ fn scripted_controller(method: &str, map: &str) -> PyResult<PyController> {
         .map_err(errors::py)?
         .factor_sizes()
         .to_vec();
-    let c = m
-        .scripted_controller(&sizes)
-        .map_err(errors::to_py)?
-        .ok_or_else(|| errors::value(format!("{method} needs a trained agent: use agent.controller('{method}')")))?;
+    let c = m.scripted_controller(&sizes).map_err(errors::to_py)?.ok_or_else(|| {
+        errors::value(format!(
+            "{method} needs a trained agent: use agent.controller('{method}')"
+        ))
+    })?;
     Ok(PyController::new(c, sizes, m))
 }
 
@@ -196,7 +202,9 @@ impl PyController {
         let n: usize = self.sizes.iter().product();
         if let Ok(i) = obs.extract::<i64>() {
             return usize::try_from(i).ok().filter(|i| *i < n).ok_or_else(|| {
-                errors::value(format!("observation {i}: expected a joint index in 0..{n} or (d, v, L, p)"))
+                errors::value(format!(
+                    "observation {i}: expected a joint index in 0..{n} or (d, v, L, p)"
+                ))
             });
         }
         let factors: Vec<i64> = obs
@@ -211,9 +219,10 @@ impl PyController {
         }
         let mut index = 0;
         for (&f, &size) in factors.iter().zip(&self.sizes) {
-            let f = usize::try_from(f).ok().filter(|f| *f < size).ok_or_else(|| {
-                errors::value(format!("observation {obs}: factor sizes are {:?}", self.sizes))
-            })?;
+            let f = usize::try_from(f)
+                .ok()
+                .filter(|f| *f < size)
+                .ok_or_else(|| errors::value(format!("observation {obs}: factor sizes are {:?}", self.sizes)))?;
             index = index * size + f;
         }
         Ok(index)
@@ -256,9 +265,16 @@ impl PyController {
     }
 
     /// The outcome of the last action: reward, next observation and the episode's flags.
-    fn observe(&self, reward: f64, next_observation: &Bound<'_, PyAny>, terminated: bool, truncated: bool) -> PyResult<()> {
+    fn observe(
+        &self,
+        reward: f64,
+        next_observation: &Bound<'_, PyAny>,
+        terminated: bool,
+        truncated: bool,
+    ) -> PyResult<()> {
         let i = self.index(next_observation)?;
-        self.lock().observe(reward, i, Ending::from_flags(terminated, truncated));
+        self.lock()
+            .observe(reward, i, Ending::from_flags(terminated, truncated));
         Ok(())
     }
 
@@ -301,19 +317,26 @@ fn evaluate_json(
     let p = scaled_params(params)?;
     let map = crate::maps::load(map, None)?;
     if !(1..=unforeseen::cli::MAX_EPISODES).contains(&episodes) {
-        return Err(errors::value(format!("episodes {episodes}: expected 1..={}", unforeseen::cli::MAX_EPISODES)));
+        return Err(errors::value(format!(
+            "episodes {episodes}: expected 1..={}",
+            unforeseen::cli::MAX_EPISODES
+        )));
     }
     let bar = ProgressBar::hidden();
     let results = match (m.is_scripted(), agent) {
         (true, _) => py.detach(|| unforeseen::experiments::evaluate_scripted(&map, m, episodes, seed, &bar)),
-        (false, Some(a)) => py.detach(|| {
-            unforeseen::experiments::evaluate_under(proto, &map, &a.bundle, &p, m, episodes, seed, &bar)
-        }),
+        (false, Some(a)) => {
+            py.detach(|| unforeseen::experiments::evaluate_under(proto, &map, &a.bundle, &p, m, episodes, seed, &bar))
+        }
         (false, None) => return Err(errors::value(format!("{method} needs a trained agent: pass agent=..."))),
     }
     .map_err(errors::to_py)?;
     let agg = unforeseen::metrics::Aggregate::of(&results);
-    let computed = if m.is_scripted() { Protocol::ZeroShot } else { proto.effective(m, &p) };
+    let computed = if m.is_scripted() {
+        Protocol::ZeroShot
+    } else {
+        proto.effective(m, &p)
+    };
     serde_json::to_string(&serde_json::json!({
         "method": m,
         "map": map.name,

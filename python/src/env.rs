@@ -46,10 +46,11 @@ pub fn new_env(map: &Map, form: ObservationForm, pedestrian_slots: usize) -> PyR
 
 /// Checks an action given from Python (any integer) and returns it as an index.
 pub fn action_index(action: i64) -> PyResult<usize> {
-    usize::try_from(action)
-        .ok()
-        .filter(|a| *a < 3)
-        .ok_or_else(|| errors::value(format!("action {action} is not one of 0 (maintain), 1 (speed up), 2 (slow down)")))
+    usize::try_from(action).ok().filter(|a| *a < 3).ok_or_else(|| {
+        errors::value(format!(
+            "action {action} is not one of 0 (maintain), 1 (speed up), 2 (slow down)"
+        ))
+    })
 }
 
 /// The observation as a numpy array: int64 `(d, v, L, p)` or float32 kinematic values.
@@ -106,7 +107,12 @@ impl PyEnv {
     /// An env of `map` (file or embedded name) with map `overrides` (dict).
     #[new]
     #[pyo3(signature = (map, observation = "discrete", pedestrian_slots = 4, overrides = None))]
-    fn new(map: &str, observation: &str, pedestrian_slots: usize, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+    fn new(
+        map: &str,
+        observation: &str,
+        pedestrian_slots: usize,
+        overrides: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
         let form = observation_form(observation)?;
         let map = crate::maps::load(map, overrides)?;
         Ok(PyEnv {
@@ -224,7 +230,9 @@ impl PyEnv {
     fn render_rgb<'py>(&self, py: Python<'py>, scale: f32) -> PyResult<Bound<'py, PyAny>> {
         self.started()?;
         if !(0.5..=50.0).contains(&scale) {
-            return Err(errors::value(format!("scale {scale}: expected 0.5..=50 pixels per metre")));
+            return Err(errors::value(format!(
+                "scale {scale}: expected 0.5..=50 pixels per metre"
+            )));
         }
         let (rgb, h, w) = render::frame(self.env.map(), self.env.snapshot(), scale);
         Ok(PyArray1::from_vec(py, rgb).reshape([h, w, 3])?.into_any())

@@ -58,7 +58,10 @@ fn locate(key: &str, sections: &[(String, Vec<String>)]) -> PyResult<(String, St
         if sections.iter().any(|(sec, fs)| sec == s && fs.iter().any(|x| x == f)) {
             return Ok((s.to_string(), f.to_string()));
         }
-        return Err(errors::value(format!("map override {key}: no such field; known: {}", known())));
+        return Err(errors::value(format!(
+            "map override {key}: no such field; known: {}",
+            known()
+        )));
     }
     let owners: Vec<&String> = sections
         .iter()
@@ -67,7 +70,10 @@ fn locate(key: &str, sections: &[(String, Vec<String>)]) -> PyResult<(String, St
         .collect();
     match owners[..] {
         [s] => Ok((s.clone(), key.to_string())),
-        [] => Err(errors::value(format!("map override {key}: no such field; known: {}", known()))),
+        [] => Err(errors::value(format!(
+            "map override {key}: no such field; known: {}",
+            known()
+        ))),
         _ => Err(errors::value(format!(
             "map override {key}: several sections have it ({}); write it as section__{key}",
             owners.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
@@ -87,10 +93,7 @@ fn ron_value(v: &Bound<'_, PyAny>) -> PyResult<String> {
     } else if v.is_instance_of::<PyString>() {
         v.extract::<String>()
     } else if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
-        let items = v
-            .try_iter()?
-            .map(|x| ron_value(&x?))
-            .collect::<PyResult<Vec<_>>>()?;
+        let items = v.try_iter()?.map(|x| ron_value(&x?)).collect::<PyResult<Vec<_>>>()?;
         Ok(format!("[{}]", items.join(", ")))
     } else {
         Err(errors::value(format!(
@@ -130,6 +133,8 @@ fn patch(map: &Map, arg: &str, fields: &[(String, String)]) -> PyResult<Map> {
     restated.base = None;
     let base = ron::to_string(&restated).map_err(|e| errors::value(format!("{arg}: cannot restate the map: {e}")))?;
     let origin = format!("{arg} (overrides)");
-    Map::from_str_named(&origin, &text, &|b| (b == BASE).then(|| (arg.to_string(), base.clone())))
-        .map_err(errors::py)
+    Map::from_str_named(&origin, &text, &|b| {
+        (b == BASE).then(|| (arg.to_string(), base.clone()))
+    })
+    .map_err(errors::py)
 }

@@ -50,7 +50,14 @@ pub fn frame(map: &Map, snap: &Snapshot, scale: f32) -> (Vec<u8>, usize, usize) 
     let (cx, cw) = (map.crosswalk.x as f32, map.crosswalk.width as f32);
     let mut y = -half;
     while y < half {
-        rect(&mut pix, cx - cw / 2.0, y, cx + cw / 2.0, (y + 0.5).min(half), [240, 240, 240]);
+        rect(
+            &mut pix,
+            cx - cw / 2.0,
+            y,
+            cx + cw / 2.0,
+            (y + 0.5).min(half),
+            [240, 240, 240],
+        );
         y += 1.0;
     }
     // Destination line.
@@ -69,13 +76,31 @@ pub fn frame(map: &Map, snap: &Snapshot, scale: f32) -> (Vec<u8>, usize, usize) 
     let v = &map.vehicle;
     let (front, lane_y) = (snap.car_x as f32, map.road.car_lane_y() as f32);
     let (len, w) = (v.length as f32, v.width as f32);
-    rect(&mut pix, front - len, lane_y - w / 2.0, front, lane_y + w / 2.0, [40, 90, 220]);
-    rect(&mut pix, front - 0.6, lane_y - w / 2.0, front, lane_y + w / 2.0, [150, 190, 255]);
+    rect(
+        &mut pix,
+        front - len,
+        lane_y - w / 2.0,
+        front,
+        lane_y + w / 2.0,
+        [40, 90, 220],
+    );
+    rect(
+        &mut pix,
+        front - 0.6,
+        lane_y - w / 2.0,
+        front,
+        lane_y + w / 2.0,
+        [150, 190, 255],
+    );
     for p in &snap.pedestrians {
         let rgb = if p.on_crosswalk { [250, 120, 20] } else { [230, 60, 160] };
         disc(&mut pix, p.x as f32, p.y as f32, 0.4, rgb);
     }
-    let rgb = pix.data().chunks_exact(4).flat_map(|px| [px[0], px[1], px[2]]).collect();
+    let rgb = pix
+        .data()
+        .chunks_exact(4)
+        .flat_map(|px| [px[0], px[1], px[2]])
+        .collect();
     (rgb, height as usize, width as usize)
 }
 

@@ -130,7 +130,10 @@ fn batch_json(
         None => Method::PAPER.iter().chain(&Method::REFERENCE).copied().collect(),
     };
     let names: Vec<String> = if maps.is_empty() {
-        unforeseen_sim::embedded::names().iter().map(|s| s.to_string()).collect()
+        unforeseen_sim::embedded::names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
     } else {
         maps
     };
@@ -149,7 +152,10 @@ fn batch_json(
             let flat = PyDict::new(d.py());
             for (k, v) in d.iter() {
                 let joined = if let Ok(list) = v.cast::<PyList>() {
-                    list.iter().map(|x| Ok(x.str()?.to_string())).collect::<PyResult<Vec<_>>>()?.join(",")
+                    list.iter()
+                        .map(|x| Ok(x.str()?.to_string()))
+                        .collect::<PyResult<Vec<_>>>()?
+                        .join(",")
                 } else {
                     v.str()?.to_string()
                 };

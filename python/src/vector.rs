@@ -123,8 +123,22 @@ impl PyVectorEnv {
             slots,
             form,
             obs_len,
-            obs: vec![0.0; if form == ObservationForm::Kinematic { num_envs * obs_len } else { 0 }],
-            ints: vec![0; if form == ObservationForm::Discrete { num_envs * 4 } else { 0 }],
+            obs: vec![
+                0.0;
+                if form == ObservationForm::Kinematic {
+                    num_envs * obs_len
+                } else {
+                    0
+                }
+            ],
+            ints: vec![
+                0;
+                if form == ObservationForm::Discrete {
+                    num_envs * 4
+                } else {
+                    0
+                }
+            ],
             outs: vec![out; num_envs],
             actions: vec![0; num_envs],
             pool,
@@ -265,14 +279,20 @@ impl PyVectorEnv {
         let n = self.slots.len();
         Ok(match self.form {
             ObservationForm::Discrete => PyArray1::from_slice(py, &self.ints).reshape([n, 4])?.into_any(),
-            ObservationForm::Kinematic => PyArray1::from_slice(py, &self.obs).reshape([n, self.obs_len])?.into_any(),
+            ObservationForm::Kinematic => PyArray1::from_slice(py, &self.obs)
+                .reshape([n, self.obs_len])?
+                .into_any(),
         })
     }
 
     /// The info of every env as arrays (one entry per env; documented on the Python class).
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let n = self.slots.len();
-        let infos: Vec<Info> = self.outs.iter().map(|o| o.info.expect("run fills every info")).collect();
+        let infos: Vec<Info> = self
+            .outs
+            .iter()
+            .map(|o| o.info.expect("run fills every info"))
+            .collect();
         let d = PyDict::new(py);
         let col = |f: &dyn Fn(&Info) -> i64| PyArray1::from_vec(py, infos.iter().map(f).collect::<Vec<_>>());
         let flag = |f: &dyn Fn(&Info) -> bool| PyArray1::from_vec(py, infos.iter().map(f).collect::<Vec<_>>());
