@@ -7,7 +7,9 @@
 //! vector env seeded `s` is the single env seeded `s + i`.
 
 use numpy::{PyArray1, PyArrayMethods};
+use pyo3::intern;
 use pyo3::prelude::*;
+use pyo3::types::PyString;
 use pyo3::types::{PyDict, PyTuple};
 use unforeseen_env::{Env, EnvConfig, Info, Observation, ObservationForm, kinematic};
 use unforeseen_sim::Map;
@@ -72,25 +74,34 @@ pub fn light_code(light: unforeseen_sim::LightPhase) -> i64 {
     }
 }
 
+/// The light's name as an interned Python string.
+fn light_str(py: Python<'_>, light: unforeseen_sim::LightPhase) -> &Bound<'_, PyString> {
+    match light {
+        unforeseen_sim::LightPhase::Green => intern!(py, "green"),
+        unforeseen_sim::LightPhase::Amber => intern!(py, "amber"),
+        unforeseen_sim::LightPhase::Red => intern!(py, "red"),
+    }
+}
+
 /// The info dict (documented on `UnforeseenEnv`).
 fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let state = |s: unforeseen_discretizer::State| (s.d as i64, s.v as i64, s.l as i64, s.p as i64);
-    d.set_item("step", info.step)?;
-    d.set_item("collision", info.events.collision)?;
-    d.set_item("goal", info.events.goal)?;
-    d.set_item("timeout", info.events.timeout)?;
-    d.set_item("state", state(info.state))?;
-    d.set_item("observed", state(info.observed))?;
-    d.set_item("light", render::light_name(info.light))?;
-    d.set_item("light_code", light_code(info.light))?;
-    d.set_item("light_time_left", info.light_time_left)?;
+    d.set_item(intern!(py, "step"), info.step)?;
+    d.set_item(intern!(py, "collision"), info.events.collision)?;
+    d.set_item(intern!(py, "goal"), info.events.goal)?;
+    d.set_item(intern!(py, "timeout"), info.events.timeout)?;
+    d.set_item(intern!(py, "state"), state(info.state))?;
+    d.set_item(intern!(py, "observed"), state(info.observed))?;
+    d.set_item(intern!(py, "light"), light_str(py, info.light))?;
+    d.set_item(intern!(py, "light_code"), light_code(info.light))?;
+    d.set_item(intern!(py, "light_time_left"), info.light_time_left)?;
     let terms = PyDict::new(py);
-    terms.set_item("progress", info.reward.progress)?;
-    terms.set_item("time", info.reward.time)?;
-    terms.set_item("goal", info.reward.goal)?;
-    terms.set_item("crash", info.reward.crash)?;
-    d.set_item("reward_terms", terms)?;
+    terms.set_item(intern!(py, "progress"), info.reward.progress)?;
+    terms.set_item(intern!(py, "time"), info.reward.time)?;
+    terms.set_item(intern!(py, "goal"), info.reward.goal)?;
+    terms.set_item(intern!(py, "crash"), info.reward.crash)?;
+    d.set_item(intern!(py, "reward_terms"), terms)?;
     Ok(d)
 }
 
