@@ -72,11 +72,10 @@ def unforeseen_figures(map_name: str, steps: int, repeats: int, hz: int) -> dict
 
 
 def highway_figures(hz: int, steps: int, repeats: int) -> dict:
-    import warnings
-
-    warnings.filterwarnings("ignore")  # intersection-v0's deprecation notice
     import gymnasium as gym
     import highway_env  # noqa: F401  (registers the envs)
+
+    gym.logger.min_level = gym.logger.ERROR  # intersection-v0's deprecation notice
 
     def run() -> float:
         env = gym.make("intersection-v0", config={"policy_frequency": hz, "duration": 40})
