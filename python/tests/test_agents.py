@@ -74,11 +74,9 @@ def cli_binary() -> Path | None:
     env = os.environ.get("UNFORESEEN_CLI")
     if env:
         return Path(env)
-    for profile in ("release", "debug"):
-        p = REPO / "target" / profile / "unforeseen"
-        if p.is_file():
-            return p
-    return None
+    # The most recently built of the release and debug binaries (CI builds debug).
+    built = [p for p in (REPO / "target" / d / "unforeseen" for d in ("release", "debug")) if p.is_file()]
+    return max(built, key=lambda p: p.stat().st_mtime, default=None)
 
 
 def test_python_rollout_equals_the_command_line(agent_file, tmp_path):
