@@ -130,9 +130,7 @@ pub fn ansi(map: &Map, snap: &Snapshot) -> String {
     let cell = |x: f64| (((x - x0) / span) * (N - 1) as f64).round().clamp(0.0, (N - 1) as f64) as usize;
     let mut line = vec!['.'; N];
     let cw = map.crosswalk.width / 2.0;
-    for c in cell(map.crosswalk.x - cw)..=cell(map.crosswalk.x + cw) {
-        line[c] = '=';
-    }
+    line[cell(map.crosswalk.x - cw)..=cell(map.crosswalk.x + cw)].fill('=');
     line[N - 1] = '|';
     for p in &snap.pedestrians {
         if p.on_crosswalk {
