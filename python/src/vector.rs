@@ -27,6 +27,12 @@ struct Slot {
 }
 
 impl Slot {
+    /// No episode was ever started.
+    fn info_missing(&self) -> bool {
+        self.env.info().is_none()
+    }
+
+    /// Starts the stream's next episode, writing its observation.
     fn reset_next(&mut self, obs: &mut [f32], ints: &mut [i64]) -> Info {
         let seed = stream_seed(self.key, self.episode);
         self.episode += 1;
@@ -89,7 +95,6 @@ impl PyVectorEnv {
         }
         let form = observation_form(observation)?;
         let map = crate::maps::load(map, overrides)?;
-        let env = new_env(&map, form, pedestrian_slots)?;
         let obs_len = match form {
             ObservationForm::Discrete => 4,
             ObservationForm::Kinematic => kinematic::len(pedestrian_slots),
@@ -105,14 +110,15 @@ impl PyVectorEnv {
             Some(n) => return Err(errors::value(format!("num_threads {n}: expected 1..=1024"))),
         };
         let slots = (0..num_envs)
-            .map(|_| Slot {
-                env: new_env(&map, form, pedestrian_slots).expect("built once above"),
-                key: 0,
-                episode: 0,
-                ended: true,
+            .map(|_| {
+                Ok(Slot {
+                    env: new_env(&map, form, pedestrian_slots)?,
+                    key: 0,
+                    episode: 0,
+                    ended: true,
+                })
             })
-            .collect();
-        drop(env);
+            .collect::<PyResult<Vec<_>>>()?;
         let out = Out {
             reward: 0.0,
             terminated: false,
@@ -209,12 +215,6 @@ impl PyVectorEnv {
             self.info(py)?,
         )
             .into_pyobject(py)
-    }
-}
-
-impl Slot {
-    fn info_missing(&self) -> bool {
-        self.env.info().is_none()
     }
 }
 
