@@ -61,3 +61,26 @@ def test_bad_agent_file(tmp_path):
         unforeseen.load_agent(str(bad))
     with pytest.raises(ValueError, match="cannot read the agent file"):
         unforeseen.load_agent(str(tmp_path / "missing.ron"))
+
+
+@pytest.mark.parametrize(
+    "call,message",
+    [
+        (lambda: unforeseen.make_env("jaywalk", offset="(((("), r"jaywalk \(overrides\):\d+:\d+: "),
+        (lambda: unforeseen.make_env("jaywalk", max_steps=10**12), "episode.max_steps"),
+        (lambda: unforeseen.make_env("jaywalk", lane_width=float("nan")), "road.lane_width: must be a finite number"),
+        (lambda: unforeseen.make_env("jaywalk", distance_edges=[60, 30]), "strictly increasing"),
+        (lambda: unforeseen.make_env("jaywalk", cycle=[]), "light.cycle"),
+        (lambda: unforeseen.make_env("jaywalk", pedestrian_slots=0), "pedestrian_slots: must be in 1..=100"),
+        (lambda: unforeseen.make_env("/dev/null"), "not a regular file"),
+        (lambda: unforeseen.VectorEnv("jaywalk", 2, num_threads=0), "num_threads 0"),
+        (lambda: unforeseen.train(episodes=0), "episodes 0"),
+        (lambda: unforeseen.scripted_controller("scaled"), "needs a trained agent"),
+        (lambda: unforeseen.evaluate_builtin("jaywalk", "scaled", episodes=2), "needs a trained agent"),
+        (lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=2, protocol="x"), "unknown protocol"),
+        (lambda: unforeseen.compare(agents=[]), "at least one agent"),
+    ],
+)
+def test_bad_input_raises_value_error_never_a_panic(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()
