@@ -15,6 +15,8 @@
 //!   (`cargo test`, `cargo install`, `cargo bench`, ...) are skipped: `.ci/run` runs the
 //!   test and bench builds itself, and this test is part of `cargo test`.
 //! * `SLURM_ARRAY_TASK_ID` is 1, as for the first task of the array.
+//! * The Python section's blocks (`console` and `python` fences) need Python and are not run
+//!   here: `.ci/run` runs its two commands, and `python/tests/test_readme.py` its example.
 
 #![cfg(unix)]
 

@@ -1,0 +1,363 @@
+//! The agents from Python: training and agent files ([`unforeseen::training`],
+//! [`unforeseen::agent_file`]), a controller of every method the command line has
+//! ([`unforeseen::methods::Method`]) with parameters through `--set`'s path
+//! ([`unforeseen::overrides`]), and the library's evaluation ([`unforeseen::experiments`]).
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use indicatif::ProgressBar;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict};
+use unforeseen::methods::Method;
+use unforeseen::protocol::Protocol;
+use unforeseen_agent::controller::{Controller, Decision, Ending};
+use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::persist::AgentBundle;
+
+use crate::errors;
+
+/// Every method, in the command line's order.
+pub fn all_methods() -> Vec<Method> {
+    let mut v = Method::PAPER.to_vec();
+    v.extend(Method::ABLATIONS);
+    v.extend(Method::REFERENCE);
+    v
+}
+
+/// A method by its command-line name.
+pub fn method(name: &str) -> PyResult<Method> {
+    all_methods().into_iter().find(|m| m.name() == name).ok_or_else(|| {
+        errors::value(format!(
+            "unknown method '{name}'; methods: {}",
+            all_methods().iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
+        ))
+    })
+}
+
+/// A protocol by name (`zero-shot`, `continual`).
+pub fn protocol(name: &str) -> PyResult<Protocol> {
+    serde_json::from_value(serde_json::Value::String(name.into()))
+        .map_err(|_| errors::value(format!("unknown protocol '{name}'; protocols: zero-shot, continual")))
+}
+
+/// Keyword parameters as `--set KEY=VALUE` strings (the one conversion to switch when
+/// the library takes typed values): `True`/`False` as `true`/`false`, anything else
+/// by `str()`.
+pub fn param_sets(params: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<String>> {
+    let mut sets = Vec::new();
+    if let Some(d) = params {
+        for (k, v) in d.iter() {
+            let key: String = k.extract()?;
+            let value = if v.is_instance_of::<PyBool>() {
+                if v.extract::<bool>()? { "true" } else { "false" }.to_string()
+            } else if v.is_none() {
+                return Err(errors::value(format!("--set {key}: None is not a value")));
+            } else {
+                v.str()?.to_string()
+            };
+            sets.push(format!("{key}={value}"));
+        }
+    }
+    Ok(sets)
+}
+
+/// The scaled agent's parameters: the defaults with `params` applied as `--set` does.
+pub fn scaled_params(params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParams> {
+    unforeseen::overrides::apply(ScaledParams::default(), &param_sets(params)?).map_err(errors::py)
+}
+
+/// A trained agent (an agent file's content).
+#[pyclass(name = "Agent", module = "unforeseen._unforeseen", frozen)]
+pub struct PyAgent {
+    pub bundle: AgentBundle,
+    returns: Vec<f64>,
+}
+
+#[pymethods]
+impl PyAgent {
+    /// Writes the agent file (atomically), as `unforeseen train --out` does.
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        unforeseen::agent_file::save(&path, &self.bundle).map_err(errors::to_py)
+    }
+
+    /// What the file records: map, episodes, seed, ... (strings).
+    #[getter]
+    fn meta(&self) -> std::collections::BTreeMap<String, String> {
+        self.bundle.meta.clone()
+    }
+
+    /// Returns of the training episodes (empty for a loaded agent).
+    #[getter]
+    fn train_returns(&self) -> Vec<f64> {
+        self.returns.clone()
+    }
+
+    /// Factor sizes `[n_d, n_v, n_L, n_p]` of its world model.
+    #[getter]
+    fn factor_sizes(&self) -> Vec<usize> {
+        self.bundle.world_model.structure().sizes()
+    }
+
+    /// A fresh controller of `method` (any name of `unforeseen eval --method`), with the
+    /// scaled agent's parameters as keywords (`epsilon=0.3, horizon=4`: the keys of `--set`).
+    #[pyo3(signature = (method = "scaled", **params))]
+    fn controller(&self, method: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<PyController> {
+        let m = self::method(method)?;
+        let p = scaled_params(params)?;
+        let c = m.controller(&self.bundle, &p).map_err(errors::to_py)?;
+        Ok(PyController::new(c, self.factor_sizes(), m))
+    }
+
+    fn __repr__(&self) -> String {
+        let g = |k: &str| self.bundle.meta.get(k).cloned().unwrap_or_else(|| "?".into());
+        format!(
+            "Agent(map={}, episodes={}, seed={})",
+            g("map"),
+            g("episodes"),
+            g("seed")
+        )
+    }
+}
+
+/// Trains an agent on `map` for `episodes` episodes from `seed` (as `unforeseen train`),
+/// with the GIL released.
+#[pyfunction]
+#[pyo3(signature = (map = "intersection", episodes = 6000, seed = 7))]
+fn train(py: Python<'_>, map: &str, episodes: u64, seed: u64) -> PyResult<PyAgent> {
+    if !(1..=unforeseen::cli::MAX_EPISODES).contains(&episodes) {
+        return Err(errors::value(format!(
+            "episodes {episodes}: expected 1..={}",
+            unforeseen::cli::MAX_EPISODES
+        )));
+    }
+    let map = crate::maps::load(map, None)?;
+    let cfg = unforeseen::training::TrainConfig {
+        quiet: true,
+        ..unforeseen::training::TrainConfig::new(episodes, seed)
+    };
+    let (bundle, log) = py
+        .detach(|| unforeseen::training::train(&map, &cfg))
+        .map_err(errors::to_py)?;
+    Ok(PyAgent {
+        bundle,
+        returns: log.returns,
+    })
+}
+
+/// Loads and checks an agent file (errors name the file, the field and the fix).
+#[pyfunction]
+fn load_agent(path: PathBuf) -> PyResult<PyAgent> {
+    let bundle = unforeseen::agent_file::load(&path).map_err(errors::to_py)?;
+    Ok(PyAgent {
+        bundle,
+        returns: Vec::new(),
+    })
+}
+
+/// A scripted reference (`brake-on-pedestrian`, `never-brake`) for `map`'s
+/// observations: it needs no agent.
+#[pyfunction]
+#[pyo3(signature = (method, map = "jaywalk"))]
+fn scripted_controller(method: &str, map: &str) -> PyResult<PyController> {
+    let m = self::method(method)?;
+    let map = crate::maps::load(map, None)?;
+    let sizes = unforeseen_discretizer::Discretizer::new(&map.bins)
+        .map_err(errors::py)?
+        .factor_sizes()
+        .to_vec();
+    let c = m.scripted_controller(&sizes).map_err(errors::to_py)?.ok_or_else(|| {
+        errors::value(format!(
+            "{method} needs a trained agent: use agent.controller('{method}')"
+        ))
+    })?;
+    Ok(PyController::new(c, sizes, m))
+}
+
+/// One method's controller: `act` decides, `observe` takes the outcome, `end_episode`
+/// learns (the scaled agent's test-time learning).
+#[pyclass(name = "Controller", module = "unforeseen._unforeseen")]
+pub struct PyController {
+    inner: Mutex<Box<dyn Controller>>,
+    sizes: Vec<usize>,
+    name: &'static str,
+}
+
+impl PyController {
+    fn new(c: Box<dyn Controller>, sizes: Vec<usize>, method: Method) -> Self {
+        let name = method.name();
+        PyController {
+            inner: Mutex::new(c),
+            sizes,
+            name,
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Box<dyn Controller>> {
+        self.inner.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// An observation as the joint index: an int, or `(d, v, L, p)`.
+    fn index(&self, obs: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let n: usize = self.sizes.iter().product();
+        if let Ok(i) = obs.extract::<i64>() {
+            return usize::try_from(i).ok().filter(|i| *i < n).ok_or_else(|| {
+                errors::value(format!(
+                    "observation {i}: expected a joint index in 0..{n} or (d, v, L, p)"
+                ))
+            });
+        }
+        let factors: Vec<i64> = obs
+            .try_iter()
+            .and_then(|it| it.map(|x| x?.extract::<i64>()).collect::<PyResult<Vec<_>>>())
+            .map_err(|_| errors::value(format!("observation {obs}: expected a joint index or (d, v, L, p)")))?;
+        if factors.len() != self.sizes.len() {
+            return Err(errors::value(format!(
+                "observation {obs}: expected {} factors (d, v, L, p)",
+                self.sizes.len()
+            )));
+        }
+        let mut index = 0;
+        for (&f, &size) in factors.iter().zip(&self.sizes) {
+            let f = usize::try_from(f)
+                .ok()
+                .filter(|f| *f < size)
+                .ok_or_else(|| errors::value(format!("observation {obs}: factor sizes are {:?}", self.sizes)))?;
+            index = index * size + f;
+        }
+        Ok(index)
+    }
+}
+
+fn decision_dict<'py>(py: Python<'py>, d: &Decision) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("action", d.action)?;
+    out.set_item("reasoned", d.reasoned)?;
+    out.set_item("surprise", d.surprise)?;
+    out.set_item("theta", d.theta)?;
+    out.set_item("policy", d.policy.to_vec())?;
+    out.set_item("psi", d.psi.as_deref().map(<[f64]>::to_vec))?;
+    out.set_item("scaling_iters", d.scaling_iters)?;
+    Ok(out)
+}
+
+#[pymethods]
+impl PyController {
+    /// The method's name (as `unforeseen eval --method` spells it).
+    #[getter]
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// Starts an episode: clears beliefs, seeds the controller's own sampling.
+    fn begin_episode(&self, seed: u64) {
+        self.lock().begin_episode(seed);
+    }
+
+    /// Decides on `observation` (joint index or `(d, v, L, p)`): `(action, decision)`,
+    /// the decision a dict with `surprise`, `theta`, `reasoned`, `policy` (the
+    /// distribution the action came from), `psi` (the planner's, on ticks that planned)
+    /// and `scaling_iters`.
+    fn act<'py>(&self, py: Python<'py>, observation: &Bound<'py, PyAny>) -> PyResult<(usize, Bound<'py, PyDict>)> {
+        let i = self.index(observation)?;
+        let d = self.lock().act(i);
+        Ok((d.action, decision_dict(py, &d)?))
+    }
+
+    /// The outcome of the last action: reward, next observation and the episode's flags.
+    fn observe(
+        &self,
+        reward: f64,
+        next_observation: &Bound<'_, PyAny>,
+        terminated: bool,
+        truncated: bool,
+    ) -> PyResult<()> {
+        let i = self.index(next_observation)?;
+        self.lock()
+            .observe(reward, i, Ending::from_flags(terminated, truncated));
+        Ok(())
+    }
+
+    /// Ends the episode (the scaled agent's test-time learning runs here).
+    fn end_episode(&self) {
+        self.lock().end_episode();
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Controller({})", self.name)
+    }
+}
+
+/// `(world, controller)` seeds of evaluation episode `episode` of `method` on `map`, as
+/// `unforeseen eval` uses them ([`unforeseen::experiments::eval_seeds`]).
+#[pyfunction]
+fn eval_seeds(seed: u64, map: &str, method: &str, episode: u64) -> PyResult<(u64, u64)> {
+    let map = crate::maps::load(map, None)?;
+    let s = unforeseen::experiments::eval_seeds(seed, &map, self::method(method)?, episode);
+    Ok((s.world, s.controller))
+}
+
+/// `unforeseen eval` in the library, with the GIL released: JSON text of
+/// `{method, map, protocol, computed_under, seed, aggregate, episodes}` (eval.json's fields).
+#[pyfunction]
+#[pyo3(signature = (map, method, episodes, seed = 7, agent = None, protocol = "zero-shot", **params))]
+#[allow(clippy::too_many_arguments)]
+fn evaluate_json(
+    py: Python<'_>,
+    map: &str,
+    method: &str,
+    episodes: u64,
+    seed: u64,
+    agent: Option<&PyAgent>,
+    protocol: &str,
+    params: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let m = self::method(method)?;
+    let proto = self::protocol(protocol)?;
+    let p = scaled_params(params)?;
+    let map = crate::maps::load(map, None)?;
+    if !(1..=unforeseen::cli::MAX_EPISODES).contains(&episodes) {
+        return Err(errors::value(format!(
+            "episodes {episodes}: expected 1..={}",
+            unforeseen::cli::MAX_EPISODES
+        )));
+    }
+    let bar = ProgressBar::hidden();
+    let results = match (m.is_scripted(), agent) {
+        (true, _) => py.detach(|| unforeseen::experiments::evaluate_scripted(&map, m, episodes, seed, &bar)),
+        (false, Some(a)) => {
+            py.detach(|| unforeseen::experiments::evaluate_under(proto, &map, &a.bundle, &p, m, episodes, seed, &bar))
+        }
+        (false, None) => return Err(errors::value(format!("{method} needs a trained agent: pass agent=..."))),
+    }
+    .map_err(errors::to_py)?;
+    let agg = unforeseen::metrics::Aggregate::of(&results);
+    let computed = if m.is_scripted() {
+        Protocol::ZeroShot
+    } else {
+        proto.effective(m, &p)
+    };
+    serde_json::to_string(&serde_json::json!({
+        "method": m,
+        "map": map.name,
+        "protocol": proto,
+        "computed_under": computed,
+        "seed": seed,
+        "reward": map.reward,
+        "aggregate": agg,
+        "episodes": results,
+    }))
+    .map_err(errors::py)
+}
+
+/// Registers the classes and functions.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyAgent>()?;
+    m.add_class::<PyController>()?;
+    m.add_function(wrap_pyfunction!(train, m)?)?;
+    m.add_function(wrap_pyfunction!(load_agent, m)?)?;
+    m.add_function(wrap_pyfunction!(scripted_controller, m)?)?;
+    m.add_function(wrap_pyfunction!(eval_seeds, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate_json, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,314 @@
+//! One env per Python object: [`unforeseen_env::Env`] with Gymnasium's seeding on top.
+//!
+//! Seeding (what `unforeseen.UnforeseenEnv.reset` documents): `reset(seed=s)` seeds
+//! Gymnasium's `np_random` with `s` and draws from it a 64-bit key; episode `k` since then
+//! (`k = 0` for that reset, 1 for the next `reset()`, ...) runs with world seed
+//! [`stream_seed`]`(key, k)`. The vector env does the same per env, so env `i` of a
+//! vector env seeded `s` is the single env seeded `s + i`.
+
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::intern;
+use pyo3::prelude::*;
+use pyo3::types::PyString;
+use pyo3::types::{PyDict, PyTuple};
+use unforeseen_env::{Env, EnvConfig, Info, Observation, ObservationForm, kinematic};
+use unforeseen_sim::Map;
+
+use crate::errors;
+use crate::render;
+
+/// World seed of episode `episode` of the stream keyed `key`.
+#[pyfunction]
+pub fn stream_seed(key: u64, episode: u64) -> u64 {
+    unforeseen::seeds::episode_seed(key, "gymnasium", episode)
+}
+
+/// Parses an observation form name.
+pub fn observation_form(name: &str) -> PyResult<ObservationForm> {
+    match name {
+        "discrete" => Ok(ObservationForm::Discrete),
+        "kinematic" => Ok(ObservationForm::Kinematic),
+        _ => Err(errors::value(format!(
+            "observation '{name}': expected \"discrete\" (d, v, L, p) or \"kinematic\" (a float vector)"
+        ))),
+    }
+}
+
+/// Builds an env of `map` observing in `form`.
+pub fn new_env(map: &Map, form: ObservationForm, pedestrian_slots: usize) -> PyResult<Env> {
+    Env::new(
+        map,
+        EnvConfig {
+            observation: form,
+            pedestrian_slots,
+        },
+    )
+    .map_err(errors::py)
+}
+
+/// Checks an action given from Python (any integer) and returns it as an index.
+pub fn action_index(action: i64) -> PyResult<usize> {
+    usize::try_from(action).ok().filter(|a| *a < 3).ok_or_else(|| {
+        errors::value(format!(
+            "action {action} is not one of 0 (maintain), 1 (speed up), 2 (slow down)"
+        ))
+    })
+}
+
+/// The observation as a numpy array: int64 `(d, v, L, p)` or float32 kinematic values.
+fn observation<'py>(py: Python<'py>, obs: &Observation) -> Bound<'py, PyAny> {
+    match obs {
+        Observation::Discrete { state, .. } => {
+            PyArray1::from_slice(py, &[state.d as i64, state.v as i64, state.l as i64, state.p as i64]).into_any()
+        }
+        Observation::Kinematic(v) => PyArray1::from_slice(py, v).into_any(),
+    }
+}
+
+/// Light phase as a small integer: 0 green, 1 amber, 2 red.
+pub fn light_code(light: unforeseen_sim::LightPhase) -> i64 {
+    match light {
+        unforeseen_sim::LightPhase::Green => 0,
+        unforeseen_sim::LightPhase::Amber => 1,
+        unforeseen_sim::LightPhase::Red => 2,
+    }
+}
+
+/// The light's name as an interned Python string.
+fn light_str(py: Python<'_>, light: unforeseen_sim::LightPhase) -> &Bound<'_, PyString> {
+    match light {
+        unforeseen_sim::LightPhase::Green => intern!(py, "green"),
+        unforeseen_sim::LightPhase::Amber => intern!(py, "amber"),
+        unforeseen_sim::LightPhase::Red => intern!(py, "red"),
+    }
+}
+
+/// The info dict (documented on `UnforeseenEnv`).
+fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let state = |s: unforeseen_discretizer::State| (s.d as i64, s.v as i64, s.l as i64, s.p as i64);
+    d.set_item(intern!(py, "step"), info.step)?;
+    d.set_item(intern!(py, "collision"), info.events.collision)?;
+    d.set_item(intern!(py, "goal"), info.events.goal)?;
+    d.set_item(intern!(py, "timeout"), info.events.timeout)?;
+    d.set_item(intern!(py, "state"), state(info.state))?;
+    d.set_item(intern!(py, "observed"), state(info.observed))?;
+    d.set_item(intern!(py, "light"), light_str(py, info.light))?;
+    d.set_item(intern!(py, "light_code"), light_code(info.light))?;
+    d.set_item(intern!(py, "light_time_left"), info.light_time_left)?;
+    let terms = PyDict::new(py);
+    terms.set_item(intern!(py, "progress"), info.reward.progress)?;
+    terms.set_item(intern!(py, "time"), info.reward.time)?;
+    terms.set_item(intern!(py, "goal"), info.reward.goal)?;
+    terms.set_item(intern!(py, "crash"), info.reward.crash)?;
+    d.set_item(intern!(py, "reward_terms"), terms)?;
+    Ok(d)
+}
+
+/// One env of a map (`unforeseen._unforeseen.Env`; the Gymnasium class wraps it).
+#[pyclass(name = "Env", module = "unforeseen._unforeseen")]
+pub struct PyEnv {
+    env: Env,
+    key: u64,
+    episode: u64,
+}
+
+#[pymethods]
+impl PyEnv {
+    /// An env of `map` (file or embedded name) with map `overrides` (dict).
+    #[new]
+    #[pyo3(signature = (map, observation = "discrete", pedestrian_slots = 4, overrides = None))]
+    fn new(
+        map: &str,
+        observation: &str,
+        pedestrian_slots: usize,
+        overrides: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let form = observation_form(observation)?;
+        let map = crate::maps::load(map, overrides)?;
+        Ok(PyEnv {
+            env: new_env(&map, form, pedestrian_slots)?,
+            key: 0,
+            episode: 0,
+        })
+    }
+
+    /// The map's name.
+    #[getter]
+    fn map_name(&self) -> String {
+        self.env.map().name.clone()
+    }
+
+    /// The map as JSON (every field, in SI units).
+    #[getter]
+    fn map_json(&self) -> PyResult<String> {
+        serde_json::to_string(self.env.map()).map_err(errors::py)
+    }
+
+    /// "discrete" or "kinematic".
+    #[getter]
+    fn observation(&self) -> &'static str {
+        match self.env.config().observation {
+            ObservationForm::Discrete => "discrete",
+            ObservationForm::Kinematic => "kinematic",
+        }
+    }
+
+    /// Sizes of the discrete factors `[n_d, n_v, n_L, n_p]`.
+    #[getter]
+    fn factor_sizes(&self) -> Vec<usize> {
+        self.env.discretizer().factor_sizes().to_vec()
+    }
+
+    /// Length of the kinematic vector.
+    #[getter]
+    fn kinematic_len(&self) -> usize {
+        kinematic::len(self.env.config().pedestrian_slots)
+    }
+
+    /// `(low, high)` of the kinematic vector (float32 arrays; [`kinematic::bounds`]).
+    fn kinematic_bounds<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>) {
+        let (lo, hi) = kinematic::bounds(self.env.map(), self.env.config().pedestrian_slots);
+        (PyArray1::from_vec(py, lo), PyArray1::from_vec(py, hi))
+    }
+
+    /// Seconds per decision tick.
+    #[getter]
+    fn decision_dt(&self) -> f64 {
+        self.env.map().episode.decision_dt
+    }
+
+    /// Decision ticks before a time-out.
+    #[getter]
+    fn max_steps(&self) -> u32 {
+        self.env.map().episode.max_steps
+    }
+
+    /// Starts an episode with world seed `seed` exactly: `(observation, info)`.
+    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyTuple>> {
+        let (obs, info) = self.env.reset(seed);
+        (observation(py, &obs), info_dict(py, &info)?).into_pyobject(py)
+    }
+
+    /// Keys the episode stream (see the module docs); the next `reset_next` is episode 0.
+    fn set_stream(&mut self, key: u64) {
+        self.key = key;
+        self.episode = 0;
+    }
+
+    /// Starts the stream's next episode: `(observation, info)`.
+    fn reset_next<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let seed = stream_seed(self.key, self.episode);
+        self.episode += 1;
+        self.reset(py, seed)
+    }
+
+    /// The world seed the last `reset_next` used, if any.
+    #[getter]
+    fn stream_position(&self) -> (u64, u64) {
+        (self.key, self.episode)
+    }
+
+    /// One decision tick: `(observation, reward, terminated, truncated, info)`.
+    fn step<'py>(&mut self, py: Python<'py>, action: i64) -> PyResult<Bound<'py, PyTuple>> {
+        let step = self.env.step(action_index(action)?).map_err(errors::py)?;
+        (
+            observation(py, &step.observation),
+            step.reward,
+            step.terminated,
+            step.truncated,
+            info_dict(py, &step.info)?,
+        )
+            .into_pyobject(py)
+    }
+
+    /// Whether the episode ended (or none started).
+    #[getter]
+    fn done(&self) -> bool {
+        self.env.is_done()
+    }
+
+    /// The kinematic vector now, whatever the observation form.
+    fn kinematic<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        self.started()?;
+        let mut v = vec![0.0; self.kinematic_len()];
+        self.env.kinematic_into(&mut v);
+        Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// A top-down frame, uint8 `(height, width, 3)`, at `scale` pixels per metre.
+    #[pyo3(signature = (scale = 6.0))]
+    fn render_rgb<'py>(&self, py: Python<'py>, scale: f32) -> PyResult<Bound<'py, PyAny>> {
+        self.started()?;
+        if !(0.5..=50.0).contains(&scale) {
+            return Err(errors::value(format!(
+                "scale {scale}: expected 0.5..=50 pixels per metre"
+            )));
+        }
+        let (rgb, h, w) = render::frame(self.env.map(), self.env.snapshot(), scale);
+        Ok(PyArray1::from_vec(py, rgb).reshape([h, w, 3])?.into_any())
+    }
+
+    /// The frame as one line of text.
+    fn render_ansi(&self) -> PyResult<String> {
+        self.started()?;
+        Ok(render::ansi(self.env.map(), self.env.snapshot()))
+    }
+}
+
+impl PyEnv {
+    fn started(&self) -> PyResult<()> {
+        if self.env.info().is_none() {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "no episode yet: call reset() before render()",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Steps `steps` decision ticks of `map` in Rust alone, with the actions of `actions`
+/// in turn, starting a new episode (world seeds `stream_seed(seed, k)`) whenever one ends;
+/// the GIL is released; `overrides` as for `Env`. Returns `(ticks, seconds, episodes)`: the Rust loop's own speed,
+/// for the benches.
+#[pyfunction]
+#[pyo3(signature = (map, actions, steps, seed = 0, observation = "discrete", overrides = None))]
+pub fn rust_loop(
+    py: Python<'_>,
+    map: &str,
+    actions: Vec<i64>,
+    steps: u64,
+    seed: u64,
+    observation: &str,
+    overrides: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(u64, f64, u64)> {
+    let form = observation_form(observation)?;
+    let map = crate::maps::load(map, overrides)?;
+    let mut env = new_env(&map, form, 4)?;
+    let actions = actions.into_iter().map(action_index).collect::<PyResult<Vec<_>>>()?;
+    if actions.is_empty() {
+        return Err(errors::value("actions: give at least one action"));
+    }
+    py.detach(|| {
+        let started = std::time::Instant::now();
+        let mut episodes = 0;
+        env.reset(stream_seed(seed, 0));
+        for t in 0..steps {
+            let step = env.step(actions[t as usize % actions.len()]).map_err(errors::py)?;
+            std::hint::black_box(&step);
+            if step.terminated || step.truncated {
+                episodes += 1;
+                env.reset(stream_seed(seed, episodes));
+            }
+        }
+        Ok((steps, started.elapsed().as_secs_f64(), episodes))
+    })
+}
+
+/// Registers the env class and functions.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyEnv>()?;
+    m.add_function(wrap_pyfunction!(stream_seed, m)?)?;
+    m.add_function(wrap_pyfunction!(rust_loop, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,49 @@
+//! # unforeseen's Python extension (`unforeseen._unforeseen`)
+//!
+//! A thin layer over the Rust crates the command line uses: every number a Python caller
+//! sees (observations, rewards, events, decisions, evaluation figures) comes from them.
+//! The Python package `unforeseen` (python/unforeseen/) wraps these classes into
+//! Gymnasium environments; `_unforeseen.pyi` is the interface, class by class.
+//!
+//! * [`maps`]: a map by file or embedded name, with keyword overrides as a RON patch
+//!   validated by the map loader;
+//! * [`env`]: one episode API ([`unforeseen_env::Env`]) per Python object;
+//! * [`vector`]: many envs stepped in Rust threads with the GIL released;
+//! * [`render`]: the top-down frame (tiny-skia) and the text line;
+//! * [`agent`]: training, agent files, every method's controller, evaluation;
+//! * [`results`]: `compare` and `batch` as the JSON data their files hold;
+//! * [`errors`]: Rust errors as Python exceptions (`ValueError` for what the user can fix).
+
+mod agent;
+mod env;
+mod errors;
+mod maps;
+mod render;
+mod results;
+mod vector;
+
+use pyo3::prelude::*;
+
+/// Names of the maps embedded in the library (`intersection`, `jaywalk`, ...).
+#[pyfunction]
+fn embedded_maps() -> Vec<&'static str> {
+    unforeseen_sim::embedded::names().to_vec()
+}
+
+/// The version of the Rust crates this extension was built from.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+/// The extension module.
+#[pymodule]
+fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(embedded_maps, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    env::register(m)?;
+    vector::register(m)?;
+    agent::register(m)?;
+    results::register(m)?;
+    Ok(())
+}

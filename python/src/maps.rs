@@ -1,0 +1,140 @@
+//! Maps from Python: a file or embedded name ([`unforeseen::maps::load`], the command
+//! line's lookup) with keyword overrides (`max_steps=60`, `lane_width=3.0`,
+//! `episode__max_steps=60`). Overrides become a RON patch laid over the loaded map
+//! (`base:` the map itself) and go through the map loader, so a bad value fails with the
+//! loader's diagnostics (file, line and column or field, and a hint) like a map file.
+
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use unforeseen_sim::Map;
+
+use crate::errors;
+
+/// The base name the patch refers to.
+const BASE: &str = "<the map being overridden>";
+
+/// Loads `arg` (a map file or an embedded name) and applies `overrides`.
+pub fn load(arg: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Map> {
+    let map = unforeseen::maps::load(arg).map_err(errors::py)?;
+    match overrides {
+        Some(o) if !o.is_empty() => {
+            let mut fields = Vec::new();
+            for (k, v) in o.iter() {
+                let key: String = k.extract()?;
+                fields.push((key, ron_value(&v)?));
+            }
+            patch(&map, arg, &fields)
+        }
+        _ => Ok(map),
+    }
+}
+
+/// The sections of a map and their fields, from the map's own serialization (so new
+/// fields need no change here).
+fn sections() -> Vec<(String, Vec<String>)> {
+    let value = serde_json::to_value(Map::default()).unwrap_or_default();
+    let mut out = Vec::new();
+    if let Some(top) = value.as_object() {
+        for (section, v) in top {
+            if let Some(fields) = v.as_object() {
+                out.push((section.clone(), fields.keys().cloned().collect()));
+            }
+        }
+    }
+    out
+}
+
+/// `key` as `(section, field)`: `section__field`, or a field name that only one
+/// section has.
+fn locate(key: &str, sections: &[(String, Vec<String>)]) -> PyResult<(String, String)> {
+    let known = || {
+        sections
+            .iter()
+            .flat_map(|(s, fs)| fs.iter().map(move |f| format!("{s}__{f}")))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Some((s, f)) = key.split_once("__") {
+        if sections.iter().any(|(sec, fs)| sec == s && fs.iter().any(|x| x == f)) {
+            return Ok((s.to_string(), f.to_string()));
+        }
+        return Err(errors::value(format!(
+            "map override {key}: no such field; known: {}",
+            known()
+        )));
+    }
+    let owners: Vec<&String> = sections
+        .iter()
+        .filter(|(_, fs)| fs.iter().any(|x| x == key))
+        .map(|(s, _)| s)
+        .collect();
+    match owners[..] {
+        [s] => Ok((s.clone(), key.to_string())),
+        [] => Err(errors::value(format!(
+            "map override {key}: no such field; known: {}",
+            known()
+        ))),
+        _ => Err(errors::value(format!(
+            "map override {key}: several sections have it ({}); write it as section__{key}",
+            owners.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
+        ))),
+    }
+}
+
+/// A Python value as RON text: bool, int, float, a list or tuple of them, or a string
+/// taken as RON text as written (e.g. `offset="Random"`).
+fn ron_value(v: &Bound<'_, PyAny>) -> PyResult<String> {
+    if v.is_instance_of::<PyBool>() {
+        Ok(if v.extract::<bool>()? { "true" } else { "false" }.into())
+    } else if v.is_instance_of::<PyInt>() {
+        Ok(v.extract::<i128>()?.to_string())
+    } else if v.is_instance_of::<PyFloat>() {
+        Ok(format!("{:?}", v.extract::<f64>()?))
+    } else if v.is_instance_of::<PyString>() {
+        v.extract::<String>()
+    } else if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let items = v.try_iter()?.map(|x| ron_value(&x?)).collect::<PyResult<Vec<_>>>()?;
+        Ok(format!("[{}]", items.join(", ")))
+    } else {
+        Err(errors::value(format!(
+            "map override value {v}: expected a bool, a number, a list of numbers or RON text"
+        )))
+    }
+}
+
+/// Lays `fields` (key, RON value) over `map` and validates the result with the loader.
+fn patch(map: &Map, arg: &str, fields: &[(String, String)]) -> PyResult<Map> {
+    let sections = sections();
+    let mut by_section: Vec<(String, Vec<String>)> = Vec::new();
+    for (key, value) in fields {
+        let (s, f) = locate(key, &sections)?;
+        let line = format!("{f}: {value}");
+        match by_section.iter_mut().find(|(x, _)| *x == s) {
+            Some((_, lines)) => lines.push(line),
+            None => by_section.push((s, vec![line])),
+        }
+    }
+    let quote = |s: &str| ron::to_string(s).unwrap_or_else(|_| format!("{s:?}"));
+    let mut text = format!(
+        "(\n    base: {},\n    name: {},\n    description: {},\n",
+        quote(BASE),
+        quote(&map.name),
+        quote(&map.description)
+    );
+    for (section, lines) in &by_section {
+        text.push_str(&format!("    {section}: (\n"));
+        for line in lines {
+            text.push_str(&format!("        {line},\n"));
+        }
+        text.push_str("    ),\n");
+    }
+    text.push_str(")\n");
+    let mut restated = map.clone();
+    restated.base = None;
+    let base = ron::to_string(&restated).map_err(|e| errors::value(format!("{arg}: cannot restate the map: {e}")))?;
+    let origin = format!("{arg} (overrides)");
+    Map::from_str_named(&origin, &text, &|b| {
+        (b == BASE).then(|| (arg.to_string(), base.clone()))
+    })
+    .map_err(errors::py)
+}

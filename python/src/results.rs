@@ -1,0 +1,208 @@
+//! `compare` and `batch` from Python, through the library functions the command line
+//! runs ([`unforeseen::study::run_study`], [`unforeseen::batch::run`]), returned as the
+//! JSON data their files hold (the caller `json.loads` it). Kept small: the library's
+//! signatures are being refactored, and this is the only glue that touches them.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use unforeseen::agents::Agent;
+use unforeseen::batch::{BatchConfig, Scenario};
+use unforeseen::cli::compare::CompareReport;
+use unforeseen::methods::Method;
+use unforeseen::protocol::Protocol;
+use unforeseen::study::{RewardPair, StudySetup};
+
+use crate::agent::{PyAgent, method, param_sets, protocol, scaled_params};
+use crate::errors;
+
+fn agents_of(agents: &Bound<'_, PyAny>) -> PyResult<Vec<Agent>> {
+    let list: Vec<PyRef<'_, PyAgent>> = if let Ok(one) = agents.extract::<PyRef<'_, PyAgent>>() {
+        vec![one]
+    } else {
+        agents
+            .extract()
+            .map_err(|_| errors::value("agents: expected an Agent or a list of Agents"))?
+    };
+    if list.is_empty() {
+        return Err(errors::value("agents: give at least one agent"));
+    }
+    Ok(list.iter().map(|a| Agent::from_bundle(a.bundle.clone())).collect())
+}
+
+fn protocols(names: Vec<String>) -> PyResult<Vec<Protocol>> {
+    names.iter().map(|n| protocol(n)).collect()
+}
+
+/// `unforeseen compare`: compare.json's data as JSON text (`columns` is null; the
+/// command line fills it with prose).
+#[pyfunction]
+#[pyo3(signature = (agents, train_map = "intersection", test_map = "jaywalk", episodes = 100, seed = 7, protocols = vec!["zero-shot".to_string(), "continual".to_string()], ablations = false, **params))]
+#[allow(clippy::too_many_arguments)]
+fn compare_json(
+    py: Python<'_>,
+    agents: &Bound<'_, PyAny>,
+    train_map: &str,
+    test_map: &str,
+    episodes: u64,
+    seed: u64,
+    protocols: Vec<String>,
+    ablations: bool,
+    params: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let agents = agents_of(agents)?;
+    let protocols = self::protocols(protocols)?;
+    let p = scaled_params(params)?;
+    let train = crate::maps::load(train_map, None)?;
+    let test = crate::maps::load(test_map, None)?;
+    let mut methods = Method::PAPER.to_vec();
+    if ablations {
+        methods.extend(Method::ABLATIONS);
+    }
+    let setup = StudySetup {
+        train_map: &train,
+        test_map: &test,
+        params: &p,
+        methods: &methods,
+        protocols: &protocols,
+        episodes,
+        seed,
+        quiet: true,
+    };
+    let tables = py
+        .detach(|| unforeseen::study::run_study(&setup, &agents))
+        .map_err(errors::to_py)?;
+    let report = CompareReport {
+        schema: 2,
+        protocols: protocols.clone(),
+        tables,
+        columns: serde_json::Value::Null,
+        paper: Method::PAPER
+            .iter()
+            .filter_map(|m| {
+                m.paper().map(|f| {
+                    serde_json::json!({"method": m.name(), "train_reward": f.train_reward, "test_reward": f.test_reward,
+                        "success_rate": f.success_rate, "collision_rate": null,
+                        "inference_rate_relative_to_bayes_rl": f.inference_rate})
+                })
+            })
+            .collect(),
+        train_map: train.name.clone(),
+        test_map: test.name.clone(),
+        reward: RewardPair::of(&train, &test),
+        seed,
+        train_seeds: agents.iter().map(|a| a.train_seed).collect(),
+        agent_file: None,
+        agent_cache: None,
+        train_episodes: agents.first().and_then(|a| a.train_episodes),
+        episodes,
+        action_selection: format!("{:?}", p.action_selection),
+        scaled_params: serde_json::to_value(&p).map_err(errors::py)?,
+    };
+    serde_json::to_string(&report).map_err(errors::py)
+}
+
+static RUN: AtomicU64 = AtomicU64::new(0);
+
+/// `unforeseen batch`: `{"lines": [...], "summary": [...]}` as JSON text, the result
+/// lines of the results file (after its `run` line) and the summary file's rows.
+/// `sweep` maps a `--set` key to a value or a list of values (their cross product).
+#[pyfunction]
+#[pyo3(signature = (maps, agents, episodes = 100, seed = 7, methods = None, protocols = vec!["zero-shot".to_string(), "continual".to_string()], sweep = None, jobs = 2))]
+#[allow(clippy::too_many_arguments)]
+fn batch_json(
+    py: Python<'_>,
+    maps: Vec<String>,
+    agents: &Bound<'_, PyAny>,
+    episodes: u64,
+    seed: u64,
+    methods: Option<Vec<String>>,
+    protocols: Vec<String>,
+    sweep: Option<&Bound<'_, PyDict>>,
+    jobs: usize,
+) -> PyResult<String> {
+    let agents = agents_of(agents)?;
+    let protocols = self::protocols(protocols)?;
+    let methods: Vec<Method> = match methods {
+        Some(names) => names.iter().map(|n| method(n)).collect::<PyResult<_>>()?,
+        None => Method::PAPER.iter().chain(&Method::REFERENCE).copied().collect(),
+    };
+    let names: Vec<String> = if maps.is_empty() {
+        unforeseen_sim::embedded::names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    } else {
+        maps
+    };
+    let scenarios = names
+        .iter()
+        .map(|n| {
+            Ok(Scenario {
+                map: crate::maps::load(n, None)?,
+                source: n.clone(),
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    // Sweep lists as `--set key=v1,v2`.
+    let sets = match sweep {
+        Some(d) => {
+            let flat = PyDict::new(d.py());
+            for (k, v) in d.iter() {
+                let joined = if let Ok(list) = v.cast::<PyList>() {
+                    list.iter()
+                        .map(|x| Ok(x.str()?.to_string()))
+                        .collect::<PyResult<Vec<_>>>()?
+                        .join(",")
+                } else {
+                    v.str()?.to_string()
+                };
+                flat.set_item(k, joined)?;
+            }
+            param_sets(Some(&flat))?
+        }
+        None => Vec::new(),
+    };
+    let params = unforeseen::batch::sweep(&sets).map_err(errors::py)?;
+    let axis: Vec<Option<u64>> = agents.iter().map(|a| a.train_seed).collect();
+    let identity = format!(
+        "python agents {}",
+        agents
+            .iter()
+            .map(|a| unforeseen::seeds::content_hash(a.bundle.to_ron_string().as_bytes()))
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    let cfg = BatchConfig {
+        agents: &agents,
+        train_seeds: &axis,
+        scenarios: &scenarios,
+        methods: &methods,
+        params: &params,
+        protocols: &protocols,
+        episodes,
+        seed,
+        jobs: jobs.clamp(1, 256),
+        shard: None,
+        agents_identity: identity,
+    };
+    let out: PathBuf = std::env::temp_dir().join(format!(
+        "unforeseen-python-batch-{}-{}.jsonl",
+        std::process::id(),
+        RUN.fetch_add(1, Ordering::Relaxed)
+    ));
+    let lines = py.detach(|| unforeseen::batch::run(&cfg, &out, false, true));
+    let _ = std::fs::remove_file(&out);
+    let lines = lines.map_err(errors::to_py)?;
+    let summary = unforeseen::batch::summarize(&lines);
+    serde_json::to_string(&serde_json::json!({"lines": lines, "summary": summary})).map_err(errors::py)
+}
+
+/// Registers the functions.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(compare_json, m)?)?;
+    m.add_function(wrap_pyfunction!(batch_json, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,86 @@
+"""Bad input raises ValueError with the command line's message, never a crash."""
+
+from __future__ import annotations
+
+import pytest
+
+import unforeseen
+
+
+def test_unknown_map_name():
+    with pytest.raises(ValueError, match=r"no_such_map: no such map file, and no embedded map of that name \(embedded maps: intersection"):
+        unforeseen.make_env("no_such_map")
+
+
+def test_broken_map_file_names_file_line_and_fix(tmp_path):
+    bad = tmp_path / "broken.ron"
+    bad.write_text('(\n    base: "jaywalk",\n    road: (lane_width: -3.0),\n)\n')
+    with pytest.raises(ValueError, match=r"broken.ron: road.lane_width: .*") as e:
+        unforeseen.make_env(str(bad))
+    syntax = tmp_path / "syntax.ron"
+    syntax.write_text('(\n    base: "jaywalk",\n    road: (lane_width: 3.0\n')
+    with pytest.raises(ValueError, match=r"syntax.ron:\d+:\d+: "):
+        unforeseen.make_env(str(syntax))
+    assert "lane_width" in str(e.value)
+
+
+def test_bad_action():
+    env = unforeseen.make_env("jaywalk")
+    env.reset(seed=0)
+    for bad in (3, -1, 99):
+        with pytest.raises(ValueError, match=rf"action {bad} is not one of 0 \(maintain\), 1 \(speed up\), 2 \(slow down\)"):
+            env.step(bad)
+    env.step(0)  # the env is unchanged and still runs
+
+
+def test_step_out_of_order():
+    env = unforeseen.make_env("jaywalk")
+    with pytest.raises(RuntimeError, match="before reset"):
+        env.step(0)
+
+
+def test_bad_parameters(agent):
+    with pytest.raises(ValueError, match="--set epsilon=abc: 'abc' is not a number"):
+        agent.controller("scaled", epsilon="abc")
+    with pytest.raises(ValueError, match="--set no_such: unknown parameter; known: omega"):
+        agent.controller("scaled", no_such=1)
+    with pytest.raises(ValueError, match="--set epsilon"):
+        agent.controller("scaled", epsilon=7.0)
+    with pytest.raises(ValueError, match="unknown method 'nope'; methods: q-learning"):
+        agent.controller("nope")
+    with pytest.raises(ValueError, match="observation"):
+        agent.controller("scaled").act(10_000)
+    with pytest.raises(ValueError, match="observation"):
+        unforeseen.make_env("jaywalk", observation="pixels")
+
+
+def test_bad_agent_file(tmp_path):
+    bad = tmp_path / "agent.ron"
+    bad.write_text("(not an agent)")
+    with pytest.raises(ValueError, match=r"agent.ron: .*retrain it with `unforeseen train --out"):
+        unforeseen.load_agent(str(bad))
+    with pytest.raises(ValueError, match="cannot read the agent file"):
+        unforeseen.load_agent(str(tmp_path / "missing.ron"))
+
+
+@pytest.mark.parametrize(
+    "call,message",
+    [
+        (lambda: unforeseen.make_env("jaywalk", offset="(((("), r"jaywalk \(overrides\):\d+:\d+: "),
+        (lambda: unforeseen.make_env("jaywalk", max_steps=10**12), "episode.max_steps"),
+        (lambda: unforeseen.make_env("jaywalk", lane_width=float("nan")), "road.lane_width: must be a finite number"),
+        (lambda: unforeseen.make_env("jaywalk", distance_edges=[60, 30]), "strictly increasing"),
+        (lambda: unforeseen.make_env("jaywalk", cycle=[]), "light.cycle"),
+        (lambda: unforeseen.make_env("jaywalk", pedestrian_slots=0), "pedestrian_slots: must be in 1..=100"),
+        (lambda: unforeseen.make_env("/dev/null"), "not a regular file"),
+        (lambda: unforeseen.VectorEnv("jaywalk", 2, num_threads=0), "num_threads 0"),
+        (lambda: unforeseen.train(episodes=0), "episodes 0"),
+        (lambda: unforeseen.scripted_controller("scaled"), "needs a trained agent"),
+        (lambda: unforeseen.evaluate_builtin("jaywalk", "scaled", episodes=2), "needs a trained agent"),
+        (lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=2, protocol="x"), "unknown protocol"),
+        (lambda: unforeseen.compare(agents=[]), "at least one agent"),
+    ],
+)
+def test_bad_input_raises_value_error_never_a_panic(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()

@@ -1,0 +1,108 @@
+"""The native vector env: make_vec, equivalence with single envs, threads, the GIL."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.vector import AutoresetMode
+
+import unforeseen
+
+
+def test_make_vec_returns_the_native_vector_env():
+    envs = gym.make_vec("unforeseen/Jaywalk-v0", num_envs=4, vectorization_mode="vector_entry_point")
+    assert isinstance(envs, unforeseen.VectorEnv)
+    assert isinstance(envs, gym.vector.VectorEnv)
+    assert envs.metadata["autoreset_mode"] == AutoresetMode.NEXT_STEP
+    obs, info = envs.reset(seed=0)
+    assert obs.shape == (4, 4) and obs in envs.observation_space
+    obs, rewards, terminated, truncated, info = envs.step(envs.action_space.sample())
+    assert rewards.shape == (4,) and terminated.dtype == np.bool_ and info["state"].shape == (4, 4)
+
+
+@pytest.mark.parametrize("observation", ["discrete", "kinematic"])
+def test_vector_env_equals_single_envs_step_for_step(observation):
+    n, seed, steps = 5, 11, 120
+    rng = np.random.default_rng(1)
+    actions = rng.integers(0, 3, size=(steps, n))
+    vec = unforeseen.VectorEnv("two_pedestrians", n, observation)
+    singles = [unforeseen.make_env("two_pedestrians", observation) for _ in range(n)]
+    vobs, _ = vec.reset(seed=seed)
+    sobs = [env.reset(seed=seed + i)[0] for i, env in enumerate(singles)]
+    np.testing.assert_array_equal(vobs, np.stack(sobs))
+    ended = [False] * n
+    resets = 0
+    for t in range(steps):
+        vobs, vrew, vterm, vtrunc, vinfo = vec.step(actions[t])
+        for i, env in enumerate(singles):
+            if ended[i]:  # NEXT_STEP autoreset: this step resets env i
+                obs, info = env.reset()
+                rew, term, trunc = 0.0, False, False
+                ended[i] = False
+                resets += 1
+            else:
+                obs, rew, term, trunc, info = env.step(int(actions[t, i]))
+                ended[i] = term or trunc
+            np.testing.assert_array_equal(vobs[i], obs)
+            assert (vrew[i], vterm[i], vtrunc[i]) == (rew, term, trunc)
+            assert tuple(vinfo["state"][i]) == info["state"]
+            assert vinfo["light"][i] == info["light"]
+            assert vinfo["reward_terms"]["progress"][i] == info["reward_terms"]["progress"]
+    assert resets > n  # several episodes each
+
+
+def test_results_do_not_depend_on_the_number_of_threads():
+    def run(threads):
+        vec = unforeseen.VectorEnv("jaywalk", 16, "kinematic", num_threads=threads)
+        out = [vec.reset(seed=3)[0]]
+        for t in range(60):
+            out.append(vec.step(np.full(16, t % 3))[0])
+        return np.stack(out)
+
+    np.testing.assert_array_equal(run(1), run(2))
+
+
+def test_a_python_thread_runs_while_a_large_vector_step_runs():
+    vec = unforeseen.VectorEnv("jaywalk", 512, num_threads=1)
+    vec.reset(seed=0)
+    actions = np.ones(512, dtype=np.int64)
+    ticks = 0
+    stop = threading.Event()
+
+    def count():
+        nonlocal ticks
+        while not stop.is_set():
+            ticks += 1
+            time.sleep(0.0005)
+
+    thread = threading.Thread(target=count)
+    started = time.perf_counter()
+    thread.start()
+    before = ticks
+    for _ in range(3):
+        vec.step(actions)
+    elapsed = time.perf_counter() - started
+    during = ticks - before
+    stop.set()
+    thread.join()
+    # Three steps of 512 envs take tens of milliseconds; with the GIL held the counter
+    # could not advance at all while Rust runs.
+    assert elapsed > 0.01
+    assert during >= 5, (during, elapsed)
+
+
+def test_bad_vector_input():
+    vec = unforeseen.VectorEnv("jaywalk", 3)
+    with pytest.raises(RuntimeError, match="before reset"):
+        vec.step(np.zeros(3))
+    vec.reset(seed=0)
+    with pytest.raises(ValueError, match="action 3"):
+        vec.step(np.array([0, 3, 1]))
+    with pytest.raises(ValueError, match="2 actions for 3 envs"):
+        vec.step(np.array([0, 1]))
+    with pytest.raises(ValueError, match="num_envs"):
+        unforeseen.VectorEnv("jaywalk", 0)

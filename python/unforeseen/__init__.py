@@ -1,0 +1,166 @@
+"""unforeseen: the intersection of *Active Inference as the Test-Time Scaling Law for
+Physical AI Agents* (a Rapier 2D world in Rust) as Gymnasium environments, with the
+paper's agents.
+
+Importing registers one Gymnasium id per embedded map (``unforeseen/Jaywalk-v0``,
+``unforeseen/Intersection-v0``, ...), each with a native vector entry point::
+
+    import gymnasium as gym, unforeseen
+    env = gym.make("unforeseen/Jaywalk-v0")
+    envs = gym.make_vec("unforeseen/Jaywalk-v0", num_envs=64, vectorization_mode="vector_entry_point")
+
+Every number comes from the Rust crates the ``unforeseen`` command line uses.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import gymnasium as gym
+
+from . import _unforeseen
+from ._unforeseen import Agent, Controller, embedded_maps, load_agent, scripted_controller, stream_seed
+from .envs import ACTIONS, LIGHTS, UnforeseenEnv
+from .vector import VectorEnv
+
+__version__ = _unforeseen.version()
+
+__all__ = [
+    "ACTIONS",
+    "LIGHTS",
+    "Agent",
+    "Controller",
+    "UnforeseenEnv",
+    "VectorEnv",
+    "batch",
+    "compare",
+    "embedded_maps",
+    "env_id",
+    "eval_seeds",
+    "evaluate_builtin",
+    "load_agent",
+    "make_env",
+    "rollout",
+    "scripted_controller",
+    "stream_seed",
+    "train",
+]
+
+
+def env_id(map_name: str) -> str:
+    """The Gymnasium id of an embedded map: ``jaywalk_late`` -> ``unforeseen/JaywalkLate-v0``."""
+    return "unforeseen/" + "".join(part.capitalize() for part in map_name.split("_")) + "-v0"
+
+
+def _register() -> None:
+    for name in embedded_maps():
+        id_ = env_id(name)
+        if id_ not in gym.registry:
+            gym.register(
+                id=id_,
+                entry_point="unforeseen.envs:UnforeseenEnv",
+                vector_entry_point="unforeseen.vector:VectorEnv",
+                kwargs={"map": name},
+            )
+
+
+_register()
+
+
+def make_env(
+    map: str = "jaywalk",
+    observation: str = "discrete",
+    render_mode: str | None = None,
+    **map_overrides: Any,
+) -> UnforeseenEnv:
+    """An env of ``map`` (embedded name or map file); keywords override map fields
+    (``max_steps=60``), checked by the map loader (a bad one raises ``ValueError``
+    with the loader's diagnostic)."""
+    return UnforeseenEnv(map, observation, render_mode, **map_overrides)
+
+
+def train(map: str = "intersection", episodes: int = 6000, seed: int = 7) -> Agent:
+    """Trains Q-learning, the world model and Bayesian RL on ``map`` (``unforeseen train``)."""
+    return _unforeseen.train(map, episodes, seed)
+
+
+def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int]:
+    """``(world, controller)`` seeds of evaluation episode ``episode`` (as ``unforeseen eval``)."""
+    return _unforeseen.eval_seeds(seed, map, method, episode)
+
+
+def evaluate_builtin(
+    map: str,
+    method: str = "scaled",
+    episodes: int = 100,
+    seed: int = 7,
+    agent: Agent | None = None,
+    protocol: str = "zero-shot",
+    **params: Any,
+) -> dict[str, Any]:
+    """``unforeseen eval`` run by the Rust library: eval.json's data (``aggregate`` and
+    the per-episode ``episodes``). ``params`` are the ``--set`` keys."""
+    return json.loads(_unforeseen.evaluate_json(map, method, episodes, seed, agent, protocol, **params))
+
+
+def rollout(
+    map: str,
+    method: str = "scaled",
+    episodes: int = 100,
+    seed: int = 7,
+    agent: Agent | None = None,
+    protocol: str = "zero-shot",
+    **params: Any,
+) -> list[dict[str, Any]]:
+    """The same evaluation as :func:`evaluate_builtin`, driven from Python: a loop over
+    :class:`UnforeseenEnv` and a :class:`Controller`, with the per-episode seeds of
+    ``unforeseen eval`` (:func:`eval_seeds`). Under ``zero-shot`` every episode gets a
+    fresh controller; under ``continual`` one controller learns across episodes.
+    Returns per episode ``ret``, ``success``, ``collision``, ``timeout``, ``ticks``,
+    ``reasoning_ticks`` and ``jaywalk_surprise`` (the fields of eval.json's episodes
+    that do not measure time)."""
+    env = UnforeseenEnv(map)
+
+    def make() -> Controller:
+        if agent is None:
+            return scripted_controller(method, map)
+        return agent.controller(method, **params)
+
+    controller = make()
+    results = []
+    for ep in range(episodes):
+        world, ctrl_seed = eval_seeds(seed, map, method, ep)
+        if protocol == "zero-shot" and ep > 0:
+            controller = make()
+        obs, info = env.reset(options={"world_seed": world})
+        controller.begin_episode(ctrl_seed)
+        r = {"ret": 0.0, "success": False, "collision": False, "timeout": False, "ticks": 0,
+             "reasoning_ticks": 0, "jaywalk_surprise": None}
+        while True:
+            action, decision = controller.act(obs)
+            r["reasoning_ticks"] += decision["reasoned"]
+            if r["jaywalk_surprise"] is None and info["state"][3] == 1 and info["state"][2] == 1:
+                r["jaywalk_surprise"] = decision["surprise"]
+            obs, reward, terminated, truncated, info = env.step(action)
+            r["ret"] += reward
+            r["ticks"] += 1
+            controller.observe(reward, obs, terminated, truncated)
+            if terminated or truncated:
+                r["collision"] = info["collision"]
+                r["success"] = info["goal"] and not info["collision"]
+                r["timeout"] = info["timeout"]
+                break
+        controller.end_episode()
+        results.append(r)
+    return results
+
+
+def compare(**kwargs: Any) -> dict[str, Any]:
+    """``unforeseen compare`` in the library: compare.json's data."""
+    return json.loads(_unforeseen.compare_json(**kwargs))
+
+
+def batch(*maps: str, **kwargs: Any) -> list[dict[str, Any]]:
+    """``unforeseen batch`` in the library: the results file's lines (dicts)."""
+    return json.loads(_unforeseen.batch_json(list(maps), **kwargs))

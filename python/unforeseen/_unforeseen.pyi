@@ -1,0 +1,170 @@
+"""The Rust extension of unforeseen (``unforeseen._unforeseen``).
+
+Python-facing classes live in :mod:`unforeseen` (``UnforeseenEnv``, ``VectorEnv``); this
+module is the thin Rust layer under them. Errors: ``ValueError`` for bad input (a map,
+an agent file, a parameter, an action), with the message the command line prints;
+``RuntimeError`` otherwise.
+"""
+
+from typing import Any, Sequence, final
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "Agent",
+    "Controller",
+    "Env",
+    "VectorEnv",
+    "compare_json",
+    "batch_json",
+    "embedded_maps",
+    "eval_seeds",
+    "evaluate_json",
+    "load_agent",
+    "rust_loop",
+    "scripted_controller",
+    "stream_seed",
+    "train",
+    "version",
+]
+
+Info = dict[str, Any]
+
+def version() -> str:
+    """The version of the Rust crates this extension was built from."""
+
+def embedded_maps() -> list[str]:
+    """Names of the embedded maps (``intersection``, ``jaywalk``, ...)."""
+
+def stream_seed(key: int, episode: int) -> int:
+    """World seed of episode ``episode`` of the episode stream keyed ``key``."""
+
+def rust_loop(
+    map: str,
+    actions: Sequence[int],
+    steps: int,
+    seed: int = 0,
+    observation: str = "discrete",
+    overrides: dict[str, Any] | None = None,
+) -> tuple[int, float, int]:
+    """Steps ``map`` ``steps`` ticks in Rust alone with ``actions`` in turn (GIL released):
+    ``(ticks, seconds, episodes)``."""
+
+@final
+class Env:
+    """One env of a map: ``unforeseen_env::Env``."""
+
+    def __init__(
+        self,
+        map: str,
+        observation: str = "discrete",
+        pedestrian_slots: int = 4,
+        overrides: dict[str, Any] | None = None,
+    ) -> None: ...
+    @property
+    def map_name(self) -> str: ...
+    @property
+    def map_json(self) -> str:
+        """The map as JSON (SI units)."""
+    @property
+    def observation(self) -> str: ...
+    @property
+    def factor_sizes(self) -> list[int]:
+        """``[n_d, n_v, n_L, n_p]``."""
+    @property
+    def kinematic_len(self) -> int: ...
+    def kinematic_bounds(self) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+    @property
+    def decision_dt(self) -> float: ...
+    @property
+    def max_steps(self) -> int: ...
+    @property
+    def done(self) -> bool: ...
+    @property
+    def stream_position(self) -> tuple[int, int]:
+        """``(key, episodes started)`` of the episode stream."""
+    def reset(self, seed: int) -> tuple[npt.NDArray[Any], Info]:
+        """Starts an episode with world seed ``seed`` exactly."""
+    def set_stream(self, key: int) -> None: ...
+    def reset_next(self) -> tuple[npt.NDArray[Any], Info]:
+        """Starts the next episode of the stream."""
+    def step(self, action: int) -> tuple[npt.NDArray[Any], float, bool, bool, Info]: ...
+    def kinematic(self) -> npt.NDArray[np.float32]: ...
+    def render_rgb(self, scale: float = 6.0) -> npt.NDArray[np.uint8]:
+        """Top-down frame, ``(height, width, 3)`` uint8."""
+    def render_ansi(self) -> str: ...
+
+@final
+class VectorEnv:
+    """``num_envs`` envs stepped in parallel in Rust (GIL released), NEXT_STEP autoreset."""
+
+    def __init__(
+        self,
+        map: str,
+        num_envs: int,
+        observation: str = "discrete",
+        pedestrian_slots: int = 4,
+        overrides: dict[str, Any] | None = None,
+        num_threads: int | None = None,
+    ) -> None: ...
+    @property
+    def num_envs(self) -> int: ...
+    @property
+    def obs_len(self) -> int: ...
+    def reset(self, keys: Sequence[int]) -> tuple[npt.NDArray[Any], dict[str, Any]]: ...
+    def step(
+        self, actions: npt.NDArray[np.int64]
+    ) -> tuple[
+        npt.NDArray[Any], npt.NDArray[np.float64], npt.NDArray[np.bool_], npt.NDArray[np.bool_], dict[str, Any]
+    ]: ...
+
+@final
+class Agent:
+    """A trained agent (Q-learning, the world model, Bayesian RL)."""
+
+    def save(self, path: str) -> None: ...
+    @property
+    def meta(self) -> dict[str, str]: ...
+    @property
+    def train_returns(self) -> list[float]: ...
+    @property
+    def factor_sizes(self) -> list[int]: ...
+    def controller(self, method: str = "scaled", **params: Any) -> Controller:
+        """A fresh controller of ``method`` (``q-learning``, ``bayes-rl``, ``scaled``, the
+        ablations, ``brake-on-pedestrian``, ``never-brake``); ``params`` are ``--set`` keys."""
+
+@final
+class Controller:
+    """One method's controller."""
+
+    @property
+    def name(self) -> str: ...
+    def begin_episode(self, seed: int) -> None: ...
+    def act(self, observation: int | Sequence[int] | npt.NDArray[np.int64]) -> tuple[int, dict[str, Any]]:
+        """``(action, decision)``; the decision has ``action``, ``reasoned``, ``surprise``,
+        ``theta``, ``policy``, ``psi`` and ``scaling_iters``."""
+    def observe(
+        self, reward: float, next_observation: int | Sequence[int] | npt.NDArray[np.int64], terminated: bool, truncated: bool
+    ) -> None: ...
+    def end_episode(self) -> None:
+        """Ends the episode; the scaled agent's test-time learning runs here."""
+
+def train(map: str = "intersection", episodes: int = 6000, seed: int = 7) -> Agent: ...
+def load_agent(path: str) -> Agent: ...
+def scripted_controller(method: str, map: str = "jaywalk") -> Controller: ...
+def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int]: ...
+def evaluate_json(
+    map: str,
+    method: str,
+    episodes: int,
+    seed: int = 7,
+    agent: Agent | None = None,
+    protocol: str = "zero-shot",
+    **params: Any,
+) -> str:
+    """eval.json's data as JSON text."""
+def compare_json(**kwargs: Any) -> str:
+    """compare.json's data as JSON text."""
+def batch_json(maps: Sequence[str], **kwargs: Any) -> str:
+    """A batch run's result lines as a JSON list."""

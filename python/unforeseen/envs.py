@@ -1,0 +1,167 @@
+"""Gymnasium environments of the unforeseen intersection (a Rapier 2D world in Rust)."""
+
+from __future__ import annotations
+
+from typing import Any, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from . import _unforeseen
+
+__all__ = ["UnforeseenEnv", "ACTIONS", "LIGHTS", "episode_key"]
+
+#: The three actions, by index.
+ACTIONS = ("maintain", "speed up", "slow down")
+#: Light phases by ``info["light_code"]``.
+LIGHTS = ("green", "amber", "red")
+
+
+def episode_key(np_random: np.random.Generator) -> int:
+    """Draws the 64-bit key of an episode stream from ``np_random`` (one full-range uint64)."""
+    return int(np_random.integers(0, 2**64, dtype=np.uint64))
+
+
+class UnforeseenEnv(gym.Env):
+    r"""A car approaching a signalised crosswalk, one decision tick at a time.
+
+    ## Description
+
+    The ego car drives along +x towards a destination line behind a crosswalk with a
+    traffic light; pedestrians cross as the map says (on red in ``intersection``, on
+    green in ``jaywalk``: the "unforeseen" event). Each step holds the chosen action
+    for ``episode.decision_dt`` seconds (1 s by default) of Rapier sub-steps. All of it
+    runs in Rust (``unforeseen_env::Env``, the loop the command line uses).
+
+    ## Action Space
+
+    ``Discrete(3)``, the longitudinal command held for one tick:
+
+    | Num | Action    | Effect                                                  |
+    |-----|-----------|---------------------------------------------------------|
+    | 0   | maintain  | keep the current speed                                  |
+    | 1   | speed up  | accelerate at ``vehicle.max_accel`` (3 m/s²) up to ``vehicle.max_speed`` (9 m/s) |
+    | 2   | slow down | brake at ``vehicle.max_brake`` (3 m/s²), never below 0 m/s |
+
+    ## Observation Space
+
+    ``observation="discrete"`` (default): ``MultiDiscrete([n_d, n_v, 2, 2])``, int64, the
+    paper's factors as the agent observes them (with the map's observation noise):
+
+    | Num | Factor | Meaning                                                              |
+    |-----|--------|----------------------------------------------------------------------|
+    | 0   | d      | distance to the destination bin (0 arrived, 1 within 30 m, 2 30–60 m, 3 beyond 60 m by default) |
+    | 1   | v      | speed bin (edges 1.5, 4.5, 7.5 m/s by default)                       |
+    | 2   | L      | light: 0 red or amber, 1 green                                       |
+    | 3   | p      | a pedestrian on the crosswalk: 0 no, 1 yes                           |
+
+    ``observation="kinematic"``: ``Box(low, high, (7 + 5·slots,), float32)`` with the bounds
+    of ``unforeseen_env::kinematic::bounds`` (the map's ranges plus a 1-unit margin):
+
+    | Index         | Value                                                      | Unit |
+    |---------------|------------------------------------------------------------|------|
+    | 0             | x of the car's front bumper                                | m    |
+    | 1             | the car's speed along +x                                   | m/s  |
+    | 2             | distance to the destination line (``goal_x - x``; <= 0 arrived) | m |
+    | 3, 4, 5       | light green, amber, red (one-hot)                          | 0/1  |
+    | 6             | time until the light changes                               | s    |
+    | 7+5k .. 11+5k | pedestrian slot k: present, x, y, vx, vy                   | 0/1, m, m, m/s, m/s |
+
+    Coordinates: x along the road, y across it (the car's lane at negative y). Slot k is
+    the k-th pedestrian in the world in order of appearance; empty slots are zeros.
+
+    ## Rewards
+
+    Per tick (the map's ``reward`` section): ``progress_per_metre`` × metres advanced
+    (0.5), minus ``step_cost`` (4.5), plus ``goal`` (50) on arrival, plus ``crash`` (-25)
+    on hitting a pedestrian. ``info["reward_terms"]`` gives the four terms.
+
+    ## Episode End
+
+    * ``terminated``: the car's front reached the destination, or it hit a pedestrian.
+    * ``truncated``: ``episode.max_steps`` ticks (40) passed without either (a time-out).
+
+    ## Info
+
+    ``step`` (ticks done), ``collision``, ``goal``, ``timeout`` (bools), ``state`` (the
+    true ``(d, v, L, p)``), ``observed`` (as observed), ``light`` (``"green"``,
+    ``"amber"``, ``"red"``), ``light_code`` (0, 1, 2), ``light_time_left`` (s),
+    ``reward_terms`` (``progress``, ``time``, ``goal``, ``crash``).
+
+    ## Seeding
+
+    ``reset(seed=s)`` seeds ``self.np_random`` (Gymnasium) and draws from it one uint64,
+    the key of the episode stream (:func:`episode_key`); the k-th episode since
+    (``k = 0`` for this reset, then one more per ``reset()``) has world seed
+    ``_unforeseen.stream_seed(key, k)`` (light offset, spawns, observation noise). So
+    ``reset(seed=s)`` and the ``reset()`` calls after it are reproducible.
+    ``reset(options={"world_seed": w})`` runs the episode with world seed ``w`` exactly
+    (what ``unforeseen eval`` uses per episode: :func:`unforeseen.eval_seeds`).
+
+    ## Arguments
+
+    ``map``: an embedded map name (``unforeseen.embedded_maps()``) or a map file;
+    ``observation``: ``"discrete"`` or ``"kinematic"``; ``render_mode``: ``None``,
+    ``"rgb_array"`` (a top-down uint8 frame drawn in Rust) or ``"ansi"`` (a text line);
+    ``pedestrian_slots`` (kinematic, default 4); any other keyword overrides a map field
+    (``max_steps=60``, ``lane_width=3.0``, ``reward__goal=40``; ``section__field`` when a
+    name is in several sections), checked by the map loader.
+    """
+
+    metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 1}
+
+    def __init__(
+        self,
+        map: str = "jaywalk",
+        observation: str = "discrete",
+        render_mode: str | None = None,
+        pedestrian_slots: int = 4,
+        render_scale: float = 6.0,
+        **map_overrides: Any,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode {render_mode!r}: expected None or one of {self.metadata['render_modes']}"
+            )
+        self._env = _unforeseen.Env(map, observation, pedestrian_slots, map_overrides)
+        self.render_mode = render_mode
+        self._scale = float(render_scale)
+        self.metadata = {**type(self).metadata, "render_fps": 1.0 / self._env.decision_dt}
+        self.action_space = spaces.Discrete(3)
+        if observation == "discrete":
+            self.observation_space = spaces.MultiDiscrete(np.array(self._env.factor_sizes, dtype=np.int64))
+        else:
+            low, high = self._env.kinematic_bounds()
+            self.observation_space = spaces.Box(low, high, dtype=np.float32)
+        self._keyed = False
+
+    @property
+    def map_name(self) -> str:
+        """The map's name."""
+        return self._env.map_name
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        if options and "world_seed" in options:
+            return self._env.reset(int(options["world_seed"]))
+        if seed is not None or not self._keyed:
+            self._env.set_stream(episode_key(self.np_random))
+            self._keyed = True
+        return self._env.reset_next()
+
+    def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        return self._env.step(int(action))
+
+    def render(self) -> np.ndarray | str | None:
+        if self.render_mode == "rgb_array":
+            return self._env.render_rgb(self._scale)
+        if self.render_mode == "ansi":
+            return self._env.render_ansi()
+        return None
+
+    def kinematic(self) -> np.ndarray:
+        """The kinematic vector now, whatever the observation form."""
+        return self._env.kinematic()
