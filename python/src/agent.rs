@@ -6,10 +6,10 @@
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-use indicatif::ProgressBar;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
 use unforeseen::methods::Method;
+use unforeseen::progress::NoProgress;
 use unforeseen::protocol::Protocol;
 use unforeseen_agent::controller::{Controller, Decision, Ending};
 use unforeseen_agent::params::ScaledParams;
@@ -41,30 +41,45 @@ pub fn protocol(name: &str) -> PyResult<Protocol> {
         .map_err(|_| errors::value(format!("unknown protocol '{name}'; protocols: zero-shot, continual")))
 }
 
-/// Keyword parameters as `--set KEY=VALUE` strings (the one conversion to switch when
-/// the library takes typed values): `True`/`False` as `true`/`false`, anything else
-/// by `str()`.
-pub fn param_sets(params: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<String>> {
-    let mut sets = Vec::new();
+/// A keyword argument as the typed value the parameter table takes: a bool, a whole
+/// number or a float (`inf` as the table writes it).
+fn json_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
+    use serde_json::Value;
+    if v.is_instance_of::<PyBool>() {
+        return Ok(Value::Bool(v.extract()?));
+    }
+    if let Ok(i) = v.extract::<i64>() {
+        return Ok(Value::from(i));
+    }
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(serde_json::Number::from_f64(x).map_or_else(
+            || Value::String(if x > 0.0 { "inf".into() } else { x.to_string() }),
+            Value::Number,
+        ));
+    }
+    Err(errors::value(format!(
+        "{key}: expected a number, a bool or a string, got {}",
+        v.get_type().name()?
+    )))
+}
+
+/// The scaled agent's parameters: the defaults with the keyword arguments `params` set
+/// through the parameter table (the path `--set` takes, with its checks and messages).
+pub fn scaled_params(params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParams> {
+    let mut p = ScaledParams::default();
     if let Some(d) = params {
         for (k, v) in d.iter() {
             let key: String = k.extract()?;
-            let value = if v.is_instance_of::<PyBool>() {
-                if v.extract::<bool>()? { "true" } else { "false" }.to_string()
-            } else if v.is_none() {
-                return Err(errors::value(format!("--set {key}: None is not a value")));
+            // Text goes the way `--set KEY=TEXT` does (the same parsing and messages);
+            // numbers and bools as typed values.
+            if let Ok(text) = v.extract::<String>() {
+                unforeseen::overrides::set_one(&mut p, &key, &text).map_err(errors::py)?;
             } else {
-                v.str()?.to_string()
-            };
-            sets.push(format!("{key}={value}"));
+                unforeseen::overrides::set_value(&mut p, &key, json_value(&key, &v)?).map_err(errors::py)?;
+            }
         }
     }
-    Ok(sets)
-}
-
-/// The scaled agent's parameters: the defaults with `params` applied as `--set` does.
-pub fn scaled_params(params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParams> {
-    unforeseen::overrides::apply(ScaledParams::default(), &param_sets(params)?).map_err(errors::py)
+    unforeseen::overrides::apply(p, &[]).map_err(errors::py)
 }
 
 /// A trained agent (an agent file's content).
@@ -132,10 +147,7 @@ fn train(py: Python<'_>, map: &str, episodes: u64, seed: u64) -> PyResult<PyAgen
         )));
     }
     let map = crate::maps::load(map, None)?;
-    let cfg = unforeseen::training::TrainConfig {
-        quiet: true,
-        ..unforeseen::training::TrainConfig::new(episodes, seed)
-    };
+    let cfg = unforeseen::training::TrainConfig::new(episodes, seed);
     let (bundle, log) = py
         .detach(|| unforeseen::training::train(&map, &cfg))
         .map_err(errors::to_py)?;
@@ -322,7 +334,7 @@ fn evaluate_json(
             unforeseen::cli::MAX_EPISODES
         )));
     }
-    let bar = ProgressBar::hidden();
+    let bar = NoProgress;
     let results = match (m.is_scripted(), agent) {
         (true, _) => py.detach(|| unforeseen::experiments::evaluate_scripted(&map, m, episodes, seed, &bar)),
         (false, Some(a)) => {

@@ -8,30 +8,54 @@ use pyo3::PyErr;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use unforeseen_env::EnvError;
 
+type DynError = dyn std::error::Error + 'static;
+
 /// Whether `err` is bad input: exit code 2 on the command line, or an env input error.
-fn is_user_error(err: &anyhow::Error) -> bool {
-    unforeseen::cli::exit_code(err) == 2
-        || err.chain().any(|e| {
-            matches!(
-                e.downcast_ref::<EnvError>(),
-                Some(EnvError::BadAction { .. } | EnvError::Config { .. } | EnvError::Bins { .. })
-            )
-        })
+fn is_user_error(err: &DynError) -> bool {
+    if unforeseen::cli::exit_code(err) == 2 {
+        return true;
+    }
+    let mut cause = Some(err);
+    while let Some(e) = cause {
+        if matches!(
+            e.downcast_ref::<EnvError>(),
+            Some(EnvError::BadAction { .. } | EnvError::Config { .. } | EnvError::Bins { .. } | EnvError::Map(_))
+        ) {
+            return true;
+        }
+        cause = e.source();
+    }
+    false
+}
+
+/// The message the command line prints: the error and its causes, joined by `: `.
+fn message(err: &DynError) -> String {
+    let mut text = err.to_string();
+    let mut cause = err.source();
+    while let Some(e) = cause {
+        let more = e.to_string();
+        // Wrappers that print their cause (`#[error(transparent)]`, "{0}") add nothing.
+        if !text.ends_with(&more) {
+            text.push_str(": ");
+            text.push_str(&more);
+        }
+        cause = e.source();
+    }
+    text
 }
 
 /// The Python exception of `err`, with the message the command line prints.
-pub fn to_py(err: anyhow::Error) -> PyErr {
-    let message = format!("{err:#}");
+pub fn to_py<E: std::error::Error + 'static>(err: E) -> PyErr {
     if is_user_error(&err) {
-        PyValueError::new_err(message)
+        PyValueError::new_err(message(&err))
     } else {
-        PyRuntimeError::new_err(message)
+        PyRuntimeError::new_err(message(&err))
     }
 }
 
-/// [`to_py`] for any error type the command line knows.
-pub fn py<E: Into<anyhow::Error>>(err: E) -> PyErr {
-    to_py(err.into())
+/// [`to_py`] under the name the binding's call sites use for any library error.
+pub fn py<E: std::error::Error + 'static>(err: E) -> PyErr {
+    to_py(err)
 }
 
 /// A `ValueError` with `message`.

@@ -5,9 +5,10 @@
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
+use unforeseen::progress::NoProgress;
 
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyBool, PyDict, PyList};
 use unforeseen::agents::Agent;
 use unforeseen::batch::{BatchConfig, Scenario};
 use unforeseen::cli::compare::CompareReport;
@@ -15,7 +16,7 @@ use unforeseen::methods::Method;
 use unforeseen::protocol::Protocol;
 use unforeseen::study::{RewardPair, StudySetup};
 
-use crate::agent::{PyAgent, method, param_sets, protocol, scaled_params};
+use crate::agent::{PyAgent, method, protocol, scaled_params};
 use crate::errors;
 
 fn agents_of(agents: &Bound<'_, PyAny>) -> PyResult<Vec<Agent>> {
@@ -69,10 +70,9 @@ fn compare_json(
         protocols: &protocols,
         episodes,
         seed,
-        quiet: true,
     };
     let tables = py
-        .detach(|| unforeseen::study::run_study(&setup, &agents))
+        .detach(|| unforeseen::study::run_study(&setup, &agents, &NoProgress))
         .map_err(errors::to_py)?;
     let report = CompareReport {
         schema: 2,
@@ -98,7 +98,7 @@ fn compare_json(
         agent_cache: None,
         train_episodes: agents.first().and_then(|a| a.train_episodes),
         episodes,
-        action_selection: format!("{:?}", p.action_selection),
+        action_selection: format!("{:?}", p.scaling.action_selection),
         scaled_params: serde_json::to_value(&p).map_err(errors::py)?,
     };
     serde_json::to_string(&report).map_err(errors::py)
@@ -146,25 +146,28 @@ fn batch_json(
             })
         })
         .collect::<PyResult<Vec<_>>>()?;
-    // Sweep lists as `--set key=v1,v2`.
-    let sets = match sweep {
-        Some(d) => {
-            let flat = PyDict::new(d.py());
-            for (k, v) in d.iter() {
-                let joined = if let Ok(list) = v.cast::<PyList>() {
-                    list.iter()
-                        .map(|x| Ok(x.str()?.to_string()))
-                        .collect::<PyResult<Vec<_>>>()?
-                        .join(",")
-                } else {
-                    v.str()?.to_string()
-                };
-                flat.set_item(k, joined)?;
-            }
-            param_sets(Some(&flat))?
+    // Sweep lists as `--set key=v1,v2` (a sweep's points are labelled by that text).
+    let text = |x: &Bound<'_, PyAny>| -> PyResult<String> {
+        if x.is_instance_of::<PyBool>() {
+            Ok(if x.extract::<bool>()? { "true" } else { "false" }.to_string())
+        } else if x.is_none() {
+            Err(errors::value("sweep: None is not a value"))
+        } else {
+            Ok(x.str()?.to_string())
         }
-        None => Vec::new(),
     };
+    let mut sets = Vec::new();
+    if let Some(d) = sweep {
+        for (k, v) in d.iter() {
+            let key: String = k.extract()?;
+            let joined = if let Ok(list) = v.cast::<PyList>() {
+                list.iter().map(|x| text(&x)).collect::<PyResult<Vec<_>>>()?.join(",")
+            } else {
+                text(&v)?
+            };
+            sets.push(format!("{key}={joined}"));
+        }
+    }
     let params = unforeseen::batch::sweep(&sets).map_err(errors::py)?;
     let axis: Vec<Option<u64>> = agents.iter().map(|a| a.train_seed).collect();
     let identity = format!(
@@ -193,7 +196,7 @@ fn batch_json(
         std::process::id(),
         RUN.fetch_add(1, Ordering::Relaxed)
     ));
-    let lines = py.detach(|| unforeseen::batch::run(&cfg, &out, false, true));
+    let lines = py.detach(|| unforeseen::batch::run(&cfg, &out, false, &NoProgress));
     let _ = std::fs::remove_file(&out);
     let lines = lines.map_err(errors::to_py)?;
     let summary = unforeseen::batch::summarize(&lines);

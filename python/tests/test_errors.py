@@ -40,12 +40,22 @@ def test_step_out_of_order():
 
 
 def test_bad_parameters(agent):
-    with pytest.raises(ValueError, match="--set epsilon=abc: 'abc' is not a number"):
+    with pytest.raises(ValueError, match="--set epsilon=abc: parameter `epsilon` = abc is invalid: 'abc' is not a number; must be in \\[0, 1\\)"):
         agent.controller("scaled", epsilon="abc")
-    with pytest.raises(ValueError, match="--set no_such: unknown parameter; known: omega"):
+    with pytest.raises(ValueError, match="--set no_such: unknown parameter `no_such`; known: epsilon"):
         agent.controller("scaled", no_such=1)
     with pytest.raises(ValueError, match="--set epsilon"):
         agent.controller("scaled", epsilon=7.0)
+    with pytest.raises(ValueError, match="--set horizon"):
+        agent.controller("scaled", horizon=2.5)
+    with pytest.raises(ValueError, match="expected a number, a bool or a string"):
+        agent.controller("scaled", epsilon=[0.1])
+
+
+def test_typed_parameters_go_through_the_parameter_table(agent):
+    # Numbers, bools, inf and text all reach the same table as `--set`.
+    agent.controller("scaled", epsilon=0.3, horizon=4, learning=False, gate_memory=float("inf"))
+    agent.controller("scaled", scaling_mode="closed-form", epsilon="0.25")
     with pytest.raises(ValueError, match="unknown method 'nope'; methods: q-learning"):
         agent.controller("nope")
     with pytest.raises(ValueError, match="observation"):

@@ -328,7 +328,7 @@ impl Default for SpawnRule {
 #[serde(deny_unknown_fields)]
 pub struct Expectation {
     /// Which method, as written in the map (e.g. `"Scaled"`).
-    #[serde(deserialize_with = "names::identifier")]
+    #[serde(deserialize_with = "names::identifier", serialize_with = "names::write_identifier")]
     pub method: String,
     /// Lowest acceptable success rate, in [0, 1].
     #[serde(default)]
@@ -350,7 +350,11 @@ pub struct Expectation {
     pub max_inference_rate: Option<f64>,
     /// The evaluation protocol the bounds apply to, as written in the map (e.g.
     /// `"Continual"`); absent: every protocol the batch ran the method under.
-    #[serde(default, deserialize_with = "names::optional_identifier")]
+    #[serde(
+        default,
+        deserialize_with = "names::optional_identifier",
+        serialize_with = "names::write_optional_identifier"
+    )]
     pub protocol: Option<String>,
 }
 
@@ -422,6 +426,42 @@ mod names {
 
         fn visit_some<D: Deserializer<'de>>(self, d: D) -> Result<Option<String>, D::Error> {
             identifier(d).map(Some)
+        }
+    }
+
+    /// Writes a name as RON reads it back (a bare identifier: a unit variant, which JSON
+    /// writes as the plain string). Serde wants variant names `'static`: each distinct
+    /// name is kept once for the program's life (a map has a handful).
+    pub(super) fn write_identifier<S: serde::Serializer>(name: &str, s: S) -> Result<S::Ok, S::Error> {
+        use std::collections::BTreeSet;
+        use std::sync::Mutex;
+        static NAMES: Mutex<BTreeSet<&'static str>> = Mutex::new(BTreeSet::new());
+        let mut names = NAMES.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let name: &'static str = match names.get(name) {
+            Some(n) => n,
+            None => {
+                let n: &'static str = Box::leak(name.to_owned().into_boxed_str());
+                names.insert(n);
+                n
+            }
+        };
+        s.serialize_unit_variant("Name", 0, name)
+    }
+
+    /// [`write_identifier`] of an optional name (`None` as RON's and JSON's none).
+    pub(super) fn write_optional_identifier<S: serde::Serializer>(
+        name: &Option<String>,
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        struct Named<'a>(&'a str);
+        impl serde::Serialize for Named<'_> {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                write_identifier(self.0, s)
+            }
+        }
+        match name {
+            Some(n) => s.serialize_some(&Named(n)),
+            None => s.serialize_none(),
         }
     }
 
