@@ -55,6 +55,31 @@ def test_vector_env_equals_single_envs_step_for_step(observation):
     assert resets > n  # several episodes each
 
 
+@pytest.mark.parametrize("observation", ["discrete", "kinematic"])
+def test_vector_env_equals_gymnasiums_sync_vector_env(observation):
+    """Gymnasium's own vectorizer over the single envs is the reference: the same
+    observations, rewards, flags and autoreset (NEXT_STEP) step for step."""
+    n, steps = 4, 150
+    actions = np.random.default_rng(2).integers(0, 3, size=(steps, n))
+    ours = unforeseen.VectorEnv("jaywalk", n, observation)
+    ref = gym.vector.SyncVectorEnv(
+        [lambda: unforeseen.make_env("jaywalk", observation) for _ in range(n)],
+        autoreset_mode=AutoresetMode.NEXT_STEP,
+    )
+    assert ours.single_observation_space == ref.single_observation_space
+    assert ours.single_action_space == ref.single_action_space
+    assert ours.observation_space == ref.observation_space
+    o1, _ = ours.reset(seed=5)
+    o2, _ = ref.reset(seed=5)
+    np.testing.assert_array_equal(o1, o2)
+    for t in range(steps):
+        a = ours.step(actions[t])
+        b = ref.step(actions[t])
+        for x, y in zip(a[:4], b[:4]):
+            np.testing.assert_array_equal(x, y)
+    ref.close()
+
+
 def test_results_do_not_depend_on_the_number_of_threads():
     def run(threads):
         vec = unforeseen.VectorEnv("jaywalk", 16, "kinematic", num_threads=threads)
