@@ -85,8 +85,10 @@ pub fn bounds(map: &Map, slots: usize) -> (Vec<f32>, Vec<f32>) {
         longest_phase + m,
     ];
     for _ in 0..slots {
-        low.extend([0.0, ped_x_lo - m, -reach - m, 0.0, -ped_speed - m]);
-        high.extend([1.0, ped_x_hi + m, reach + m, 0.0, ped_speed + m]);
+        // vx is 0 on every shipped map (pedestrians walk straight across); its range is
+        // the walking speed's, like vy's, so the space stays valid for any direction.
+        low.extend([0.0, ped_x_lo - m, -reach - m, -ped_speed - m, -ped_speed - m]);
+        high.extend([1.0, ped_x_hi + m, reach + m, ped_speed + m, ped_speed + m]);
     }
     let f32s = |v: Vec<f64>| v.into_iter().map(|x| x as f32).collect();
     (f32s(low), f32s(high))
