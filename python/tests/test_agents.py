@@ -79,18 +79,23 @@ def cli_binary() -> Path | None:
     return max(built, key=lambda p: p.stat().st_mtime, default=None)
 
 
-def test_python_rollout_equals_the_command_line(agent_file, tmp_path):
+@pytest.mark.parametrize("map_name,protocol", [("jaywalk", "continual"), ("jaywalk", "zero-shot"), ("two_pedestrians", "continual")])
+def test_python_rollout_equals_the_command_line(agent_file, tmp_path, map_name, protocol):
     cli = cli_binary()
     if cli is None:
+        if os.environ.get("CI"):
+            pytest.fail("CI must build the unforeseen binary before the Python tests (cargo test does)")
         pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
     out = tmp_path / "eval"
     subprocess.run(
-        [str(cli), "eval", "--agent", str(agent_file), "--map", "jaywalk", "--method", "scaled",
-         "--episodes", "5", "--seed", "9", "--protocol", "continual", "--set", "horizon=3", "--quiet",
+        [str(cli), "eval", "--agent", str(agent_file), "--map", map_name, "--method", "scaled",
+         "--episodes", "5", "--seed", "9", "--protocol", protocol, "--set", "horizon=3", "--quiet",
          "--out", str(out)],
         check=True, capture_output=True,
     )
-    cli_eps = json.loads((out / "eval.json").read_text())["episodes"]
+    report = json.loads((out / "eval.json").read_text())
     agent = unforeseen.load_agent(str(agent_file))
-    py = unforeseen.rollout("jaywalk", "scaled", episodes=5, seed=9, agent=agent, protocol="continual", horizon=3)
-    assert [{k: e[k] for k in FIELDS} for e in cli_eps] == py
+    py = unforeseen.rollout(map_name, "scaled", episodes=5, seed=9, agent=agent, protocol=protocol, horizon=3)
+    assert [{k: e[k] for k in FIELDS} for e in report["episodes"]] == py
+    # The figures `eval` prints are the means of those episodes.
+    assert report["aggregate"]["success_rate"] == sum(e["success"] for e in py) / len(py)
