@@ -157,6 +157,48 @@ fn train(py: Python<'_>, map: &str, episodes: u64, seed: u64) -> PyResult<PyAgen
     })
 }
 
+/// Trains one agent per seed of `seeds` on `map`, in parallel (rayon, the GIL released),
+/// loading and saving them in the agent cache `cache` (`None`: no cache) as
+/// `--train-seeds` does, so a notebook and the command line share agents.
+#[pyfunction]
+#[pyo3(signature = (seeds, map = "intersection", episodes = 6000, cache = Some(PathBuf::from(unforeseen::agents::DEFAULT_CACHE)), timeout_as = "truncation"))]
+fn train_agents(
+    py: Python<'_>,
+    seeds: Vec<u64>,
+    map: &str,
+    episodes: u64,
+    cache: Option<PathBuf>,
+    timeout_as: &str,
+) -> PyResult<Vec<PyAgent>> {
+    if !(1..=unforeseen::cli::MAX_EPISODES).contains(&episodes) {
+        return Err(errors::value(format!(
+            "episodes {episodes}: expected 1..={}",
+            unforeseen::cli::MAX_EPISODES
+        )));
+    }
+    if seeds.is_empty() {
+        return Err(errors::value("seeds: give at least one training seed"));
+    }
+    let timeout_as = timeout_as
+        .parse()
+        .map_err(|e: String| errors::value(format!("timeout_as: {e}")))?;
+    let map = crate::maps::load(map, None)?;
+    let cfg = unforeseen::training::TrainConfig {
+        timeout_as,
+        ..unforeseen::training::TrainConfig::new(episodes, 0)
+    };
+    let agents = py
+        .detach(|| unforeseen::agents::train_agents(&map, &seeds, &cfg, cache.as_deref(), &NoProgress))
+        .map_err(errors::to_py)?;
+    Ok(agents
+        .into_iter()
+        .map(|a| PyAgent {
+            bundle: a.bundle,
+            returns: Vec::new(),
+        })
+        .collect())
+}
+
 /// Loads and checks an agent file (errors name the file, the field and the fix).
 #[pyfunction]
 fn load_agent(path: PathBuf) -> PyResult<PyAgent> {
@@ -368,6 +410,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyController>()?;
     m.add_function(wrap_pyfunction!(train, m)?)?;
     m.add_function(wrap_pyfunction!(load_agent, m)?)?;
+    m.add_function(wrap_pyfunction!(train_agents, m)?)?;
     m.add_function(wrap_pyfunction!(scripted_controller, m)?)?;
     m.add_function(wrap_pyfunction!(eval_seeds, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate_json, m)?)?;

@@ -20,7 +20,7 @@ from typing import Any
 import gymnasium as gym
 
 from . import _unforeseen
-from ._unforeseen import Agent, Controller, embedded_maps, load_agent, scripted_controller, stream_seed
+from ._unforeseen import Agent, Controller, embedded_maps, load_agent, scripted_controller, stream_seed, train_agents
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
 from .vector import VectorEnv
 
@@ -45,6 +45,7 @@ __all__ = [
     "scripted_controller",
     "stream_seed",
     "train",
+    "train_agents",
 ]
 
 
