@@ -174,7 +174,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let rows = summarize(&lines);
     print_summary(&rows);
     for warning in survivability_warnings(&scenarios, &lines) {
-        eprintln!("{warning}");
+        errln!("{warning}");
     }
     let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
     let failures = failures(&rows);
@@ -191,7 +191,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             "rows": rows,
         }),
     )?;
-    println!(
+    outln!(
         "wrote {} ({} lines) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
         args.out.display(),
         lines.len(),
@@ -201,7 +201,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     );
     if !failures.is_empty() {
         for f in &failures {
-            eprintln!("expectation failed: {f}");
+            errln!("expectation failed: {f}");
         }
         anyhow::bail!("{} expectation(s) failed", failures.len());
     }
@@ -244,7 +244,7 @@ fn print_summary(rows: &[SummaryRow]) {
         ]);
     }
     if many {
-        println!("each figure: mean ± half-width of the 95% interval over training seeds (Student t)");
+        outln!("each figure: mean ± half-width of the 95% interval over training seeds (Student t)");
     }
     print_grid(&grid);
 }

@@ -30,13 +30,13 @@ pub fn run(args: CheckMapArgs) -> anyhow::Result<()> {
     for file in &args.files {
         match crate::maps::load_file(file) {
             Ok(map) => {
-                println!("{}: ok\n{}\n", file.display(), map.summary());
+                outln!("{}: ok\n{}\n", file.display(), map.summary());
                 for warning in survivability::check(&map, args.survivability_episodes, args.seed)? {
-                    eprintln!("{}: {warning}\n", file.display());
+                    errln!("{}: {warning}\n", file.display());
                 }
             }
             Err(e) => {
-                eprintln!("{e}\n");
+                errln!("{e}\n");
                 bad += 1;
             }
         }

@@ -74,7 +74,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     };
     bars.finish();
     let agg = Aggregate::of(&results);
-    println!(
+    outln!(
         "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
         args.method,
         map.name,
@@ -107,7 +107,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
             "episodes": results,
         }),
     )?;
-    println!("wrote {}/eval.json", dir.display());
+    outln!("wrote {}/eval.json", dir.display());
     Ok(())
 }
 

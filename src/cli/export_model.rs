@@ -87,7 +87,7 @@ pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
     }
     super::warn_replacing_file(&args.out);
     write_json(&args.out, &exported)?;
-    println!(
+    outln!(
         "wrote {} ({} states, {} actions, horizon {}, gamma {})",
         args.out.display(),
         gm.n_states(),

@@ -15,6 +15,24 @@ use crate::progress::Progress;
 use crate::protocol::Protocol;
 use crate::training::{DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
 
+/// `println!` that never panics or stops the program when stdout's reader has gone (a
+/// closed pipe, `| head`): what is printed is a report of the work, and a closed report
+/// stream must not change what the program does or its exit code.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+/// `eprintln!` that never panics when stderr's reader has gone (see `outln!`).
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 pub mod batch;
 pub mod check_map;
 pub mod compare;
@@ -25,6 +43,7 @@ pub mod learn;
 pub mod params;
 pub mod plot_sweep;
 pub mod progress;
+pub mod signals;
 pub mod table;
 pub mod trace;
 pub mod train;
@@ -241,7 +260,7 @@ pub fn load_or_train(
 /// earlier run wrote.
 pub fn warn_replacing_file(path: &std::path::Path) {
     if path.is_file() {
-        eprintln!(
+        errln!(
             "warning: replacing {} from an earlier run (--out FILE writes elsewhere)",
             path.display()
         );
@@ -253,7 +272,7 @@ pub fn warn_replacing_file(path: &std::path::Path) {
 pub fn warn_replacing(dir: &std::path::Path, names: &[&str]) {
     let existing: Vec<&str> = names.iter().copied().filter(|n| dir.join(n).is_file()).collect();
     if !existing.is_empty() {
-        eprintln!(
+        errln!(
             "warning: replacing {} in {} from an earlier run (--out DIR writes them elsewhere)",
             existing.join(", "),
             dir.display()

@@ -175,7 +175,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         "x as named in the panel title (each point: mean over training seeds)",
         &panels,
     )?;
-    println!(
+    outln!(
         "wrote {} ({} panels over {} result lines)",
         args.out.display(),
         panels.len(),

@@ -61,7 +61,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     progress::phase(args.quiet, format_args!("writing {}", args.out.display()));
     super::warn_replacing_file(&args.out);
     crate::agent_file::save(&args.out, &bundle)?;
-    println!(
+    outln!(
         "trained on '{}' for {} episodes in {:.1} s (mean return of the last {} with exploration: {mean:.2}); wrote {}",
         map.name,
         args.episodes,
