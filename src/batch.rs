@@ -1119,6 +1119,12 @@ fn read_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
                 .filter(|f| f.extension().is_some_and(|x| x == "ron"))
                 .collect();
             found.sort();
+            if found.is_empty() {
+                return Err(Error::flag(
+                    p.display().to_string(),
+                    "a folder with no map files (*.ron): nothing to run; give map files or a folder of them",
+                ));
+            }
             for f in found {
                 scenarios.push(Scenario {
                     map: crate::maps::load_file(&f)?,

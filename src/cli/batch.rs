@@ -54,6 +54,10 @@ pub struct BatchArgs {
     /// differ): otherwise it is refused, saying what differs.
     #[arg(long)]
     pub resume: bool,
+    /// Replace --out even when it holds something other than a batch's results (a file
+    /// whose first line is not `{"run": ...}`); without it such a file is refused.
+    #[arg(long)]
+    pub force: bool,
     /// Run only shard I of N (1-based) of the canonical unit order.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<Shard>,
@@ -89,6 +93,11 @@ fn default_jobs() -> usize {
 /// Runs `batch`; fails (exit 1) when any expectation fails on the mean over seeds.
 pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let scenarios = load_scenarios(&args.maps)?;
+    let summary = summary_path(&args.out);
+    check_out(&args, &scenarios, &summary)?;
+    // One run at a time per results file: a second one would interleave its lines with
+    // this run's and lose them. The lock is released when the process ends.
+    let _lock = lock_results(&args.out)?;
     let methods = if args.methods.is_empty() {
         DEFAULT_METHODS.to_vec()
     } else {
@@ -170,6 +179,19 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             args.out.display()
         ),
     );
+    let total = plan.units.len();
+    if plan.shard.is_empty() {
+        errln!(
+            "note: shard {}/{} has no units (the run has {total}); writing a results file with none",
+            args.shard.map_or(1, |s| s.index),
+            args.shard.map_or(1, |s| s.count),
+        );
+    } else if plan.todo().is_empty() {
+        errln!(
+            "note: --resume: every unit of this run is in {} already",
+            args.out.display()
+        );
+    }
     let lines = run_plan(&cfg, &plan, &args.out, &Bars::new(args.quiet))?;
     let rows = summarize(&lines);
     print_summary(&rows);
@@ -178,7 +200,6 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     }
     let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
     let failures = failures(&rows);
-    let summary = summary_path(&args.out);
     write_json(
         &summary,
         &serde_json::json!({
@@ -206,6 +227,67 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         anyhow::bail!("{} expectation(s) failed", failures.len());
     }
     Ok(())
+}
+
+/// Checks `--out` and the summary beside it before any work: regular files (or not
+/// there yet) in a folder that can hold files, none of them an input (`--agent`, a map),
+/// and `--out` a batch's results file (first line `{"run": ...}`), empty, or missing,
+/// unless `--force`.
+fn check_out(args: &BatchArgs, scenarios: &[Scenario], summary: &std::path::Path) -> anyhow::Result<()> {
+    use super::outputs;
+    outputs::file("--out", &args.out)?;
+    outputs::file("--out (its summary)", summary)?;
+    let mut inputs: Vec<(&str, &std::path::Path)> = args.agent.iter().map(|p| ("--agent", p.as_path())).collect();
+    inputs.extend(scenarios.iter().map(|s| ("MAP", std::path::Path::new(&s.source))));
+    outputs::not_an_input("--out", &args.out, &inputs)?;
+    outputs::not_an_input("--out (its summary)", summary, &inputs)?;
+    if !args.force && !args.resume {
+        let mut head = Vec::new();
+        if let Ok(f) = std::fs::File::open(&args.out) {
+            use std::io::Read;
+            f.take(16)
+                .read_to_end(&mut head)
+                .map_err(|e| crate::error::Error::io("read", &args.out, e))?;
+        }
+        if !head.is_empty() && !head.starts_with(b"{\"run\":") {
+            return Err(crate::error::Error::flag(
+                format!("--out {}", args.out.display()),
+                "exists and is not a batch's results file (its first line is not {\"run\": ...}); \
+                 give another --out, or add --force to replace it",
+            )
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// Takes an advisory lock on `OUT.lock` beside the results file `out` (created if
+/// missing, left in place), or refuses a run while another holds it.
+fn lock_results(out: &std::path::Path) -> anyhow::Result<std::fs::File> {
+    let mut name = out.as_os_str().to_owned();
+    name.push(".lock");
+    let path = std::path::PathBuf::from(name);
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| crate::error::Error::io("create folder", dir, e))?;
+    }
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(|e| crate::error::Error::io("open the lock file", &path, e))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => Err(crate::error::Error::flag(
+            format!("--out {}", out.display()),
+            format!(
+                "another batch is writing this results file now (it holds {}); wait for it to finish, or give another --out",
+                path.display()
+            ),
+        )
+        .into()),
+        Err(std::fs::TryLockError::Error(e)) => Err(crate::error::Error::io("lock", &path, e).into()),
+    }
 }
 
 /// Prints one row per (scenario, method, parameters, protocol) over its training seeds.

@@ -122,6 +122,11 @@ pub struct CompareReport {
 
 /// Runs `compare`.
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
+    args.agent.check_out_dir(
+        &args.out,
+        &["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"],
+        &[&args.train_map, &args.test_map],
+    )?;
     let train_map = maps::load(&args.train_map)?;
     let test_map = maps::load(&args.test_map)?;
     let params = args.agent.params()?;

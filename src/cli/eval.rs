@@ -42,6 +42,7 @@ pub struct EvalArgs {
 
 /// Runs `eval`.
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
+    args.agent.check_out_dir(&args.out, &["eval.json"], &[&args.map])?;
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bars = Bars::new(args.agent.quiet);

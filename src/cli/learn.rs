@@ -30,6 +30,8 @@ pub struct LearnArgs {
 
 /// Runs `learn`.
 pub fn run(args: LearnArgs) -> anyhow::Result<()> {
+    args.agent
+        .check_out_dir(&args.out, &["learn.csv", "learn.json", "learn.svg"], &[&args.map])?;
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bundle = args.agent.bundle()?;

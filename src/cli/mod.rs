@@ -40,6 +40,7 @@ pub mod eval;
 pub mod export_model;
 pub mod inspect;
 pub mod learn;
+pub mod outputs;
 pub mod params;
 pub mod plot_sweep;
 pub mod progress;
@@ -200,6 +201,24 @@ impl AgentArgs {
     /// Loads the agent file, or trains one on `map` (file or embedded name).
     pub fn bundle_trained_on(&self, map: &str, episodes: u64) -> anyhow::Result<AgentBundle> {
         load_or_train(self.agent.as_deref(), map, episodes, self.seed, self.quiet)
+    }
+
+    /// The input files among these options (`--agent`), with their flags, for
+    /// [`outputs::not_an_input`].
+    pub fn inputs(&self) -> Vec<(&'static str, &std::path::Path)> {
+        self.agent.iter().map(|p| ("--agent", p.as_path())).collect()
+    }
+
+    /// Checks the output folder `dir` (`--out`) and the files `names` in it before any
+    /// work: none of them is an input (`--agent`, or the map files `maps`).
+    pub fn check_out_dir(&self, dir: &std::path::Path, names: &[&str], maps: &[&str]) -> anyhow::Result<()> {
+        outputs::dir("--out", dir)?;
+        let mut inputs = self.inputs();
+        inputs.extend(maps.iter().map(|m| ("--map", std::path::Path::new(*m))));
+        for n in names {
+            outputs::not_an_input("--out", &dir.join(n), &inputs)?;
+        }
+        Ok(())
     }
 
     /// The scaled agent's parameters with the `--set` overrides applied.

@@ -45,6 +45,8 @@ const COLORS: [RGBColor; 12] = [
 
 /// Runs `plot-sweep`.
 pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
+    super::outputs::file("--out", &args.out)?;
+    super::outputs::not_an_input("--out", &args.out, &[("RESULTS.jsonl", &args.results)])?;
     let lines = read_lines(&args.results)?;
     if lines.is_empty() {
         return Err(Error::Results {
