@@ -351,7 +351,8 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
         };
         for (i, p) in l.cycle.iter().enumerate() {
             let path = format!("light.cycle[{i}].duration");
-            if p.duration > 0.0 && p.duration < shortest {
+            if p.duration == 0.0 || (p.duration > 0.0 && p.duration < shortest) {
+                // 0 s too: a phase that never shows is as wrong as one shorter than a sub-step.
                 c.fail(
                     &path,
                     format!("{} s is shorter than one physics sub-step ({shortest} s)", p.duration),

@@ -81,7 +81,7 @@ pub struct BatchArgs {
 /// Parses `--jobs`: 1 to 256 worker threads.
 fn jobs(s: &str) -> Result<usize, String> {
     match s.trim().parse::<usize>() {
-        Ok(n) if (1..=256).contains(&n) => Ok(n),
+        Ok(n) if (1..=super::MAX_JOBS).contains(&n) => Ok(n),
         _ => Err(format!("'{s}': expected a number of worker threads from 1 to 256")),
     }
 }

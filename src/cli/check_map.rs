@@ -16,7 +16,7 @@ pub struct CheckMapArgs {
     /// Episodes of each scripted witness (brake-on-pedestrian, never-brake) on every
     /// map with pedestrian rules; warns when the map is not survivable or not
     /// dangerous. 0 disables the check.
-    #[arg(long, value_name = "N", default_value_t = survivability::DEFAULT_EPISODES)]
+    #[arg(long, value_name = "N", default_value_t = survivability::DEFAULT_EPISODES, value_parser = super::episodes_or_none)]
     pub survivability_episodes: u64,
     /// Run seed of the witnesses' episodes (the same episodes as `eval`/`batch --seed`).
     #[arg(long, default_value_t = 7)]

@@ -103,6 +103,7 @@ pub enum Command {
 
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    cap_rayon_threads();
     match cli
         .command
         .unwrap_or_else(|| Command::Compare(compare::CompareArgs::default()))
@@ -231,6 +232,30 @@ impl AgentArgs {
 /// here, and each episode keeps a result in memory; run more as shards or seeds.
 pub const MAX_EPISODES: u64 = 1_000_000;
 
+/// Parses an episode count that may be 0 (`check-map --survivability-episodes`, where 0
+/// turns the check off): a whole number in 0..=MAX_EPISODES.
+pub fn episodes_or_none(s: &str) -> Result<u64, String> {
+    if s == "0" { Ok(0) } else { episodes(s) }
+}
+
+/// Most worker threads: `--jobs` and `RAYON_NUM_THREADS` beyond it are capped.
+pub const MAX_JOBS: usize = 256;
+
+/// Caps `RAYON_NUM_THREADS` (which sizes the thread pools of every command but batch)
+/// at [`MAX_JOBS`], with a warning: a huge value spent minutes starting threads.
+/// Called before any pool is built; a value that is not a number is left to rayon.
+pub fn cap_rayon_threads() {
+    let Ok(v) = std::env::var("RAYON_NUM_THREADS") else {
+        return;
+    };
+    if let Ok(n) = v.trim().parse::<usize>()
+        && n > MAX_JOBS
+    {
+        errln!("warning: RAYON_NUM_THREADS={n} is more than {MAX_JOBS} worker threads; using {MAX_JOBS}");
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(MAX_JOBS).build_global();
+    }
+}
+
 /// Parses `--timeout-as`.
 pub fn timeout_as(s: &str) -> Result<crate::training::TimeoutAs, String> {
     s.parse()
@@ -238,7 +263,12 @@ pub fn timeout_as(s: &str) -> Result<crate::training::TimeoutAs, String> {
 
 /// Parses an episode count (`--episodes`, `--train-episodes`): a whole number in 1..=MAX_EPISODES.
 pub fn episodes(s: &str) -> Result<u64, String> {
-    match s.trim().parse::<u64>() {
+    if s.is_empty() || !s.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(format!(
+            "'{s}' is not a whole number of episodes (digits only, e.g. 100)"
+        ));
+    }
+    match s.parse::<u64>() {
         Ok(n) if (1..=MAX_EPISODES).contains(&n) => Ok(n),
         Ok(0) => Err("must be at least 1 (0 episodes would measure nothing)".into()),
         Ok(_) => Err(format!(
