@@ -201,6 +201,25 @@ mod tests {
     }
 
     #[test]
+    fn all_or_none_leaves_the_previous_set_when_one_write_fails() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a.csv");
+        std::fs::write(&a, "old").unwrap();
+        let bad = dir.path().join("taken");
+        std::fs::create_dir(&bad).unwrap();
+        let result = all_or_none(|| -> Result<(), Error> {
+            write_atomic(&a, b"new")?;
+            write_atomic(&bad, b"x")
+        });
+        assert!(result.is_err());
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+        all_or_none(|| write_atomic(&a, b"new")).unwrap();
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    #[test]
     fn a_refused_write_leaves_nothing_behind() {
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("out.csv");
