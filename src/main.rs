@@ -12,12 +12,22 @@ fn main() {
     unforeseen::cli::signals::install();
     let cli = Cli::parse();
     let code = match run(cli) {
-        Ok(()) => 0,
+        // What was printed is part of the result: a full disk under `> file` fails the run.
+        Ok(()) => match (std::io::stdout().flush(), unforeseen::cli::stream_failed()) {
+            (Err(e), _) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                let _ = writeln!(std::io::stderr(), "error: cannot write stdout: {e}");
+                1
+            }
+            (_, Some(why)) => {
+                let _ = writeln!(std::io::stderr(), "error: {why}");
+                1
+            }
+            _ => 0,
+        },
         Err(err) => {
             let _ = writeln!(std::io::stderr(), "error: {err:#}");
             exit_code(&*err)
         }
     };
-    let _ = std::io::stdout().flush();
     std::process::exit(code);
 }

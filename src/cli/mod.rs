@@ -18,10 +18,12 @@ use crate::training::{DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
 /// `println!` that never panics or stops the program when stdout's reader has gone (a
 /// closed pipe, `| head`): what is printed is a report of the work, and a closed report
 /// stream must not change what the program does or its exit code.
+/// Any other failure to write (a full disk under `> file`) is remembered
+/// ([`stream_failed`]) and fails the run at its end, naming the stream.
 macro_rules! outln {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
+        $crate::cli::wrote("stdout", writeln!(std::io::stdout(), $($arg)*));
     }};
 }
 
@@ -29,8 +31,28 @@ macro_rules! outln {
 macro_rules! errln {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = writeln!(std::io::stderr(), $($arg)*);
+        $crate::cli::wrote("stderr", writeln!(std::io::stderr(), $($arg)*));
     }};
+}
+
+/// The first failure to write stdout or stderr other than a closed pipe.
+static STREAM_FAILED: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// Records the outcome of a write to `stream` (`stdout`, `stderr`): a closed reader
+/// (EPIPE) is ignored, any other failure remembered for [`stream_failed`].
+pub fn wrote(stream: &str, result: std::io::Result<()>) {
+    if let Err(e) = result
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        let mut failed = STREAM_FAILED.lock().unwrap_or_else(|e| e.into_inner());
+        failed.get_or_insert_with(|| format!("cannot write {stream}: {e}"));
+    }
+}
+
+/// Why writing stdout or stderr failed (not a closed pipe: a full disk, an I/O error),
+/// if it did: `main` then fails a run that otherwise succeeded (exit 1).
+pub fn stream_failed() -> Option<String> {
+    STREAM_FAILED.lock().unwrap_or_else(|e| e.into_inner()).clone()
 }
 
 pub mod batch;
@@ -53,7 +75,8 @@ pub mod train_seeds;
 /// What each command writes by default (`--out` changes it), shown under `--help`.
 const OUTPUTS: &str = "\
 Outputs (default places; --out changes them; a rerun replaces them, with a warning,
-except batch, which replaces its results unless --resume completes them):
+except batch, which replaces its results unless --resume completes them, and refuses
+an --out that is not a results file unless --force; no output may be an input):
   compare       out/compare/: compare.json, compare.csv, compare_seeds.csv, compare.svg
                 (agents trained with --train-seeds are cached in out/agents/)
   train         agent.ron
