@@ -112,6 +112,13 @@ fn a_closed_pipe_changes_neither_the_work_nor_the_exit_code() {
     ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(results.is_file() && dir.path().join("r.summary.json").is_file());
+    // A full disk under stdout is not a closed pipe: the run fails, naming the stream.
+    let out = bin()
+        .args(["check-map", "maps/jaywalk.ron", "--survivability-episodes", "0"])
+        .stdout(std::fs::File::create("/dev/full").unwrap())
+        .output()
+        .unwrap();
+    assert_code(&out, 1, &["cannot write stdout"]);
     // eval: its report is written.
     let eval_dir = dir.path().join("eval");
     let out = closed_pipes(&[
@@ -357,7 +364,7 @@ fn map_validation_edges_of_issue_25() {
 fn sigint_leaves_no_temporary_file_and_exits_130() {
     let dir = tempfile::tempdir().unwrap();
     let t = dir.path().join("t.ron");
-    let mut child = bin()
+    let child = bin()
         .args(["train", "--episodes", "1000000", "-q", "--out"])
         .arg(&t)
         .stderr(Stdio::piped())
