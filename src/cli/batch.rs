@@ -95,9 +95,6 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let scenarios = load_scenarios(&args.maps)?;
     let summary = summary_path(&args.out);
     check_out(&args, &scenarios, &summary)?;
-    // One run at a time per results file: a second one would interleave its lines with
-    // this run's and lose them. The lock is released when the process ends.
-    let _lock = lock_results(&args.out)?;
     let methods = if args.methods.is_empty() {
         DEFAULT_METHODS.to_vec()
     } else {
@@ -106,6 +103,9 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let params = checked_sweep(&args.sweep)?;
     let protocols = args.protocol.protocols();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs.max(1)).build()?;
+    // One run at a time per results file: a second one would interleave its lines with
+    // this run's and lose them. The lock is released when the process ends.
+    let _lock = lock_results(&args.out)?;
     // Without --train-seeds, the one agent (loaded, or trained now) and what determines
     // it; with them, what determines the agents, trained once the plan says which the
     // units still to run need.
