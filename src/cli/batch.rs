@@ -161,8 +161,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             )
         })?,
     };
+    let states = agents.iter().map(|a| a.bundle.bayes_rl.n_states()).max().unwrap_or(0);
     let cfg = BatchConfig {
         agents: &agents,
+        jobs: memory_bound_jobs(args.jobs, states),
         ..planning
     };
     progress::phase(
@@ -174,7 +176,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             params.len(),
             protocols.len(),
             axis.len(),
-            args.jobs,
+            cfg.jobs,
             args.episodes,
             args.out.display()
         ),
@@ -227,6 +229,41 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         anyhow::bail!("{} expectation(s) failed", failures.len());
     }
     Ok(())
+}
+
+/// Bytes of one copy of an agent's learners with `states` joint states (the world model
+/// and Bayesian RL keep dense N x N matrices per action: about 370 bytes x N²).
+fn learner_bytes(states: usize) -> u64 {
+    370 * (states as u64).pow(2)
+}
+
+/// The memory the system says is available (`MemAvailable` of /proc/meminfo), if known.
+fn available_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// `jobs`, or fewer when that many workers' copies of the learners (each running episode
+/// learns on its own copy of its method's learner) would take more than half the memory
+/// available; says so on stderr. Results do not depend on the number of workers.
+fn memory_bound_jobs(jobs: usize, states: usize) -> usize {
+    let per = learner_bytes(states);
+    let Some(available) = available_bytes() else {
+        return jobs;
+    };
+    let fit = ((available / 2) / per.max(1)).max(1) as usize;
+    if jobs > fit {
+        errln!(
+            "warning: --jobs {jobs}: each worker holds its own copy of the agent's learners (about {} MB for {states} states) and {} MB are available; running {fit} worker(s)",
+            per >> 20,
+            available >> 20
+        );
+        fit
+    } else {
+        jobs
+    }
 }
 
 /// Checks `--out` and the summary beside it before any work: regular files (or not
@@ -393,4 +430,19 @@ fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<S
             .map(move |w| format!("{}: {w}", s.source))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jobs_are_bounded_by_the_memory_of_the_learners_copies() {
+        // 64 states (the embedded maps): 1.5 MB a copy, never a bound.
+        assert_eq!(memory_bound_jobs(16, 64), 16);
+        // A million states would be 370 TB a copy: one worker, where memory is known.
+        if available_bytes().is_some() {
+            assert_eq!(memory_bound_jobs(16, 1 << 20), 1);
+        }
+    }
 }
