@@ -352,6 +352,18 @@ fn map_validation_edges_of_issue_25() {
     assert!(top(depth).is_ok(), "{:?}", top(depth).err().map(|e| e.to_string()));
     let err = top(depth + 1).unwrap_err().to_string();
     assert!(err.contains("levels of base maps"), "{err}");
+    // A map whose Bayesian-RL episode would plan for minutes is refused (the issue's map).
+    let long = dir.path().join("long.ron");
+    std::fs::write(
+        &long,
+        "Map(light: (cycle: [(phase: Green, duration: 3600.0)]), episode: (max_steps: 100000, decision_dt: 0.05, physics_hz: 20.0))",
+    )
+    .unwrap();
+    let err = unforeseen_sim::Map::load(&long).unwrap_err().to_string();
+    assert!(
+        err.contains("episode.max_steps") && err.contains("at most 12207 ticks"),
+        "{err}"
+    );
     // A base that is a folder says so, as the same path given directly does.
     std::fs::create_dir(dir.path().join("folder.ron")).unwrap();
     let uses = dir.path().join("uses.ron");
