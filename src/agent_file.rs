@@ -37,7 +37,9 @@ fn bad(path: &Path, field: Option<String>, problem: impl Into<String>, fix: Stri
 pub fn load(path: &Path) -> Result<AgentBundle, Error> {
     let create = format!("create one with `unforeseen train --out {}`", path.display());
     if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
-        return Err(bad(path, None, "not a regular file", create));
+        // Never suggest writing an agent over a device, a folder or a pipe.
+        let give = "give the agent file `unforeseen train --out FILE` wrote (a regular file)".to_string();
+        return Err(bad(path, None, "not a regular file", give));
     }
     let mut bytes = Vec::new();
     std::fs::File::open(path)

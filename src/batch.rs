@@ -721,6 +721,9 @@ pub struct ResultsFile {
     pub identities: Vec<(usize, RunIdentity)>,
     /// Result lines.
     pub lines: Vec<KeptLine>,
+    /// The number of the last line when it was cut (no newline at the end: a killed
+    /// run or a full disk); it is not read.
+    pub cut_line: Option<usize>,
 }
 
 fn results_error(path: &Path, problem: String) -> Error {
@@ -731,7 +734,9 @@ fn results_error(path: &Path, problem: String) -> Error {
 }
 
 /// Reads the complete lines of a results file (a missing file has none; a truncated last
-/// line from a killed run is dropped, so that unit runs again).
+/// line from a killed run or a full disk is dropped, whatever byte it ends on, even
+/// inside a UTF-8 character, so that unit runs again: [`ResultsFile::cut_line`]). A
+/// complete line that is not UTF-8 text (a binary file) is refused.
 pub fn read_results(path: &Path) -> Result<ResultsFile, Error> {
     match std::fs::metadata(path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(ResultsFile::default()),
@@ -742,12 +747,22 @@ pub fn read_results(path: &Path) -> Result<ResultsFile, Error> {
         }
         _ => {}
     }
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io("read", path, e))?;
+    let bytes = std::fs::read(path).map_err(|e| Error::io("read", path, e))?;
     let mut file = ResultsFile::default();
-    for (i, raw) in text.split_inclusive('\n').enumerate() {
-        if !raw.ends_with('\n') {
-            break; // truncated by a kill: redo that unit
+    for (i, raw) in bytes.split_inclusive(|&b| b == b'\n').enumerate() {
+        if !raw.ends_with(b"\n") {
+            file.cut_line = Some(i + 1); // truncated by a kill or a full disk: redo that unit
+            break;
         }
+        let Ok(raw) = std::str::from_utf8(raw) else {
+            return Err(results_error(
+                path,
+                format!(
+                    "line {}: not text (invalid UTF-8): not a batch results file; give the results file `unforeseen batch` wrote",
+                    i + 1
+                ),
+            ));
+        };
         let body = raw.trim_end();
         if body.starts_with("{\"run\":") {
             let id: IdentityLine = serde_json::from_str(body).map_err(|e| {
@@ -823,6 +838,17 @@ pub fn resume_lines(
     let mut seen: BTreeSet<usize> = BTreeSet::new();
     for l in &file.lines {
         let unit = units.get(l.parsed.unit).filter(|u| u.key(scenarios) == l.parsed.key());
+        if let Some(u) = unit
+            && let Some(problem) = line_problem(&l.parsed, u, identity)
+        {
+            return Err(results_error(
+                out,
+                format!(
+                    "--resume: line {} (unit {}, {} {} {}) {problem}; {fix}",
+                    l.line, l.parsed.unit, l.parsed.scenario, l.parsed.method, l.parsed.param_set
+                ),
+            ));
+        }
         if unit.is_none() {
             return Err(results_error(
                 out,
@@ -843,6 +869,63 @@ pub fn resume_lines(
         }
     }
     Ok(file.lines)
+}
+
+/// Largest magnitude a figure of a result line may have (a return, ticks, µs per tick):
+/// far above what any map allows, far below what only a corrupt line holds.
+pub const MAX_FIGURE: f64 = 1e9;
+
+/// What is wrong with result line `l` as the line of unit `u` of the run `identity`: a
+/// field of its own that is not this run's (seed, episodes, parameters,
+/// protocols covered), or a figure out of its range (rates in [0, 1]; others finite,
+/// non-negative where they count, at most [`MAX_FIGURE`] in magnitude).
+fn line_problem(l: &ResultLine, u: &Unit, identity: &RunIdentity) -> Option<String> {
+    if l.seed != identity.seed {
+        return Some(format!("has seed {}, the run's header {}", l.seed, identity.seed));
+    }
+    if l.episodes != identity.episodes {
+        return Some(format!(
+            "has {} episodes, the run's header {}",
+            l.episodes, identity.episodes
+        ));
+    }
+    if l.params != u.params.0 {
+        return Some(format!(
+            "has parameters {:?}, the unit's are {:?}",
+            l.params, u.params.0
+        ));
+    }
+    if l.covers != u.covers {
+        return Some(format!("covers {:?}, the unit covers {:?}", l.covers, u.covers));
+    }
+    let rates = [
+        ("success_rate", l.success_rate),
+        ("collision_rate", l.collision_rate),
+        ("timeout_rate", l.timeout_rate),
+        ("inference_rate", l.inference_rate),
+    ];
+    for (name, x) in rates {
+        if !(0.0..=1.0).contains(&x) {
+            return Some(format!("has {name} {x}, outside [0, 1]"));
+        }
+    }
+    let counts = [
+        ("efe_matvecs_per_tick", l.efe_matvecs_per_tick),
+        ("mean_ticks", l.mean_ticks),
+        ("timing_us_per_tick", l.timing_us_per_tick),
+    ];
+    for (name, x) in counts {
+        if !(0.0..=MAX_FIGURE).contains(&x) {
+            return Some(format!("has {name} {x}, outside [0, {MAX_FIGURE:e}]"));
+        }
+    }
+    if !(l.mean_reward.is_finite() && l.mean_reward.abs() <= MAX_FIGURE) {
+        return Some(format!(
+            "has mean_reward {}, not a finite return within ±{MAX_FIGURE:e}",
+            l.mean_reward
+        ));
+    }
+    None
 }
 
 fn to_line(r: &ResultLine) -> String {
@@ -1119,6 +1202,12 @@ fn read_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
                 .filter(|f| f.extension().is_some_and(|x| x == "ron"))
                 .collect();
             found.sort();
+            if found.is_empty() {
+                return Err(Error::flag(
+                    p.display().to_string(),
+                    "a folder with no map files (*.ron): nothing to run; give map files or a folder of them",
+                ));
+            }
             for f in found {
                 scenarios.push(Scenario {
                     map: crate::maps::load_file(&f)?,

@@ -1,26 +1,33 @@
 //! The `unforeseen` command line; see `unforeseen --help`.
 
 use clap::Parser;
+use std::io::Write;
 use unforeseen::cli::{Cli, exit_code, run};
 
 fn main() {
-    // Rust ignores SIGPIPE, so printing into a closed pipe (`unforeseen check-map maps/ | head`)
-    // fails and `println!` panics; end quietly instead, as command-line tools do.
-    let default_hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        let payload = info.payload();
-        let message = (payload.downcast_ref::<String>().map(String::as_str))
-            .or_else(|| payload.downcast_ref::<&str>().copied())
-            .unwrap_or_default();
-        if message.contains("Broken pipe") {
-            std::process::exit(0);
-        }
-        default_hook(info);
-    }));
+    // Rust ignores SIGPIPE, so writing into a closed pipe (`unforeseen ... | head`) fails
+    // with EPIPE. The command line's prints ignore that (`outln!`/`errln!` in `cli`): a
+    // closed report stream never stops the work nor changes the exit code it earned.
     unforeseen::cli::progress::start_clock();
+    unforeseen::cli::signals::install();
     let cli = Cli::parse();
-    if let Err(err) = run(cli) {
-        eprintln!("error: {err:#}");
-        std::process::exit(exit_code(&*err));
-    }
+    let code = match run(cli) {
+        // What was printed is part of the result: a full disk under `> file` fails the run.
+        Ok(()) => match (std::io::stdout().flush(), unforeseen::cli::stream_failed()) {
+            (Err(e), _) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                let _ = writeln!(std::io::stderr(), "error: cannot write stdout: {e}");
+                1
+            }
+            (_, Some(why)) => {
+                let _ = writeln!(std::io::stderr(), "error: {why}");
+                1
+            }
+            _ => 0,
+        },
+        Err(err) => {
+            let _ = writeln!(std::io::stderr(), "error: {err:#}");
+            exit_code(&*err)
+        }
+    };
+    std::process::exit(code);
 }

@@ -1,10 +1,45 @@
 //! Writing results: atomically (temporary file, then rename), so a killed run never
 //! leaves a half-written file behind, and a failed write leaves no temporary file.
 
+use std::collections::BTreeSet;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::error::Error;
+
+/// The temporary files of writes under way, for [`remove_temporaries`].
+static TEMPORARIES: Mutex<BTreeSet<PathBuf>> = Mutex::new(BTreeSet::new());
+
+/// Removes the temporary files of the writes under way (the command line calls it on
+/// SIGINT/SIGTERM, which end the process without dropping them); later writes fail.
+pub fn remove_temporaries() {
+    let set = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+    for p in set.iter() {
+        let _ = std::fs::remove_file(p);
+    }
+    // Keep the lock: a writer that would create a temporary now waits until the exit.
+    std::mem::forget(set);
+}
+
+/// A temporary file registered in [`TEMPORARIES`] while it lives.
+struct Registered(PathBuf);
+
+impl Registered {
+    fn new(path: &Path) -> Self {
+        TEMPORARIES
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(path.to_path_buf());
+        Registered(path.to_path_buf())
+    }
+}
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner()).remove(&self.0);
+    }
+}
 
 /// Writes `bytes` to `path` through a temporary file in the same folder
 /// ([`tempfile::NamedTempFile`], removed if anything fails, a panic included) and a
@@ -26,9 +61,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
     let result = (|| -> std::io::Result<()> {
         let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+        let _registered = Registered::new(tmp.path());
         tmp.write_all(bytes)?;
         tmp.as_file().sync_all()?;
-        tmp.persist(path).map_err(|e| e.error)?;
+        let tmp = match STAGED.with_borrow_mut(|staged| match staged {
+            Some(list) => {
+                list.push((tmp, path.to_path_buf(), _registered));
+                None
+            }
+            None => Some((tmp, _registered)),
+        }) {
+            Some(t) => t,
+            None => return Ok(()), // renamed by `all_or_none`
+        };
+        tmp.0.persist(path).map_err(|e| e.error)?;
         // Make the rename durable (a folder can be opened and synced on Unix; elsewhere
         // this is best effort).
         if let Ok(d) = std::fs::File::open(dir) {
@@ -37,6 +83,39 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         Ok(())
     })();
     result.map_err(|e| Error::io("write", path, e))
+}
+
+/// A staged write: the temporary file, where it goes, its registration.
+type Staged = (tempfile::NamedTempFile, PathBuf, Registered);
+
+std::thread_local! {
+    /// The writes [`all_or_none`] holds back on this thread until its closure succeeds.
+    static STAGED: std::cell::RefCell<Option<Vec<Staged>>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `write` (which writes files with [`write_atomic`] on this thread) so that its
+/// files appear together: each is written to a temporary file first, and only when
+/// `write` succeeds are they all renamed into place; when it fails (a full disk) every
+/// temporary is removed and the previous files stay as they were, never a mix of old and
+/// new outputs.
+pub fn all_or_none<T, E: From<Error>>(write: impl FnOnce() -> Result<T, E>) -> Result<T, E> {
+    let outer = STAGED.with_borrow_mut(|s| s.replace(Vec::new()));
+    let result = write();
+    let staged = STAGED
+        .with_borrow_mut(|s| std::mem::replace(s, outer))
+        .unwrap_or_default();
+    let value = result?;
+    for (tmp, path, _registered) in staged {
+        tmp.persist(&path).map_err(|e| Error::io("write", &path, e.error))?;
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        if let Ok(d) = std::fs::File::open(dir) {
+            let _ = d.sync_all();
+        }
+    }
+    Ok(value)
 }
 
 /// Serializes `value` as pretty JSON to `path`, atomically.
@@ -119,6 +198,25 @@ mod tests {
             csv.to_text(),
             "a,b\n1,\"x,y\"\n\"say \"\"hi\"\"\",\"two\nlines\"\n,-0.5000\n"
         );
+    }
+
+    #[test]
+    fn all_or_none_leaves_the_previous_set_when_one_write_fails() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a.csv");
+        std::fs::write(&a, "old").unwrap();
+        let bad = dir.path().join("taken");
+        std::fs::create_dir(&bad).unwrap();
+        let result = all_or_none(|| -> Result<(), Error> {
+            write_atomic(&a, b"new")?;
+            write_atomic(&bad, b"x")
+        });
+        assert!(result.is_err());
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+        all_or_none(|| write_atomic(&a, b"new")).unwrap();
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 
     #[test]

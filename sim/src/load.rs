@@ -133,7 +133,15 @@ impl Map {
             if !including.starts_with(EMBEDDED_PREFIX) {
                 let dir = Path::new(including).parent().map(Path::to_path_buf).unwrap_or_default();
                 let candidates = [dir.join(base), dir.join(format!("{base}.ron"))];
-                if let Some(p) = candidates.iter().find(|p| p.is_file()) {
+                // A regular file, or else a `.ron` path that exists but is not one (a
+                // folder, a pipe, a device): read_text then says "not a regular file",
+                // as for the same path given directly, rather than "not found".
+                let found = (candidates.iter().find(|p| p.is_file())).or_else(|| {
+                    candidates
+                        .iter()
+                        .find(|p| p.extension().is_some_and(|x| x == "ron") && std::fs::metadata(p).is_ok())
+                });
+                if let Some(p) = found {
                     let origin = p.display().to_string();
                     return Some(Resolved {
                         text: read_text(p, &origin),
@@ -424,7 +432,9 @@ fn build(origin: &str, src: &str, resolve: &Resolver, chain: &mut Vec<String>) -
                     Some("remove the cycle of `base` fields".into()),
                 )));
             }
-            if chain.len() >= MAX_BASE_DEPTH {
+            // `chain` holds the top map and the bases read so far: this base would be
+            // the chain.len()-th; MAX_BASE_DEPTH of them are accepted.
+            if chain.len() > MAX_BASE_DEPTH {
                 return Err(MapError::one(Diagnostic::new(
                     origin,
                     "base",

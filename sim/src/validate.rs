@@ -17,6 +17,11 @@ pub const MAX_STEPS: u32 = 100_000;
 /// sub-step takes about 1.75 µs here, so an episode stays under about 0.35 s of
 /// physics (the default episode has 2400).
 pub const MAX_EPISODE_SUBSTEPS: f64 = 200_000.0;
+/// Most planning work per episode, `max_steps x (joint states)²`: Bayesian RL plans on
+/// dense N x N matrices every decision tick (about 740 µs a tick at the default 64
+/// states here), so an episode of it stays under about 10 s (max_steps ≤ 12207 at 64
+/// states, ≤ 47 at 1024; the default episode is 40 x 64² = 163840).
+pub const MAX_EPISODE_PLANNING: f64 = 5e7;
 /// Largest length / coordinate accepted, m.
 pub const MAX_METRES: f64 = 100_000.0;
 /// Most entries in any list (light phases, bin edges, expectations).
@@ -351,7 +356,8 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
         };
         for (i, p) in l.cycle.iter().enumerate() {
             let path = format!("light.cycle[{i}].duration");
-            if p.duration > 0.0 && p.duration < shortest {
+            if p.duration == 0.0 || (p.duration > 0.0 && p.duration < shortest) {
+                // 0 s too: a phase that never shows is as wrong as one shorter than a sub-step.
                 c.fail(
                     &path,
                     format!("{} s is shorter than one physics sub-step ({shortest} s)", p.duration),
@@ -522,6 +528,30 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
             ),
             "lower max_steps or physics_hz (60 Hz is plenty for road speeds)",
         );
+    }
+
+    // Planning cost per episode: ticks x N² (checked when both are valid).
+    let b = &map.bins;
+    if e.max_steps >= 1
+        && e.max_steps <= MAX_STEPS
+        && b.distance_edges.len() <= MAX_LIST
+        && b.speed_edges.len() <= MAX_LIST
+    {
+        let states = ((b.distance_edges.len() + 1) * (b.speed_edges.len() + 1) * 4) as f64;
+        let work = f64::from(e.max_steps) * states * states;
+        if states <= MAX_JOINT_STATES as f64 && work > MAX_EPISODE_PLANNING {
+            c.fail(
+                "episode.max_steps",
+                format!(
+                    "max_steps x (joint states)² = {} x {states}² = {work:.0} (at most {MAX_EPISODE_PLANNING:e}: Bayesian RL plans on N x N matrices every tick, so an episode would take minutes)",
+                    e.max_steps
+                ),
+                &format!(
+                    "at {states} states, at most {} ticks per episode: lower max_steps or use fewer bins",
+                    (MAX_EPISODE_PLANNING / (states * states)).floor()
+                ),
+            );
+        }
     }
 
     if map.expect.len() > MAX_LIST {

@@ -54,6 +54,10 @@ pub struct BatchArgs {
     /// differ): otherwise it is refused, saying what differs.
     #[arg(long)]
     pub resume: bool,
+    /// Replace --out even when it holds something other than a batch's results (a file
+    /// whose first line is not `{"run": ...}`); without it such a file is refused.
+    #[arg(long)]
+    pub force: bool,
     /// Run only shard I of N (1-based) of the canonical unit order.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<Shard>,
@@ -77,7 +81,7 @@ pub struct BatchArgs {
 /// Parses `--jobs`: 1 to 256 worker threads.
 fn jobs(s: &str) -> Result<usize, String> {
     match s.trim().parse::<usize>() {
-        Ok(n) if (1..=256).contains(&n) => Ok(n),
+        Ok(n) if (1..=super::MAX_JOBS).contains(&n) => Ok(n),
         _ => Err(format!("'{s}': expected a number of worker threads from 1 to 256")),
     }
 }
@@ -89,6 +93,8 @@ fn default_jobs() -> usize {
 /// Runs `batch`; fails (exit 1) when any expectation fails on the mean over seeds.
 pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let scenarios = load_scenarios(&args.maps)?;
+    let summary = summary_path(&args.out);
+    check_out(&args, &scenarios, &summary)?;
     let methods = if args.methods.is_empty() {
         DEFAULT_METHODS.to_vec()
     } else {
@@ -97,6 +103,9 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let params = checked_sweep(&args.sweep)?;
     let protocols = args.protocol.protocols();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs.max(1)).build()?;
+    // One run at a time per results file: a second one would interleave its lines with
+    // this run's and lose them. The lock is released when the process ends.
+    let _lock = lock_results(&args.out)?;
     // Without --train-seeds, the one agent (loaded, or trained now) and what determines
     // it; with them, what determines the agents, trained once the plan says which the
     // units still to run need.
@@ -152,8 +161,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             )
         })?,
     };
+    let states = agents.iter().map(|a| a.bundle.bayes_rl.n_states()).max().unwrap_or(0);
     let cfg = BatchConfig {
         agents: &agents,
+        jobs: memory_bound_jobs(args.jobs, states),
         ..planning
     };
     progress::phase(
@@ -165,20 +176,32 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             params.len(),
             protocols.len(),
             axis.len(),
-            args.jobs,
+            cfg.jobs,
             args.episodes,
             args.out.display()
         ),
     );
+    let total = plan.units.len();
+    if plan.shard.is_empty() {
+        errln!(
+            "note: shard {}/{} has no units (the run has {total}); writing a results file with none",
+            args.shard.map_or(1, |s| s.index),
+            args.shard.map_or(1, |s| s.count),
+        );
+    } else if plan.todo().is_empty() {
+        errln!(
+            "note: --resume: every unit of this run is in {} already",
+            args.out.display()
+        );
+    }
     let lines = run_plan(&cfg, &plan, &args.out, &Bars::new(args.quiet))?;
     let rows = summarize(&lines);
     print_summary(&rows);
     for warning in survivability_warnings(&scenarios, &lines) {
-        eprintln!("{warning}");
+        errln!("{warning}");
     }
     let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
     let failures = failures(&rows);
-    let summary = summary_path(&args.out);
     write_json(
         &summary,
         &serde_json::json!({
@@ -191,7 +214,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             "rows": rows,
         }),
     )?;
-    println!(
+    outln!(
         "wrote {} ({} lines) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
         args.out.display(),
         lines.len(),
@@ -201,11 +224,107 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     );
     if !failures.is_empty() {
         for f in &failures {
-            eprintln!("expectation failed: {f}");
+            errln!("expectation failed: {f}");
         }
         anyhow::bail!("{} expectation(s) failed", failures.len());
     }
     Ok(())
+}
+
+/// Bytes of one copy of an agent's learners with `states` joint states (the world model
+/// and Bayesian RL keep dense N x N matrices per action: about 370 bytes x N²).
+fn learner_bytes(states: usize) -> u64 {
+    370 * (states as u64).pow(2)
+}
+
+/// The memory the system says is available (`MemAvailable` of /proc/meminfo), if known.
+fn available_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// `jobs`, or fewer when that many workers' copies of the learners (each running episode
+/// learns on its own copy of its method's learner) would take more than half the memory
+/// available; says so on stderr. Results do not depend on the number of workers.
+fn memory_bound_jobs(jobs: usize, states: usize) -> usize {
+    let per = learner_bytes(states);
+    let Some(available) = available_bytes() else {
+        return jobs;
+    };
+    let fit = ((available / 2) / per.max(1)).max(1) as usize;
+    if jobs > fit {
+        errln!(
+            "warning: --jobs {jobs}: each worker holds its own copy of the agent's learners (about {} MB for {states} states) and {} MB are available; running {fit} worker(s)",
+            per >> 20,
+            available >> 20
+        );
+        fit
+    } else {
+        jobs
+    }
+}
+
+/// Checks `--out` and the summary beside it before any work: regular files (or not
+/// there yet) in a folder that can hold files, none of them an input (`--agent`, a map),
+/// and `--out` a batch's results file (first line `{"run": ...}`), empty, or missing,
+/// unless `--force`.
+fn check_out(args: &BatchArgs, scenarios: &[Scenario], summary: &std::path::Path) -> anyhow::Result<()> {
+    use super::outputs;
+    outputs::file("--out", &args.out)?;
+    outputs::file("--out (its summary)", summary)?;
+    let mut inputs: Vec<(&str, &std::path::Path)> = args.agent.iter().map(|p| ("--agent", p.as_path())).collect();
+    inputs.extend(scenarios.iter().map(|s| ("MAP", std::path::Path::new(&s.source))));
+    outputs::not_an_input("--out", &args.out, &inputs)?;
+    outputs::not_an_input("--out (its summary)", summary, &inputs)?;
+    if !args.force && !args.resume {
+        let mut head = Vec::new();
+        if let Ok(f) = std::fs::File::open(&args.out) {
+            use std::io::Read;
+            f.take(16)
+                .read_to_end(&mut head)
+                .map_err(|e| crate::error::Error::io("read", &args.out, e))?;
+        }
+        if !head.is_empty() && !head.starts_with(b"{\"run\":") {
+            return Err(crate::error::Error::flag(
+                format!("--out {}", args.out.display()),
+                "exists and is not a batch's results file (its first line is not {\"run\": ...}); \
+                 give another --out, or add --force to replace it",
+            )
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// Takes an advisory lock on `OUT.lock` beside the results file `out` (created if
+/// missing, left in place), or refuses a run while another holds it.
+fn lock_results(out: &std::path::Path) -> anyhow::Result<std::fs::File> {
+    let mut name = out.as_os_str().to_owned();
+    name.push(".lock");
+    let path = std::path::PathBuf::from(name);
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| crate::error::Error::io("create folder", dir, e))?;
+    }
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(|e| crate::error::Error::io("open the lock file", &path, e))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => Err(crate::error::Error::flag(
+            format!("--out {}", out.display()),
+            format!(
+                "another batch is writing this results file now (it holds {}); wait for it to finish, or give another --out",
+                path.display()
+            ),
+        )
+        .into()),
+        Err(std::fs::TryLockError::Error(e)) => Err(crate::error::Error::io("lock", &path, e).into()),
+    }
 }
 
 /// Prints one row per (scenario, method, parameters, protocol) over its training seeds.
@@ -244,7 +363,7 @@ fn print_summary(rows: &[SummaryRow]) {
         ]);
     }
     if many {
-        println!("each figure: mean ± half-width of the 95% interval over training seeds (Student t)");
+        outln!("each figure: mean ± half-width of the 95% interval over training seeds (Student t)");
     }
     print_grid(&grid);
 }
@@ -311,4 +430,19 @@ fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<S
             .map(move |w| format!("{}: {w}", s.source))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jobs_are_bounded_by_the_memory_of_the_learners_copies() {
+        // 64 states (the embedded maps): 1.5 MB a copy, never a bound.
+        assert_eq!(memory_bound_jobs(16, 64), 16);
+        // A million states would be 370 TB a copy: one worker, where memory is known.
+        if available_bytes().is_some() {
+            assert_eq!(memory_bound_jobs(16, 1 << 20), 1);
+        }
+    }
 }

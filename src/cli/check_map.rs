@@ -16,7 +16,7 @@ pub struct CheckMapArgs {
     /// Episodes of each scripted witness (brake-on-pedestrian, never-brake) on every
     /// map with pedestrian rules; warns when the map is not survivable or not
     /// dangerous. 0 disables the check.
-    #[arg(long, value_name = "N", default_value_t = survivability::DEFAULT_EPISODES)]
+    #[arg(long, value_name = "N", default_value_t = survivability::DEFAULT_EPISODES, value_parser = super::episodes_or_none)]
     pub survivability_episodes: u64,
     /// Run seed of the witnesses' episodes (the same episodes as `eval`/`batch --seed`).
     #[arg(long, default_value_t = 7)]
@@ -30,13 +30,13 @@ pub fn run(args: CheckMapArgs) -> anyhow::Result<()> {
     for file in &args.files {
         match crate::maps::load_file(file) {
             Ok(map) => {
-                println!("{}: ok\n{}\n", file.display(), map.summary());
+                outln!("{}: ok\n{}\n", file.display(), map.summary());
                 for warning in survivability::check(&map, args.survivability_episodes, args.seed)? {
-                    eprintln!("{}: {warning}\n", file.display());
+                    errln!("{}: {warning}\n", file.display());
                 }
             }
             Err(e) => {
-                eprintln!("{e}\n");
+                errln!("{e}\n");
                 bad += 1;
             }
         }

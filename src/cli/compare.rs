@@ -122,6 +122,11 @@ pub struct CompareReport {
 
 /// Runs `compare`.
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
+    args.agent.check_out_dir(
+        &args.out,
+        &["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"],
+        &[&args.train_map, &args.test_map],
+    )?;
     let train_map = maps::load(&args.train_map)?;
     let test_map = maps::load(&args.test_map)?;
     let params = args.agent.params()?;
@@ -179,12 +184,16 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let files = ["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"];
     warn_replacing(dir, &files);
     super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
-    write_json(&dir.join("compare.json"), &report)?;
-    let maps = (report.train_map.as_str(), report.test_map.as_str());
-    summary_csv(&report.tables, maps).write(&dir.join("compare.csv"))?;
-    seeds_csv(&report.tables, maps).write(&dir.join("compare_seeds.csv"))?;
-    plot(&dir.join("compare.svg"), &report.tables)?;
-    println!(
+    // All four or none: a failed write (a full disk) leaves the previous run's set.
+    crate::report::all_or_none(|| -> anyhow::Result<()> {
+        write_json(&dir.join("compare.json"), &report)?;
+        let maps = (report.train_map.as_str(), report.test_map.as_str());
+        summary_csv(&report.tables, maps).write(&dir.join("compare.csv"))?;
+        seeds_csv(&report.tables, maps).write(&dir.join("compare_seeds.csv"))?;
+        plot(&dir.join("compare.svg"), &report.tables)?;
+        Ok(())
+    })?;
+    outln!(
         "wrote {}/compare.json, compare.csv, compare_seeds.csv, compare.svg",
         dir.display()
     );
@@ -238,21 +247,22 @@ fn agents_line(m: &MethodSummary) -> String {
 fn print_table(table: &ProtocolTable, train_map: &Map, test_map: &Map) {
     let Some(first) = table.methods.first() else { return };
     let n = first.train_seeds.len();
-    println!();
-    println!("== {} protocol: {}", table.protocol, table.meaning);
-    println!("{}", agents_line(first));
-    println!(
+    outln!();
+    outln!("== {} protocol: {}", table.protocol, table.meaning);
+    outln!("{}", agents_line(first));
+    outln!(
         "train reward: on the training map '{}'; every other column: on the test map '{}'",
-        train_map.name, test_map.name
+        train_map.name,
+        test_map.name
     );
     let (train_reward, test_reward) = (rewards::describe(train_map), rewards::describe(test_map));
     if train_reward == test_reward {
-        println!("reward on both maps: {train_reward}");
+        outln!("reward on both maps: {train_reward}");
     } else {
-        println!("reward: training map {train_reward}; test map {test_reward}");
+        outln!("reward: training map {train_reward}; test map {test_reward}");
     }
     if n > 1 {
-        println!(
+        outln!(
             "each figure: mean ± half-width of the 95% interval over the {n} agents (Student t, {} df)",
             n - 1
         );
@@ -286,7 +296,7 @@ fn print_table(table: &ProtocolTable, train_map: &Map, test_map: &Map) {
     }
     print_grid(&rows);
     if table.protocol == Protocol::ZeroShot {
-        println!(
+        outln!(
             "(paper's values in parentheses, §VI; n/a: the paper gives no collision rate; its inference rate is relative, below)"
         );
     }
@@ -298,14 +308,14 @@ fn print_table(table: &ProtocolTable, train_map: &Map, test_map: &Map) {
         .collect();
     if !copied.is_empty() {
         let verb = if copied.len() == 1 { "does" } else { "do" };
-        println!(
+        outln!(
             "* {} {verb} not learn across episodes: identical under both protocols, run once ({}) and repeated here",
             copied.join(", "),
             Protocol::ZeroShot
         );
     }
     if let Some(rel) = &table.scaled_inference_relative_to_bayes_rl {
-        println!(
+        outln!(
             "scaled reasons on {} of the ticks Bayesian RL does (paper: 63.3%)",
             cell(rel, 1, true)
         );
@@ -335,7 +345,7 @@ fn maps_row(train_map: &str, test_map: &str, last: &str) -> Vec<String> {
 
 /// The range over agents of each figure and the worst seed (lowest test success).
 fn print_spread(table: &ProtocolTable, train_map: &str, test_map: &str) {
-    println!("over the agents: min .. max, and the worst seed (lowest test success; its success and test reward)");
+    outln!("over the agents: min .. max, and the worst seed (lowest test success; its success and test reward)");
     let mut rows = vec![header("worst seed"), maps_row(train_map, test_map, "")];
     for m in &table.methods {
         let w = &m.worst_seed;

@@ -42,6 +42,7 @@ pub struct EvalArgs {
 
 /// Runs `eval`.
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
+    args.agent.check_out_dir(&args.out, &["eval.json"], &[&args.map])?;
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bars = Bars::new(args.agent.quiet);
@@ -74,7 +75,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     };
     bars.finish();
     let agg = Aggregate::of(&results);
-    println!(
+    outln!(
         "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
         args.method,
         map.name,
@@ -107,7 +108,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
             "episodes": results,
         }),
     )?;
-    println!("wrote {}/eval.json", dir.display());
+    outln!("wrote {}/eval.json", dir.display());
     Ok(())
 }
 

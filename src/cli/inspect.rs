@@ -24,6 +24,6 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
         path: args.model.clone(),
         problem: e.to_string(),
     })?;
-    println!("{out}");
+    outln!("{out}");
     Ok(())
 }

@@ -30,6 +30,8 @@ pub struct LearnArgs {
 
 /// Runs `learn`.
 pub fn run(args: LearnArgs) -> anyhow::Result<()> {
+    args.agent
+        .check_out_dir(&args.out, &["learn.csv", "learn.json", "learn.svg"], &[&args.map])?;
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bundle = args.agent.bundle()?;
@@ -69,34 +71,37 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     }
     if let (Some(first), Some(last)) = (points.first(), points.last()) {
         let shown = |x: Option<f64>, unit: &str| x.map(|b| format!("{b:.2}{unit}")).unwrap_or_else(|| "n/a".into());
-        println!(
+        outln!(
             "test-time learning on '{}' over {} episodes, continual protocol (paper's Fig. 9 in parentheses):",
             map.name,
             points.len()
         );
-        println!(
+        outln!(
             "  surprise at the event           {} -> {}   (1.95 -> ~0.2 bits)",
             shown(first.event_surprise_bits, " bits"),
             shown(last.event_surprise_bits, " bits")
         );
-        println!(
+        outln!(
             "  P(p=1 | L=1, d=2)               {} -> {}   (0.25 -> 0.9)",
             shown(first.p_pedestrian_green_d2, ""),
             shown(last.p_pedestrian_green_d2, "")
         );
-        println!(
+        outln!(
             "  pi_o(slow down | event state)   {:.2} -> {:.2}   (0.3 -> 0.92)",
-            first.p_slow_down, last.p_slow_down
+            first.p_slow_down,
+            last.p_slow_down
         );
-        println!(
+        outln!(
             "  planner's P(p'=1 | p=1, L'=1, d'=2)  {:.2} -> {:.2}",
-            first.p_stay_green_d2, last.p_stay_green_d2
+            first.p_stay_green_d2,
+            last.p_stay_green_d2
         );
-        println!(
+        outln!(
             "  reasoning ticks per episode     {} -> {}",
-            first.reasoning_ticks, last.reasoning_ticks
+            first.reasoning_ticks,
+            last.reasoning_ticks
         );
-        println!(
+        outln!(
             "  successes                       {}/{}",
             points.iter().filter(|p| p.success).count(),
             points.len()
@@ -105,51 +110,55 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     let dir = &args.out;
     warn_replacing(dir, &["learn.csv", "learn.json", "learn.svg"]);
     super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
-    csv.write(&dir.join("learn.csv"))?;
-    write_json(&dir.join("learn.json"), &points)?;
-    let x = |f: &dyn Fn(&crate::experiments::LearnPoint) -> Option<f64>| -> Vec<(f64, f64)> {
-        points
-            .iter()
-            .filter_map(|p| f(p).map(|y| (p.episode as f64, y)))
-            .collect()
-    };
-    line_panels(
-        &dir.join("learn.svg"),
-        "episode of test-time learning",
-        &[
-            (
-                "(a) surprise at the event (bits)",
-                vec![Series {
-                    label: "gate's surprise at the first pedestrian on green",
-                    points: x(&|p| p.event_surprise_bits),
-                    color: RED,
-                }],
-            ),
-            (
-                "(b) pedestrian on green at d = 2",
-                vec![
-                    Series {
-                        label: "gate: P(p=1 | L=1, d=2)",
-                        points: x(&|p| p.p_pedestrian_green_d2),
+    // All three or none: a failed write (a full disk) leaves the previous run's set.
+    crate::report::all_or_none(|| -> anyhow::Result<()> {
+        csv.write(&dir.join("learn.csv"))?;
+        write_json(&dir.join("learn.json"), &points)?;
+        let x = |f: &dyn Fn(&crate::experiments::LearnPoint) -> Option<f64>| -> Vec<(f64, f64)> {
+            points
+                .iter()
+                .filter_map(|p| f(p).map(|y| (p.episode as f64, y)))
+                .collect()
+        };
+        line_panels(
+            &dir.join("learn.svg"),
+            "episode of test-time learning",
+            &[
+                (
+                    "(a) surprise at the event (bits)",
+                    vec![Series {
+                        label: "gate's surprise at the first pedestrian on green",
+                        points: x(&|p| p.event_surprise_bits),
+                        color: RED,
+                    }],
+                ),
+                (
+                    "(b) pedestrian on green at d = 2",
+                    vec![
+                        Series {
+                            label: "gate: P(p=1 | L=1, d=2)",
+                            points: x(&|p| p.p_pedestrian_green_d2),
+                            color: BLUE,
+                        },
+                        Series {
+                            label: "planner: P(p'=1 | p=1, L'=1, d'=2)",
+                            points: x(&|p| Some(p.p_stay_green_d2)),
+                            color: RGBColor(0, 150, 0),
+                        },
+                    ],
+                ),
+                (
+                    "(c) policy: pi_o(slow down | event state)",
+                    vec![Series {
+                        label: "P(slow down)",
+                        points: x(&|p| Some(p.p_slow_down)),
                         color: BLUE,
-                    },
-                    Series {
-                        label: "planner: P(p'=1 | p=1, L'=1, d'=2)",
-                        points: x(&|p| Some(p.p_stay_green_d2)),
-                        color: RGBColor(0, 150, 0),
-                    },
-                ],
-            ),
-            (
-                "(c) policy: pi_o(slow down | event state)",
-                vec![Series {
-                    label: "P(slow down)",
-                    points: x(&|p| Some(p.p_slow_down)),
-                    color: BLUE,
-                }],
-            ),
-        ],
-    )?;
-    println!("wrote {}/learn.csv, learn.json, learn.svg", dir.display());
+                    }],
+                ),
+            ],
+        )?;
+        Ok(())
+    })?;
+    outln!("wrote {}/learn.csv, learn.json, learn.svg", dir.display());
     Ok(())
 }

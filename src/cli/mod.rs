@@ -15,6 +15,46 @@ use crate::progress::Progress;
 use crate::protocol::Protocol;
 use crate::training::{DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
 
+/// `println!` that never panics or stops the program when stdout's reader has gone (a
+/// closed pipe, `| head`): what is printed is a report of the work, and a closed report
+/// stream must not change what the program does or its exit code.
+/// Any other failure to write (a full disk under `> file`) is remembered
+/// ([`stream_failed`]) and fails the run at its end, naming the stream.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        $crate::cli::wrote("stdout", writeln!(std::io::stdout(), $($arg)*));
+    }};
+}
+
+/// `eprintln!` that never panics when stderr's reader has gone (see `outln!`).
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        $crate::cli::wrote("stderr", writeln!(std::io::stderr(), $($arg)*));
+    }};
+}
+
+/// The first failure to write stdout or stderr other than a closed pipe.
+static STREAM_FAILED: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// Records the outcome of a write to `stream` (`stdout`, `stderr`): a closed reader
+/// (EPIPE) is ignored, any other failure remembered for [`stream_failed`].
+pub fn wrote(stream: &str, result: std::io::Result<()>) {
+    if let Err(e) = result
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        let mut failed = STREAM_FAILED.lock().unwrap_or_else(|e| e.into_inner());
+        failed.get_or_insert_with(|| format!("cannot write {stream}: {e}"));
+    }
+}
+
+/// Why writing stdout or stderr failed (not a closed pipe: a full disk, an I/O error),
+/// if it did: `main` then fails a run that otherwise succeeded (exit 1).
+pub fn stream_failed() -> Option<String> {
+    STREAM_FAILED.lock().unwrap_or_else(|e| e.into_inner()).clone()
+}
+
 pub mod batch;
 pub mod check_map;
 pub mod compare;
@@ -22,9 +62,11 @@ pub mod eval;
 pub mod export_model;
 pub mod inspect;
 pub mod learn;
+pub mod outputs;
 pub mod params;
 pub mod plot_sweep;
 pub mod progress;
+pub mod signals;
 pub mod table;
 pub mod trace;
 pub mod train;
@@ -33,7 +75,8 @@ pub mod train_seeds;
 /// What each command writes by default (`--out` changes it), shown under `--help`.
 const OUTPUTS: &str = "\
 Outputs (default places; --out changes them; a rerun replaces them, with a warning,
-except batch, which replaces its results unless --resume completes them):
+except batch, which replaces its results unless --resume completes them, and refuses
+an --out that is not a results file unless --force; no output may be an input):
   compare       out/compare/: compare.json, compare.csv, compare_seeds.csv, compare.svg
                 (agents trained with --train-seeds are cached in out/agents/)
   train         agent.ron
@@ -83,6 +126,7 @@ pub enum Command {
 
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    cap_rayon_threads();
     match cli
         .command
         .unwrap_or_else(|| Command::Compare(compare::CompareArgs::default()))
@@ -183,6 +227,24 @@ impl AgentArgs {
         load_or_train(self.agent.as_deref(), map, episodes, self.seed, self.quiet)
     }
 
+    /// The input files among these options (`--agent`), with their flags, for
+    /// [`outputs::not_an_input`].
+    pub fn inputs(&self) -> Vec<(&'static str, &std::path::Path)> {
+        self.agent.iter().map(|p| ("--agent", p.as_path())).collect()
+    }
+
+    /// Checks the output folder `dir` (`--out`) and the files `names` in it before any
+    /// work: none of them is an input (`--agent`, or the map files `maps`).
+    pub fn check_out_dir(&self, dir: &std::path::Path, names: &[&str], maps: &[&str]) -> anyhow::Result<()> {
+        outputs::dir("--out", dir)?;
+        let mut inputs = self.inputs();
+        inputs.extend(maps.iter().map(|m| ("--map", std::path::Path::new(*m))));
+        for n in names {
+            outputs::not_an_input("--out", &dir.join(n), &inputs)?;
+        }
+        Ok(())
+    }
+
     /// The scaled agent's parameters with the `--set` overrides applied.
     pub fn params(&self) -> anyhow::Result<ScaledParams> {
         Ok(params::apply(ScaledParams::default(), &self.set)?)
@@ -193,6 +255,30 @@ impl AgentArgs {
 /// here, and each episode keeps a result in memory; run more as shards or seeds.
 pub const MAX_EPISODES: u64 = 1_000_000;
 
+/// Parses an episode count that may be 0 (`check-map --survivability-episodes`, where 0
+/// turns the check off): a whole number in 0..=MAX_EPISODES.
+pub fn episodes_or_none(s: &str) -> Result<u64, String> {
+    if s == "0" { Ok(0) } else { episodes(s) }
+}
+
+/// Most worker threads: `--jobs` and `RAYON_NUM_THREADS` beyond it are capped.
+pub const MAX_JOBS: usize = 256;
+
+/// Caps `RAYON_NUM_THREADS` (which sizes the thread pools of every command but batch)
+/// at [`MAX_JOBS`], with a warning: a huge value spent minutes starting threads.
+/// Called before any pool is built; a value that is not a number is left to rayon.
+pub fn cap_rayon_threads() {
+    let Ok(v) = std::env::var("RAYON_NUM_THREADS") else {
+        return;
+    };
+    if let Ok(n) = v.trim().parse::<usize>()
+        && n > MAX_JOBS
+    {
+        errln!("warning: RAYON_NUM_THREADS={n} is more than {MAX_JOBS} worker threads; using {MAX_JOBS}");
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(MAX_JOBS).build_global();
+    }
+}
+
 /// Parses `--timeout-as`.
 pub fn timeout_as(s: &str) -> Result<crate::training::TimeoutAs, String> {
     s.parse()
@@ -200,7 +286,12 @@ pub fn timeout_as(s: &str) -> Result<crate::training::TimeoutAs, String> {
 
 /// Parses an episode count (`--episodes`, `--train-episodes`): a whole number in 1..=MAX_EPISODES.
 pub fn episodes(s: &str) -> Result<u64, String> {
-    match s.trim().parse::<u64>() {
+    if s.is_empty() || !s.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(format!(
+            "'{s}' is not a whole number of episodes (digits only, e.g. 100)"
+        ));
+    }
+    match s.parse::<u64>() {
         Ok(n) if (1..=MAX_EPISODES).contains(&n) => Ok(n),
         Ok(0) => Err("must be at least 1 (0 episodes would measure nothing)".into()),
         Ok(_) => Err(format!(
@@ -241,7 +332,7 @@ pub fn load_or_train(
 /// earlier run wrote.
 pub fn warn_replacing_file(path: &std::path::Path) {
     if path.is_file() {
-        eprintln!(
+        errln!(
             "warning: replacing {} from an earlier run (--out FILE writes elsewhere)",
             path.display()
         );
@@ -253,7 +344,7 @@ pub fn warn_replacing_file(path: &std::path::Path) {
 pub fn warn_replacing(dir: &std::path::Path, names: &[&str]) {
     let existing: Vec<&str> = names.iter().copied().filter(|n| dir.join(n).is_file()).collect();
     if !existing.is_empty() {
-        eprintln!(
+        errln!(
             "warning: replacing {} in {} from an earlier run (--out DIR writes them elsewhere)",
             existing.join(", "),
             dir.display()

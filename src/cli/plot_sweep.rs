@@ -6,7 +6,7 @@ use plotters::style::RGBColor;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use crate::batch::read_lines;
+use crate::batch::{ResultLine, read_results};
 use crate::error::Error;
 use crate::plots::{Series, line_panels};
 
@@ -43,9 +43,53 @@ const COLORS: [RGBColor; 12] = [
     RGBColor(187, 187, 187),
 ];
 
+/// The result lines of `path` for one plot: refuses a file holding two runs (two
+/// different `{"run": ...}` identity lines: concatenated results of different runs);
+/// says on stderr how many lines were cut (a last line without its newline, not read)
+/// and how many repeated a unit already read (left out, the first kept).
+fn checked_lines(path: &std::path::Path) -> Result<Vec<ResultLine>, Error> {
+    let file = read_results(path)?;
+    if let Some((first_line, first)) = file.identities.first()
+        && let Some((line, other)) = file.identities.iter().find(|(_, id)| id != first)
+    {
+        return Err(Error::Results {
+            path: path.to_path_buf(),
+            problem: format!(
+                "holds two runs (line {line} differs from line {first_line}: {}); plot each run's results file on its own",
+                other.differences(first).join("; ")
+            ),
+        });
+    }
+    if let Some(n) = file.cut_line {
+        errln!(
+            "warning: {}: line {n} is cut (no newline at its end: a killed run or a full disk?); left out",
+            path.display()
+        );
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    let mut lines = Vec::new();
+    let mut repeated = 0;
+    for l in file.lines {
+        if seen.insert((l.parsed.unit, l.parsed.key())) {
+            lines.push(l.parsed);
+        } else {
+            repeated += 1;
+        }
+    }
+    if repeated > 0 {
+        errln!(
+            "warning: {}: {repeated} line(s) repeat a unit read already (duplicated lines?); each unit is plotted once, from its first line",
+            path.display()
+        );
+    }
+    Ok(lines)
+}
+
 /// Runs `plot-sweep`.
 pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
-    let lines = read_lines(&args.results)?;
+    super::outputs::file("--out", &args.out)?;
+    super::outputs::not_an_input("--out", &args.out, &[("RESULTS.jsonl", &args.results)])?;
+    let lines = checked_lines(&args.results)?;
     if lines.is_empty() {
         return Err(Error::Results {
             path: args.results.clone(),
@@ -175,7 +219,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         "x as named in the panel title (each point: mean over training seeds)",
         &panels,
     )?;
-    println!(
+    outln!(
         "wrote {} ({} panels over {} result lines)",
         args.out.display(),
         panels.len(),

@@ -30,7 +30,7 @@ pub fn phase_lines(quiet: bool) -> bool {
 pub fn phase(quiet: bool, what: impl Display) {
     if phase_lines(quiet) {
         let t = START.get_or_init(Instant::now).elapsed().as_secs_f64();
-        eprintln!("[{t:>6.1} s] {what}");
+        errln!("[{t:>6.1} s] {what}");
     }
 }
 
@@ -110,9 +110,9 @@ impl Progress for Bars {
         match kind {
             Message::Status => phase(self.quiet, line),
             Message::Item if self.quiet => {}
-            Message::Item | Message::Warning if bar.is_hidden() => eprintln!("{line}"),
+            Message::Item | Message::Warning if bar.is_hidden() => errln!("{line}"),
             Message::Item => bar.println(line),
-            Message::Warning => bar.suspend(|| eprintln!("{line}")),
+            Message::Warning => bar.suspend(|| errln!("{line}")),
         }
     }
 }

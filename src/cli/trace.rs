@@ -49,6 +49,14 @@ fn mode(reasoned: bool) -> &'static str {
 
 /// Runs `trace`.
 pub fn run(args: TraceArgs) -> anyhow::Result<()> {
+    if let Some(html) = &args.html {
+        super::outputs::file("--html", html)?;
+        let mut inputs = args.agent.inputs();
+        inputs.push(("--map", std::path::Path::new(&args.map)));
+        super::outputs::not_an_input("--html", html, &inputs)?;
+    }
+    args.agent
+        .check_out_dir(&args.out, &["trace.csv", "theta.svg", "filmstrip.svg"], &[&args.map])?;
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bundle = args.agent.bundle()?;
@@ -63,14 +71,29 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     )?;
     let bits = |x: Option<f64>| x.map(|s| s / std::f64::consts::LN_2);
     let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
-    println!(
+    outln!(
         "{} on '{}', seed {}, episode {} ({})",
-        args.method, map.name, args.agent.seed, args.episode, args.protocol
+        args.method,
+        map.name,
+        args.agent.seed,
+        args.episode,
+        args.protocol
     );
     let dist = |x: &[f64]| x.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join("/");
-    println!(
+    outln!(
         "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}  {:<14} {:<14}",
-        "step", "d", "v", "L", "p", "action", "mode", "S(bits)", "theta", "reward", "policy", "psi"
+        "step",
+        "d",
+        "v",
+        "L",
+        "p",
+        "action",
+        "mode",
+        "S(bits)",
+        "theta",
+        "reward",
+        "policy",
+        "psi"
     );
     let mut csv = Csv::new(&[
         "step",
@@ -92,7 +115,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     let decided = &ticks[..ticks.len().saturating_sub(1)];
     for t in decided {
         let s = t.state;
-        println!(
+        outln!(
             "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8.2}  {:<14} {:<14}",
             t.step,
             s.d,
@@ -135,9 +158,11 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     } else {
         "ran out of time"
     };
-    println!(
+    outln!(
         "{outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
-        result.ticks, result.ret, result.reasoning_ticks
+        result.ticks,
+        result.ret,
+        result.reasoning_ticks
     );
     let dir = &args.out;
     warn_replacing(dir, &["trace.csv", "theta.svg", "filmstrip.svg"]);
@@ -162,7 +187,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         &map,
         &ticks,
     )?;
-    println!("wrote {}/trace.csv, theta.svg, filmstrip.svg", dir.display());
+    outln!("wrote {}/trace.csv, theta.svg, filmstrip.svg", dir.display());
     if let Some(html) = &args.html {
         let title = format!("{} on {}, seed {}", args.method, map.name, args.agent.seed);
         let outcome = format!(
@@ -171,7 +196,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         );
         let page = replay_html(&title, &outcome, &map, &ticks, params.gate.epsilon)?;
         write_atomic(html, page.as_bytes())?;
-        println!("wrote {} (open it in a browser)", html.display());
+        outln!("wrote {} (open it in a browser)", html.display());
     }
     Ok(())
 }

@@ -34,6 +34,8 @@ pub struct TrainArgs {
 
 /// Runs `train`.
 pub fn run(args: TrainArgs) -> anyhow::Result<()> {
+    super::outputs::file("--out", &args.out)?;
+    super::outputs::not_an_input("--out", &args.out, &[("--map", std::path::Path::new(&args.map))])?;
     let map = maps::load(&args.map)?;
     let cfg = TrainConfig {
         timeout_as: args.timeout_as,
@@ -61,7 +63,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     progress::phase(args.quiet, format_args!("writing {}", args.out.display()));
     super::warn_replacing_file(&args.out);
     crate::agent_file::save(&args.out, &bundle)?;
-    println!(
+    outln!(
         "trained on '{}' for {} episodes in {:.1} s (mean return of the last {} with exploration: {mean:.2}); wrote {}",
         map.name,
         args.episodes,

@@ -18,5 +18,6 @@ mod protocols;
 mod readme;
 mod reference;
 mod replay;
+mod robustness;
 mod svg_text;
 mod train_seeds;
