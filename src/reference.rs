@@ -8,7 +8,7 @@
 //!   jaywalk family must let it succeed (it is the witness that the map is survivable).
 //!   On a map with the red-light rule (`reward.red_light < 0`) it also stops for red
 //!   ([`RedLightStop`]): it slows down while L = 0 in the distance bin before the
-//!   crosswalk, and stays standing while L = 0 where it stands in a crosswalk bin.
+//!   crosswalk, and in a crosswalk bin while L = 0 at the lowest speeds (v <= 1).
 //! * [`NeverBrake`] (`never-brake`): always speeds up. It is the witness that a map is
 //!   dangerous: a car that drives on must be hit.
 //!
@@ -50,10 +50,12 @@ fn decision(action: Action) -> Decision {
 /// the discrete state, so it cannot tell where in a distance bin the car is: it brakes on
 /// L = 0 (amber or red) in the bin before the crosswalk, where braking still stops the
 /// car before the crosswalk's near edge (from 9 m/s with the default bins: 13.5 m from at
-/// least 30 m), and keeps standing on L = 0 when it already stands (v = 0) in a bin
-/// that overlaps the crosswalk. Moving in a crosswalk bin it drives on: there the car
-/// is either too close to stop or already on or past the crosswalk, where stopping
-/// would leave it standing in the pedestrians' way.
+/// least 30 m), and on L = 0 in a bin that overlaps the crosswalk when it stands or
+/// crawls (v <= 1: 0 or 3 m/s with the defaults, so one tick of braking stops it within
+/// 1.5 m; it gets there by braking in the bin before, e.g. 42 -> 34.5 -> 30 m). Faster
+/// in a crosswalk bin it drives on: there the car is either too close to stop or
+/// already on or past the crosswalk, where stopping would leave it standing in the
+/// pedestrians' way.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RedLightStop {
     /// The distance bin just before (farther from the goal than) the crosswalk's bins.
@@ -79,7 +81,7 @@ impl RedLightStop {
 
     /// Whether the rule says slow down at (d, v, L).
     fn stops(&self, d: usize, v: usize, l: usize) -> bool {
-        l == 0 && (self.approach == Some(d) || (v == 0 && self.crosswalk.contains(&d)))
+        l == 0 && (self.approach == Some(d) || (v <= 1 && self.crosswalk.contains(&d)))
     }
 }
 
@@ -263,7 +265,7 @@ mod tests {
         );
         for s in 0..disc().n_states() {
             let st = disc().decode(s);
-            let red = st.l == 0 && (st.d == 2 || (st.d == 1 && st.v == 0));
+            let red = st.l == 0 && (st.d == 2 || (st.d == 1 && st.v <= 1));
             let want = if (st.p == 1 && st.d >= 1) || red {
                 Action::SlowDown
             } else {
@@ -273,8 +275,9 @@ mod tests {
         }
         // The light turns amber or red at d = 2 at full speed: brake.
         assert_eq!(act(&mut c, 2, 3, 0, 0), Action::SlowDown);
-        // Standing before the crosswalk (d = 1) on red: keep standing; on green: go.
+        // Standing or crawling before the crosswalk (d = 1) on red: stop; on green: go.
         assert_eq!(act(&mut c, 1, 0, 0, 0), Action::SlowDown);
+        assert_eq!(act(&mut c, 1, 1, 0, 0), Action::SlowDown);
         assert_eq!(act(&mut c, 1, 0, 1, 0), Action::SpeedUp);
         // Moving in the crosswalk bin on red: too close to stop, drive on.
         assert_eq!(act(&mut c, 1, 2, 0, 0), Action::SpeedUp);
