@@ -326,6 +326,9 @@ pub struct ResultLine {
     pub collision_rate: f64,
     /// Time-out rate.
     pub timeout_rate: f64,
+    /// Red-light violations per episode (the car entering the crosswalk on red).
+    #[serde(default)]
+    pub red_light_rate: f64,
     /// Share of ticks that reasoned.
     pub inference_rate: f64,
     /// Reasoning compute in expected-free-energy mat-vecs per tick: inference rate times
@@ -581,6 +584,7 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error>
         success_rate: agg.success_rate,
         collision_rate: agg.collision_rate,
         timeout_rate: agg.timeout_rate,
+        red_light_rate: agg.red_light_rate,
         inference_rate: agg.inference_rate,
         efe_matvecs_per_tick: if plans_by_efe {
             agg.inference_rate * tree as f64
@@ -1053,6 +1057,8 @@ pub struct SummaryRow {
     pub collision_rate: Stat,
     /// Time-out rate, over seeds.
     pub timeout_rate: Stat,
+    /// Red-light violations per episode, over seeds.
+    pub red_light_rate: Stat,
     /// Share of ticks that reasoned, over seeds.
     pub inference_rate: Stat,
     /// EFE mat-vecs per tick, over seeds.
@@ -1111,6 +1117,7 @@ fn summary_row(group: &[&ResultLine]) -> SummaryRow {
         success_rate: stat(|l| l.success_rate),
         collision_rate: stat(|l| l.collision_rate),
         timeout_rate: stat(|l| l.timeout_rate),
+        red_light_rate: stat(|l| l.red_light_rate),
         inference_rate: stat(|l| l.inference_rate),
         efe_matvecs_per_tick: stat(|l| l.efe_matvecs_per_tick),
         mean_ticks: stat(|l| l.mean_ticks),

@@ -71,7 +71,7 @@ pub fn evaluate_under(
     progress: &dyn Progress,
 ) -> Result<Vec<EpisodeResult>, Error> {
     check_compatible(bundle, map)?;
-    let make = || method.controller(bundle, params);
+    let make = || method.controller_for(bundle, params, map);
     evaluate_with(protocol, map, method, params, &make, episodes, seed, progress)
 }
 
@@ -124,9 +124,11 @@ pub fn evaluate_scripted(
 ) -> Result<Vec<EpisodeResult>, Error> {
     let sizes = Discretizer::new(&map.bins)?.factor_sizes();
     let make = || {
-        method.scripted_controller(&sizes)?.ok_or_else(|| Error::NotScripted {
-            method: method.to_string(),
-        })
+        method
+            .scripted_controller_for(&sizes, map)?
+            .ok_or_else(|| Error::NotScripted {
+                method: method.to_string(),
+            })
     };
     evaluate_with(
         Protocol::ZeroShot,
@@ -155,6 +157,8 @@ pub struct MethodRow {
     pub success_rate: f64,
     /// Collision rate on the test map.
     pub collision_rate: f64,
+    /// Red-light violations per episode on the test map.
+    pub red_light_rate: f64,
     /// Share of test ticks that ran planning.
     pub inference_rate: f64,
     /// Mean wall-clock µs inside the controller per test tick (the only field measured
@@ -175,6 +179,7 @@ pub fn method_row(method: Method, train_seed: Option<u64>, train: Aggregate, tes
         test_reward: test.mean_reward,
         success_rate: test.success_rate,
         collision_rate: test.collision_rate,
+        red_light_rate: test.red_light_rate,
         inference_rate: test.inference_rate,
         reasoning_us_per_tick: test.us_per_tick,
         train,
@@ -197,7 +202,7 @@ pub fn trace(
 ) -> Result<(EpisodeResult, Vec<Tick>), Error> {
     let mut env = Env::new(map, EnvConfig::default())?;
     check_compatible(bundle, map)?;
-    let mut controller = method.controller(bundle, params)?;
+    let mut controller = method.controller_for(bundle, params, map)?;
     if protocol.effective(method, params) == Protocol::Continual {
         for ep in 0..episode {
             run_episode(&mut env, controller.as_mut(), eval_seeds(seed, map, method, ep), false)?;

@@ -5,6 +5,7 @@ use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::{GateLearning, GateMode, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_sim::Map;
 
 use crate::error::Error;
 use crate::reference::{BrakeOnPedestrian, NeverBrake};
@@ -203,12 +204,41 @@ impl Method {
     /// [`Method::controller`] builds its scripted methods here, with the sizes of the
     /// bundle's world model; callers without an agent (`check-map`, `eval` without
     /// `--agent`) pass the map discretizer's sizes.
+    /// Without a map, `brake-on-pedestrian` ignores the light
+    /// ([`Method::scripted_controller_for`] gives the witness of a map).
     pub fn scripted_controller(self, sizes: &[usize]) -> Result<Option<Box<dyn Controller>>, Error> {
         Ok(match self {
             Method::BrakeOnPedestrian => Some(Box::new(BrakeOnPedestrian::new(sizes)?)),
             Method::NeverBrake => Some(Box::new(NeverBrake)),
             _ => None,
         })
+    }
+
+    /// [`Method::scripted_controller`] for episodes on `map`: `brake-on-pedestrian` also
+    /// stops for red where the map's reward has the red-light rule
+    /// ([`BrakeOnPedestrian::for_map`]).
+    pub fn scripted_controller_for(self, sizes: &[usize], map: &Map) -> Result<Option<Box<dyn Controller>>, Error> {
+        Ok(match self {
+            Method::BrakeOnPedestrian => Some(Box::new(BrakeOnPedestrian::for_map(sizes, map)?)),
+            _ => self.scripted_controller(sizes)?,
+        })
+    }
+
+    /// [`Method::controller`] for episodes on `map` (the scripted witness follows the
+    /// map's red-light rule; every other method is the same).
+    pub fn controller_for(
+        self,
+        bundle: &AgentBundle,
+        params: &ScaledParams,
+        map: &Map,
+    ) -> Result<Box<dyn Controller>, Error> {
+        if self.is_scripted() {
+            let sizes = bundle.world_model.structure().sizes();
+            return Ok(self
+                .scripted_controller_for(&sizes, map)?
+                .expect("scripted_controller_for builds every scripted method"));
+        }
+        self.controller(bundle, params)
     }
 
     /// Builds a fresh controller of this method from the trained bundle (the scripted

@@ -1,5 +1,6 @@
 //! The metrics of §VI: training reward, test reward, success rate, collision rate,
-//! inference rate (share of ticks that ran planning) and measured reasoning time.
+//! inference rate (share of ticks that ran planning) and measured reasoning time; and
+//! red-light violations per episode (the traffic rule, not in the paper).
 
 use crate::runner::EpisodeResult;
 
@@ -16,6 +17,11 @@ pub struct Aggregate {
     pub collision_rate: f64,
     /// Share of episodes that ran out of ticks.
     pub timeout_rate: f64,
+    /// Red-light violations per episode (the car's front entering the crosswalk on red),
+    /// mean; at most one per episode, so also the share of episodes with one. Counted on
+    /// every map, whether or not its reward pays for it.
+    #[serde(default)]
+    pub red_light_rate: f64,
     /// Share of decision ticks that ran planning.
     pub inference_rate: f64,
     /// Mean decision ticks per episode.
@@ -44,6 +50,7 @@ impl Aggregate {
             success_rate: share(&|r| r.success),
             collision_rate: share(&|r| r.collision),
             timeout_rate: share(&|r| r.timeout),
+            red_light_rate: results.iter().map(|r| f64::from(r.red_lights)).sum::<f64>() / n as f64,
             inference_rate: if ticks == 0 {
                 0.0
             } else {
@@ -75,6 +82,7 @@ mod tests {
             success: true,
             ticks: 10,
             reasoning_ticks: 5,
+            red_lights: 1,
             decide_ns: 10_000,
             reasoning_ns: 9_000,
             ..Default::default()
@@ -93,6 +101,7 @@ mod tests {
         assert_eq!(agg.success_rate, 0.5);
         assert_eq!(agg.collision_rate, 0.5);
         assert_eq!(agg.timeout_rate, 0.0);
+        assert_eq!(agg.red_light_rate, 0.5);
         assert!((agg.inference_rate - 5.0 / 14.0).abs() < 1e-15);
         assert_eq!(agg.mean_ticks, 7.0);
         assert!((agg.us_per_tick - 1.0).abs() < 1e-12);

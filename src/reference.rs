@@ -6,6 +6,9 @@
 //!   pedestrian is on the crosswalk while the car has not yet arrived (p = 1 and
 //!   d >= 1), otherwise speeds up. It is the careful driver of §VI: a map of the
 //!   jaywalk family must let it succeed (it is the witness that the map is survivable).
+//!   On a map with the red-light rule (`reward.red_light < 0`) it also stops for red
+//!   ([`RedLightStop`]): it slows down while L = 0 in the distance bin before the
+//!   crosswalk, and in a crosswalk bin while L = 0 at the lowest speeds (v <= 1).
 //! * [`NeverBrake`] (`never-brake`): always speeds up. It is the witness that a map is
 //!   dangerous: a car that drives on must be hit.
 //!
@@ -20,7 +23,8 @@
 //! with the factor sizes they are built with.
 
 use unforeseen_agent::controller::{Controller, Decision, Dist};
-use unforeseen_sim::Action;
+use unforeseen_discretizer::Discretizer;
+use unforeseen_sim::{Action, Map};
 
 use crate::error::Error;
 
@@ -42,12 +46,53 @@ fn decision(action: Action) -> Decision {
     }
 }
 
+/// How [`BrakeOnPedestrian`] stops for red on a map with the red-light rule. It sees only
+/// the discrete state, so it cannot tell where in a distance bin the car is: it brakes on
+/// L = 0 (amber or red) in the bin before the crosswalk, where braking still stops the
+/// car before the crosswalk's near edge (from 9 m/s with the default bins: 13.5 m from at
+/// least 30 m), and on L = 0 in a bin that overlaps the crosswalk when it stands or
+/// crawls (v <= 1: 0 or 3 m/s with the defaults, so one tick of braking stops it within
+/// 1.5 m; it gets there by braking in the bin before, e.g. 42 -> 34.5 -> 30 m). Faster
+/// in a crosswalk bin it drives on: there the car is either too close to stop or
+/// already on or past the crosswalk, where stopping would leave it standing in the
+/// pedestrians' way.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RedLightStop {
+    /// The distance bin just before (farther from the goal than) the crosswalk's bins.
+    pub approach: Option<usize>,
+    /// The distance bins that overlap the crosswalk ([`crate::rewards::crosswalk_bins`]).
+    pub crosswalk: Vec<usize>,
+}
+
+impl RedLightStop {
+    /// The rule for `map`, if its reward has the red-light term (`reward.red_light < 0`).
+    pub fn of(map: &Map, disc: &Discretizer) -> Option<Self> {
+        if map.reward.red_light >= 0.0 {
+            return None;
+        }
+        let crosswalk = crate::rewards::crosswalk_bins(map, disc);
+        let last = *crosswalk.last()?;
+        let n_d = disc.factor_sizes()[0];
+        Some(Self {
+            approach: (last + 1 < n_d).then_some(last + 1),
+            crosswalk,
+        })
+    }
+
+    /// Whether the rule says slow down at (d, v, L).
+    fn stops(&self, d: usize, v: usize, l: usize) -> bool {
+        l == 0 && (self.approach == Some(d) || (v <= 1 && self.crosswalk.contains(&d)))
+    }
+}
+
 /// Brakes while a pedestrian is on the crosswalk and the car has not arrived, else
-/// speeds up (§VI's careful driver).
+/// speeds up (§VI's careful driver); with a [`RedLightStop`], also stops for red.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct BrakeOnPedestrian {
     /// Factor sizes `[n_d, n_v, n_L, n_p]` of the joint observation index.
     sizes: [usize; 4],
+    /// Stops for red too (maps with the red-light rule).
+    red_light: Option<RedLightStop>,
 }
 
 impl BrakeOnPedestrian {
@@ -58,6 +103,7 @@ impl BrakeOnPedestrian {
         match *sizes {
             [n_d, n_v, 2, 2] if n_d >= 2 && n_v >= 1 => Ok(Self {
                 sizes: [n_d, n_v, 2, 2],
+                red_light: None,
             }),
             _ => Err(Error::Agent {
                 problem: format!(
@@ -68,12 +114,33 @@ impl BrakeOnPedestrian {
         }
     }
 
-    /// The action for joint observation `obs`: slow down iff p = 1 and d >= 1.
+    /// The witness for `map`: [`BrakeOnPedestrian::new`], stopping for red where the map's
+    /// reward has the red-light rule ([`RedLightStop::of`], with the map's bins).
+    pub fn for_map(sizes: &[usize], map: &Map) -> Result<Self, Error> {
+        let mut c = Self::new(sizes)?;
+        let disc = Discretizer::new(&map.bins)?;
+        if disc.factor_sizes() == c.sizes {
+            c.red_light = RedLightStop::of(map, &disc);
+        }
+        Ok(c)
+    }
+
+    /// The same witness stopping for red by `rule` (or not, for `None`).
+    pub fn with_red_light(mut self, rule: Option<RedLightStop>) -> Self {
+        self.red_light = rule;
+        self
+    }
+
+    /// The action for joint observation `obs`: slow down iff p = 1 and d >= 1, or the
+    /// red-light rule says so; otherwise speed up.
     pub fn action(&self, obs: usize) -> Action {
         let [_, n_v, n_l, n_p] = self.sizes;
         let p = obs % n_p;
+        let l = (obs / n_p) % n_l;
+        let v = (obs / (n_l * n_p)) % n_v;
         let d = obs / (n_v * n_l * n_p);
-        if p == 1 && d >= 1 {
+        let red = self.red_light.as_ref().is_some_and(|r| r.stops(d, v, l));
+        if (p == 1 && d >= 1) || red {
             Action::SlowDown
         } else {
             Action::SpeedUp
@@ -178,6 +245,44 @@ mod tests {
             };
             assert_eq!(c.action(s), want, "{st:?}");
         }
+    }
+
+    #[test]
+    fn stops_for_red_only_where_the_map_has_the_rule() {
+        let mut map = crate::maps::load("intersection").unwrap();
+        map.reward.red_light = 0.0;
+        let sizes = disc().factor_sizes();
+        let plain = BrakeOnPedestrian::for_map(&sizes, &map).unwrap();
+        assert_eq!(plain, brake(), "no rule: the witness of before");
+        map.reward.red_light = -10.0;
+        let mut c = BrakeOnPedestrian::for_map(&sizes, &map).unwrap();
+        assert_eq!(
+            c.red_light,
+            Some(RedLightStop {
+                approach: Some(2),
+                crosswalk: vec![1]
+            })
+        );
+        for s in 0..disc().n_states() {
+            let st = disc().decode(s);
+            let red = st.l == 0 && (st.d == 2 || (st.d == 1 && st.v <= 1));
+            let want = if (st.p == 1 && st.d >= 1) || red {
+                Action::SlowDown
+            } else {
+                Action::SpeedUp
+            };
+            assert_eq!(act(&mut c, st.d, st.v, st.l, st.p), want, "{st:?}");
+        }
+        // The light turns amber or red at d = 2 at full speed: brake.
+        assert_eq!(act(&mut c, 2, 3, 0, 0), Action::SlowDown);
+        // Standing or crawling before the crosswalk (d = 1) on red: stop; on green: go.
+        assert_eq!(act(&mut c, 1, 0, 0, 0), Action::SlowDown);
+        assert_eq!(act(&mut c, 1, 1, 0, 0), Action::SlowDown);
+        assert_eq!(act(&mut c, 1, 0, 1, 0), Action::SpeedUp);
+        // Moving in the crosswalk bin on red: too close to stop, drive on.
+        assert_eq!(act(&mut c, 1, 2, 0, 0), Action::SpeedUp);
+        // Far away (d = 3) on red: not yet.
+        assert_eq!(act(&mut c, 3, 3, 0, 0), Action::SpeedUp);
     }
 
     #[test]

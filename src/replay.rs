@@ -46,6 +46,8 @@ struct Frame {
     /// The discrete state (d, v, L, p).
     state: [usize; 4],
     reward: f64,
+    /// This tick's action took the car into the crosswalk on red (a violation).
+    red_light: bool,
     policy: Vec<f64>,
     psi: Option<Vec<f64>>,
 }
@@ -131,6 +133,7 @@ pub fn replay_html(
                 surprise_bits: t.surprise.filter(|_| i < last).map(|s| s / std::f64::consts::LN_2),
                 state: [t.state.d, t.state.v, t.state.l, t.state.p],
                 reward: t.reward,
+                red_light: t.red_light,
                 policy: t.policy.clone(),
                 psi: t.psi.clone(),
             })
@@ -178,6 +181,7 @@ const PAGE: &str = r##"<!DOCTYPE html>
   .bar { display: inline-block; height: 10px; background: #4466cc; vertical-align: middle; }
   .mode-reasoning { color: #c06000; font-weight: bold; }
   .mode-habit { color: #2846e6; font-weight: bold; }
+  .violation { color: #d01818; font-weight: bold; }
 </style>
 </head>
 <body>
@@ -205,6 +209,7 @@ const PAGE: &str = r##"<!DOCTYPE html>
       <span><span class="sw dot" style="background:#1db31d"></span><span class="sw dot" style="background:#ffaa00"></span><span class="sw dot" style="background:#e02020"></span>traffic light</span>
       <span><span class="sw" style="background:#f5f5f5"></span>crosswalk</span>
       <span><span class="sw" style="background:#000"></span>destination</span>
+      <span><span class="sw" style="border:2px solid #d01818"></span>car outlined red: that tick entered the crosswalk on red</span>
     </div>
   </div>
   <div class="card" id="info-card">
@@ -221,6 +226,7 @@ const PAGE: &str = r##"<!DOCTYPE html>
       <span><span class="sw" style="background:#8fd18f"></span>speed up</span>
       <span><span class="sw" style="background:#d0d0d0"></span>maintain</span>
       <span><span class="sw" style="background:#f09090"></span>slow down</span>
+      <span><span class="sw" style="background:#d01818;height:4px"></span>entered the crosswalk on red</span>
       <span><span class="sw" style="background:#222;width:2px"></span>now</span>
     </div>
   </div>
@@ -287,6 +293,10 @@ for (let i = 0; i < N; i++) {
   const box = el(tl, "rect", { x: X(i - 0.5) + 1, y: AY, width: Math.max(cell - 2, 1), height: AH, fill: ACTION[a], rx: 2 });
   el(box, "title", {}, `tick ${i}: ${a}`);
   if (cell > 22) el(tl, "text", { x: X(i), y: AY + AH / 2 + 4, "text-anchor": "middle", "font-size": 10 }, a === "speed up" ? "up" : a === "slow down" ? "down" : "keep");
+  if (T[i].red_light) {
+    const mark = el(tl, "rect", { x: X(i - 0.5) + 1, y: AY + AH + 1, width: Math.max(cell - 2, 1), height: 4, fill: "#d01818", class: "red-light" });
+    el(mark, "title", {}, `tick ${i}: entered the crosswalk on red`);
+  }
 }
 const cursor = el(tl, "line", { y1: TOP - 4, y2: AY + AH + 4, stroke: "#222", "stroke-width": 2 });
 tl.addEventListener("click", (ev) => {
@@ -312,6 +322,7 @@ function info(i) {
     ["light", `${t.light}, ${t.light_left.toFixed(1)} s left`],
     ["pedestrians", String(t.pedestrians.length)],
     ["reward", t.reward.toFixed(2)],
+    ["red light", t.red_light ? '<span class="violation">ran a red light: entered the crosswalk on red this tick</span>' : "–"],
   ];
   if (t.action !== null) rows.push(["policy acted on", bars(t.policy)]);
   if (t.psi) rows.push(["planner psi", bars(t.psi)]);
@@ -326,6 +337,8 @@ function show(t) {
   const lerp = (p, q) => p + (q - p) * f;
   car.setAttribute("x", lerp(a.car_x, b.car_x) - S.car_length);
   car.setAttribute("fill", a.reasoned ? "#e68c00" : "#2846e6");
+  car.setAttribute("stroke", a.red_light ? "#d01818" : "none");
+  car.setAttribute("stroke-width", a.red_light ? 0.6 : 0);
   light.setAttribute("fill", LIGHT[a.light]);
   const same = a.pedestrians.length === b.pedestrians.length;
   peds.replaceChildren();

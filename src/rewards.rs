@@ -6,7 +6,8 @@
 use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::Map;
 
-/// One line naming a map's reward, for tables: its four numbers, and whether it pays
+/// One line naming a map's reward, for tables: its four numbers (and the red-light rule's,
+/// where the map has it), and whether it pays
 /// rapid approach (a tick at the car's top speed nets at most 0, so every slower tick
 /// costs, §VI) or progress per metre (a tick at top speed earns, so waiting costs little).
 pub fn describe(map: &Map) -> String {
@@ -17,8 +18,13 @@ pub fn describe(map: &Map) -> String {
     } else {
         "per metre"
     };
+    let rule = if r.red_light != 0.0 {
+        format!(", entering on red {:+}", r.red_light)
+    } else {
+        String::new()
+    };
     format!(
-        "{kind}: {}/m of progress, -{} per tick, goal {:+}, crash {:+}",
+        "{kind}: {}/m of progress, -{} per tick, goal {:+}, crash {:+}{rule}",
         r.progress_per_metre, r.step_cost, r.goal, r.crash
     )
 }
@@ -71,6 +77,12 @@ mod describe_tests {
         assert_eq!(
             describe(&map),
             "rapid approach: 0.5/m of progress, -4.5 per tick, goal +50, crash -25"
+        );
+        map.reward.red_light = -100.0;
+        assert!(
+            describe(&map).ends_with("crash -25, entering on red -100"),
+            "{}",
+            describe(&map)
         );
         map.reward.step_cost = 1.0;
         assert!(describe(&map).starts_with("per metre: "), "{}", describe(&map));

@@ -31,6 +31,8 @@ pub struct Tick {
     pub psi: Option<Vec<f64>>,
     /// Reward paid for this tick.
     pub reward: f64,
+    /// This tick's action took the car's front into the crosswalk on red (a violation).
+    pub red_light: bool,
     /// The world before acting (for the filmstrip).
     pub snapshot: Snapshot,
 }
@@ -46,6 +48,10 @@ pub struct EpisodeResult {
     pub collision: bool,
     /// Ran out of decision ticks.
     pub timeout: bool,
+    /// Red-light violations: ticks in which the car's front entered the crosswalk on red
+    /// ([`unforeseen_env::Events::red_light`]; at most one, since the car never reverses).
+    #[serde(default)]
+    pub red_lights: u32,
     /// Decision ticks taken.
     pub ticks: u32,
     /// Ticks on which the controller reasoned (ran planning).
@@ -112,6 +118,7 @@ pub fn run_episode(
         })?;
         result.ret += step.reward;
         result.ticks += 1;
+        result.red_lights += u32::from(step.info.events.red_light);
         let next_index = step
             .observation
             .index()
@@ -130,6 +137,7 @@ pub fn run_episode(
                 policy: decision.policy.to_vec(),
                 psi: decision.psi.as_deref().map(<[f64]>::to_vec),
                 reward: step.reward,
+                red_light: step.info.events.red_light,
                 snapshot,
             });
         }
@@ -151,6 +159,7 @@ pub fn run_episode(
                     policy: Vec::new(),
                     psi: None,
                     reward: 0.0,
+                    red_light: false,
                     snapshot: env.snapshot().clone(),
                 });
             }

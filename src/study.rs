@@ -78,6 +78,8 @@ pub struct MethodSummary {
     pub success_rate: Stat,
     /// Collision rate on the test map, over agents.
     pub collision_rate: Stat,
+    /// Red-light violations per episode on the test map, over agents.
+    pub red_light_rate: Stat,
     /// Share of test ticks that ran planning, over agents.
     pub inference_rate: Stat,
     /// Wall-clock µs per test tick, over agents (the only clock-measured figure).
@@ -124,13 +126,14 @@ pub struct ProtocolTable {
 pub type Metric = (&'static str, fn(&MethodRow) -> f64);
 
 /// The summarized metrics, in column order.
-pub const METRICS: [Metric; 6] = [
+pub const METRICS: [Metric; 7] = [
     ("train_reward", |r| r.train_reward),
     ("test_reward", |r| r.test_reward),
     ("success_rate", |r| r.success_rate),
     ("collision_rate", |r| r.collision_rate),
     ("inference_rate", |r| r.inference_rate),
     ("reasoning_us_per_tick", |r| r.reasoning_us_per_tick),
+    ("red_light_rate", |r| r.red_light_rate),
 ];
 
 impl MethodSummary {
@@ -143,6 +146,7 @@ impl MethodSummary {
             "collision_rate" => &self.collision_rate,
             "inference_rate" => &self.inference_rate,
             "reasoning_us_per_tick" => &self.reasoning_us_per_tick,
+            "red_light_rate" => &self.red_light_rate,
             _ => panic!("unknown metric {metric}"),
         }
     }
@@ -286,6 +290,7 @@ fn summarize(
         collision_rate: stat(METRICS[3].1),
         inference_rate: stat(METRICS[4].1),
         reasoning_us_per_tick: stat(METRICS[5].1),
+        red_light_rate: stat(METRICS[6].1),
         worst_seed: worst_seed(&rows),
         per_seed: rows,
     }

@@ -134,6 +134,11 @@ pub struct Events {
     pub goal: bool,
     /// The tick limit was reached without goal or collision (truncates it).
     pub timeout: bool,
+    /// The car's front entered the crosswalk (crossed its near edge) while the light was
+    /// red (not amber), a traffic-rule violation; it does not end the episode. Reported
+    /// on every map; the reward pays `reward.red_light` for it ([`RewardTerms::red_light`]).
+    #[serde(default)]
+    pub red_light: bool,
 }
 
 /// What an observer may know besides the observation: the true state, the events and the
@@ -311,6 +316,7 @@ impl Env {
             collision: outcome.collision,
             goal: outcome.goal,
             timeout: outcome.timeout,
+            red_light: outcome.red_light,
         };
         let terms = RewardTerms::of(&self.map, &outcome);
         let info = self.look(events, terms);

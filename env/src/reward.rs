@@ -14,6 +14,10 @@ pub struct RewardTerms {
     pub goal: f64,
     /// `crash` on the tick the car hits a pedestrian, else 0.
     pub crash: f64,
+    /// `red_light` on the tick the car's front enters the crosswalk on red, else 0
+    /// (maps/README.md: the traffic-rule term; 0 on maps without it).
+    #[serde(default)]
+    pub red_light: f64,
 }
 
 impl RewardTerms {
@@ -25,11 +29,15 @@ impl RewardTerms {
             time: -r.step_cost,
             goal: if outcome.goal { r.goal } else { 0.0 },
             crash: if outcome.collision { r.crash } else { 0.0 },
+            red_light: if outcome.red_light { r.red_light } else { 0.0 },
         }
     }
 
-    /// The reward: `progress + time + goal + crash`, summed in that order.
+    /// The reward: `progress + time + goal + crash + red_light`, summed in that order (the
+    /// last term is +0 on maps without the rule, and `x + 0.0` is `x` bit for bit for every
+    /// `x` but -0.0, which the other terms never sum to: rewards on such maps are the
+    /// same bits as before the term existed).
     pub fn total(&self) -> f64 {
-        self.progress + self.time + self.goal + self.crash
+        self.progress + self.time + self.goal + self.crash + self.red_light
     }
 }

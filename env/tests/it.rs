@@ -42,6 +42,54 @@ fn rollout(env: &mut Env, seed: u64, actions: &[usize]) -> (Observation, Vec<Ste
 }
 
 #[test]
+fn running_a_red_light_pays_the_rule_term_on_that_tick_only() {
+    // Red from 7 s: a car that speeds up from the start reaches the crosswalk at 7.8 s.
+    let src = |red_light: f64| {
+        format!(
+            "Map(base: \"intersection\", pedestrians: [], light: (offset: Fixed(0.0), cycle: [(phase: Green, duration: 7.0), (phase: Red, duration: 20.0)]), reward: (red_light: {red_light:?}))"
+        )
+    };
+    let with = map_from(&src(-30.0));
+    let without = map_from(&src(0.0));
+    let (_, a) = rollout(
+        &mut Env::new(&with, EnvConfig::default()).unwrap(),
+        3,
+        &[Action::SpeedUp.index()],
+    );
+    let (_, b) = rollout(
+        &mut Env::new(&without, EnvConfig::default()).unwrap(),
+        3,
+        &[Action::SpeedUp.index()],
+    );
+    assert_eq!(a.len(), b.len());
+    let flagged: Vec<usize> = (0..a.len()).filter(|&k| a[k].info.events.red_light).collect();
+    assert_eq!(flagged, vec![7], "the tick 7..8 s enters the crosswalk on red");
+    for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+        // The world reports the violation on both maps; only the rule's map pays for it.
+        assert_eq!(x.info.events, y.info.events);
+        let t = x.info.reward;
+        assert_eq!(x.reward, t.progress + t.time + t.goal + t.crash + t.red_light);
+        assert_eq!(t.red_light, if k == 7 { -30.0 } else { 0.0 });
+        assert_eq!(y.info.reward.red_light, 0.0);
+        let expected = if k == 7 { y.reward - 30.0 } else { y.reward };
+        assert_eq!(x.reward, expected, "tick {k}");
+    }
+    // A green light throughout: no violation.
+    let green = map_from(
+        "Map(base: \"intersection\", pedestrians: [], light: (offset: Fixed(0.0), cycle: [(phase: Green, duration: 100.0)]), reward: (red_light: -30.0))",
+    );
+    let (_, g) = rollout(
+        &mut Env::new(&green, EnvConfig::default()).unwrap(),
+        3,
+        &[Action::SpeedUp.index()],
+    );
+    assert!(
+        g.iter()
+            .all(|s| !s.info.events.red_light && s.info.reward.red_light == 0.0)
+    );
+}
+
+#[test]
 fn the_same_seed_and_actions_give_bit_identical_steps() {
     let m = map("two_pedestrians");
     for form in [ObservationForm::Discrete, ObservationForm::Kinematic] {
@@ -270,7 +318,8 @@ proptest! {
         let (_, steps) = rollout(&mut env, seed, &actions);
         for (k, s) in steps.iter().enumerate() {
             let t = s.info.reward;
-            prop_assert_eq!(s.reward, t.progress + t.time + t.goal + t.crash);
+            prop_assert_eq!(s.reward, t.progress + t.time + t.goal + t.crash + t.red_light);
+            prop_assert_eq!(t.red_light, 0.0);
             prop_assert_eq!(t.time, -m.reward.step_cost);
             prop_assert!(!(s.info.events.goal && s.info.events.collision));
             prop_assert_eq!(s.terminated || s.truncated, k + 1 == steps.len());

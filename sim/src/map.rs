@@ -206,6 +206,11 @@ config_struct! {
         /// rapid goal approach" (§VI). Set it to 1 for the per-metre reward of
         /// `maps/per_metre/`, under which waiting costs little.
         step_cost: f64 = 4.5,
+        /// Reward (negative: a penalty) paid on the tick in which the car's front crosses the
+        /// crosswalk's near edge while the light shows `Red` (amber is allowed: it is the
+        /// warning a car that cannot stop any more may still clear on). Default 0: no rule.
+        /// The world reports the violation whatever this value ([`crate::StepOutcome`]).
+        red_light: f64 = 0.0,
     }
 }
 
@@ -682,9 +687,14 @@ impl Map {
             b.distance_edges, b.speed_edges, b.observation_noise
         );
         let w = &self.reward;
+        let red_light = if w.red_light != 0.0 {
+            format!(", entering the crosswalk on red {}", w.red_light)
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             s,
-            "reward: {} per metre, goal {}, crash {}, step cost {}",
+            "reward: {} per metre, goal {}, crash {}, step cost {}{red_light}",
             w.progress_per_metre, w.goal, w.crash, w.step_cost
         );
         let e = &self.episode;

@@ -479,6 +479,7 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
     c.finite("reward.goal", rw.goal);
     c.finite("reward.crash", rw.crash);
     c.finite("reward.step_cost", rw.step_cost);
+    c.finite("reward.red_light", rw.red_light);
 
     let e = &map.episode;
     c.within(

@@ -101,6 +101,10 @@ pub struct StepOutcome {
     pub timeout: bool,
     /// Metres the car's front advanced during this tick.
     pub progress: f64,
+    /// The car's front crossed the crosswalk's near edge during this tick, in a sub-step
+    /// whose light (at the sub-step's start, as the spawn rules see it) was `Red` (amber
+    /// is not a violation). Reported whatever the map's `reward.red_light`.
+    pub red_light: bool,
 }
 
 impl StepOutcome {
@@ -266,14 +270,21 @@ impl World {
         let start_x = self.car_front();
         let mut collision = false;
         let mut goal = false;
+        let mut red_light = false;
+        let near_x = self.map.crosswalk_near_x();
         let v0 = self.car_speed();
         for k in 1..=self.substeps {
             self.spawn_due();
             self.move_pedestrians();
             self.control_car(action, v0, k);
+            let before = self.car_front();
+            let t = self.time_at(self.substep);
             self.phys.step();
             self.substep += 1;
             self.after_substep();
+            if before < near_x && self.car_front() >= near_x {
+                red_light |= light_at(&self.map.light, self.light_offset, t).0 == LightPhase::Red;
+            }
             if self.car_touches_pedestrian() {
                 collision = true;
                 break;
@@ -291,6 +302,7 @@ impl World {
             goal,
             timeout,
             progress: self.car_front() - start_x,
+            red_light,
         };
         if out.done() {
             self.terminal = Some(out);

@@ -162,7 +162,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         protocols,
         paper: Method::PAPER
             .iter()
-            .filter_map(|m| m.paper().map(|p| serde_json::json!({"method": m.name(), "train_reward": p.train_reward, "test_reward": p.test_reward, "success_rate": p.success_rate, "collision_rate": null, "inference_rate_relative_to_bayes_rl": p.inference_rate})))
+            .filter_map(|m| m.paper().map(|p| serde_json::json!({"method": m.name(), "train_reward": p.train_reward, "test_reward": p.test_reward, "success_rate": p.success_rate, "collision_rate": null, "red_light_rate": null, "inference_rate_relative_to_bayes_rl": p.inference_rate})))
             .collect(),
         columns: columns(&train_map.name, &test_map.name, args.episodes),
         train_map: train_map.name.clone(),
@@ -208,6 +208,7 @@ fn columns(train_map: &str, test_map: &str, episodes: u64) -> serde_json::Value 
         "test_reward": on_test("mean return"),
         "success_rate": on_test("share of episodes reaching the destination without a collision"),
         "collision_rate": format!("{}; the paper gives no value", on_test("share of episodes that hit a pedestrian")),
+        "red_light_rate": format!("{}; not in the paper", on_test("red-light violations per episode: the car's front entering the crosswalk on red (at most one per episode)")),
         "inference_rate": on_test("share of decision ticks that ran planning"),
         "reasoning_us_per_tick": on_test("wall-clock µs per tick inside the controller"),
     })
@@ -290,6 +291,7 @@ fn print_table(table: &ProtocolTable, train_map: &Map, test_map: &Map) {
                 cell(&m.collision_rate, if n > 1 { 1 } else { 0 }, true),
                 p.map(|_| "n/a".to_string()),
             ),
+            cell(&m.red_light_rate, if n > 1 { 1 } else { 0 }, true),
             cell(&m.inference_rate, 1, true),
             cell(&m.reasoning_us_per_tick, 2, false),
         ]);
@@ -297,7 +299,7 @@ fn print_table(table: &ProtocolTable, train_map: &Map, test_map: &Map) {
     print_grid(&rows);
     if table.protocol == Protocol::ZeroShot {
         outln!(
-            "(paper's values in parentheses, §VI; n/a: the paper gives no collision rate; its inference rate is relative, below)"
+            "(paper's values in parentheses, §VI; n/a: the paper gives no collision rate; red lights: episodes entering the crosswalk on red, not in the paper; its inference rate is relative, below)"
         );
     }
     let copied: Vec<&str> = table
@@ -327,7 +329,14 @@ fn print_table(table: &ProtocolTable, train_map: &Map, test_map: &Map) {
 
 /// The header of compare's printed tables: the method, the table's figures, then `last`.
 fn header(last: &str) -> Vec<String> {
-    let figures = ["train reward", "test reward", "success", "collisions", "inference rate"];
+    let figures = [
+        "train reward",
+        "test reward",
+        "success",
+        "collisions",
+        "red lights",
+        "inference rate",
+    ];
     std::iter::once("method")
         .chain(figures)
         .chain([last])
@@ -338,7 +347,7 @@ fn header(last: &str) -> Vec<String> {
 /// The second header line: the map each figure was measured on, then `last`.
 fn maps_row(train_map: &str, test_map: &str, last: &str) -> Vec<String> {
     let test = format!("({test_map})");
-    ["", &format!("({train_map})"), &test, &test, &test, &test, last]
+    ["", &format!("({train_map})"), &test, &test, &test, &test, &test, last]
         .map(String::from)
         .to_vec()
 }
@@ -355,6 +364,7 @@ fn print_spread(table: &ProtocolTable, train_map: &str, test_map: &str) {
             range_cell(&m.test_reward, 1, false),
             range_cell(&m.success_rate, 0, true),
             range_cell(&m.collision_rate, 0, true),
+            range_cell(&m.red_light_rate, 0, true),
             range_cell(&m.inference_rate, 1, true),
             format!(
                 "{} ({:.0}%, {})",

@@ -76,13 +76,14 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     bars.finish();
     let agg = Aggregate::of(&results);
     outln!(
-        "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
+        "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, red lights {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
         args.method,
         map.name,
         protocol_note(args.method, args.protocol, &params),
         agg.mean_reward,
         100.0 * agg.success_rate,
         100.0 * agg.collision_rate,
+        100.0 * agg.red_light_rate,
         100.0 * agg.timeout_rate,
         100.0 * agg.inference_rate,
         agg.us_per_tick,

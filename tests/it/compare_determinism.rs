@@ -68,6 +68,7 @@ fn compare_json_is_identical_across_runs_with_the_same_seed() {
                 "test_reward",
                 "success_rate",
                 "collision_rate",
+                "red_light_rate",
                 "inference_rate",
             ] {
                 assert!(m[k]["mean"].is_number(), "{k} missing in {m}");

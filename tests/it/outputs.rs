@@ -115,9 +115,21 @@ fn compare_says_which_map_each_column_is_on_and_how_many_episodes_ran() {
             .as_array()
             .unwrap()
             .iter()
-            .all(|p| p["collision_rate"].is_null())
+            .all(|p| p["collision_rate"].is_null() && p["red_light_rate"].is_null())
     );
+    assert!(json["columns"]["red_light_rate"].as_str().unwrap().contains("red"));
+    assert!(
+        text.contains("red lights"),
+        "the table has the red-light column:\n{text}"
+    );
+    assert!(csv_header_has(&dir.path().join("compare.csv"), "red_light_rate"));
     let csv = std::fs::read_to_string(dir.path().join("compare.csv")).unwrap();
     assert!(csv.lines().next().unwrap().contains("train_map,test_map"), "{csv}");
     assert!(csv.lines().nth(1).unwrap().contains("intersection,jaywalk"), "{csv}");
+}
+
+/// Whether the first line of a CSV file names `column`.
+fn csv_header_has(path: &std::path::Path, column: &str) -> bool {
+    let csv = std::fs::read_to_string(path).unwrap();
+    csv.lines().next().unwrap().split(',').any(|c| c == column)
 }

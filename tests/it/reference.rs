@@ -184,3 +184,39 @@ fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(stdout.contains("success 100.0%"), "{stdout}");
 }
+
+/// On a map with the red-light rule the careful driver also stops for red: on
+/// red_on_approach (the light turns red as the car approaches, a pedestrian crosses
+/// legally) it never enters on red and never hits anyone; never-brake runs every red
+/// light, and the metric counts one violation per such episode. Without the rule (the
+/// same map, `red_light: 0`) the witness ignores the light, as before.
+#[test]
+fn brake_on_pedestrian_stops_for_red_where_the_map_has_the_rule() {
+    use unforeseen::experiments::evaluate_scripted;
+    let mut map = unforeseen::maps::load(&shipped("red_light/red_on_approach.ron")).unwrap();
+    assert_eq!(map.reward.red_light, -100.0);
+    let run = |map: &unforeseen_sim::Map, method| {
+        Aggregate::of(&evaluate_scripted(map, method, EPISODES, 7, &NoProgress).unwrap())
+    };
+    let careful = run(&map, Method::BrakeOnPedestrian);
+    assert_eq!(
+        (careful.success_rate, careful.red_light_rate),
+        (1.0, 0.0),
+        "{careful:?}"
+    );
+    let reckless = run(&map, Method::NeverBrake);
+    assert_eq!(reckless.red_light_rate, 1.0, "{reckless:?}");
+    // Every violation paid -100: the reckless return is 100 below the same drive without the rule.
+    map.reward.red_light = 0.0;
+    let free = run(&map, Method::NeverBrake);
+    assert_eq!(
+        free.red_light_rate, 1.0,
+        "the world reports the violation whatever the reward"
+    );
+    assert!((free.mean_reward - reckless.mean_reward - 100.0).abs() < 1e-9);
+    let ignores = run(&map, Method::BrakeOnPedestrian);
+    assert_eq!(
+        ignores.red_light_rate, 1.0,
+        "without the rule the witness ignores the light: {ignores:?}"
+    );
+}

@@ -126,3 +126,34 @@ fn names_in_the_page_cannot_end_its_script() {
         "the data keep the title as it was"
     );
 }
+
+/// The frame of the tick that entered the crosswalk on red says so (never-brake on
+/// red_on_approach runs the red light every episode), and no other frame does.
+#[test]
+fn the_replay_marks_the_tick_that_ran_the_red_light() {
+    let dir = tempfile::tempdir().unwrap();
+    let agent = dir.path().join("agent.ron");
+    unforeseen::agent_file::save(&agent, common::bundle()).unwrap();
+    let html = dir.path().join("episode.html");
+    let map = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("maps/red_light/red_on_approach.ron");
+    let out = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+        .args(["trace", "--method", "never-brake", "-q", "--map"])
+        .arg(&map)
+        .arg("--agent")
+        .arg(&agent)
+        .arg("--out")
+        .arg(dir.path().join("trace"))
+        .arg("--html")
+        .arg(&html)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let page = std::fs::read_to_string(&html).unwrap();
+    let episode = embedded_episode(&page);
+    let ticks = episode["ticks"].as_array().unwrap();
+    let flagged: Vec<usize> = (0..ticks.len())
+        .filter(|&i| ticks[i]["red_light"].as_bool().unwrap())
+        .collect();
+    assert_eq!(flagged, vec![7], "the tick 7..8 s enters the crosswalk on red");
+    assert!(page.contains("ran a red light"));
+}

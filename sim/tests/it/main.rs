@@ -4,6 +4,7 @@
 mod bad_maps;
 mod common;
 mod determinism;
+mod red_light;
 mod scenarios;
 mod triggers;
 mod vehicle_kinematics;
