@@ -91,6 +91,7 @@ fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> 
     d.set_item(intern!(py, "collision"), info.events.collision)?;
     d.set_item(intern!(py, "goal"), info.events.goal)?;
     d.set_item(intern!(py, "timeout"), info.events.timeout)?;
+    d.set_item(intern!(py, "red_light"), info.events.red_light)?;
     d.set_item(intern!(py, "state"), state(info.state))?;
     d.set_item(intern!(py, "observed"), state(info.observed))?;
     d.set_item(intern!(py, "light"), light_str(py, info.light))?;
@@ -101,6 +102,7 @@ fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> 
     terms.set_item(intern!(py, "time"), info.reward.time)?;
     terms.set_item(intern!(py, "goal"), info.reward.goal)?;
     terms.set_item(intern!(py, "crash"), info.reward.crash)?;
+    terms.set_item(intern!(py, "red_light"), info.reward.red_light)?;
     d.set_item(intern!(py, "reward_terms"), terms)?;
     Ok(d)
 }

@@ -311,6 +311,7 @@ impl PyVectorEnv {
         d.set_item("collision", flag(&|i| i.events.collision))?;
         d.set_item("goal", flag(&|i| i.events.goal))?;
         d.set_item("timeout", flag(&|i| i.events.timeout))?;
+        d.set_item("red_light", flag(&|i| i.events.red_light))?;
         d.set_item("state", states(&|i| i.state)?)?;
         d.set_item("observed", states(&|i| i.observed)?)?;
         d.set_item("light_code", col(&|i| light_code(i.light)))?;
@@ -320,6 +321,7 @@ impl PyVectorEnv {
         terms.set_item("time", real(&|i| i.reward.time))?;
         terms.set_item("goal", real(&|i| i.reward.goal))?;
         terms.set_item("crash", real(&|i| i.reward.crash))?;
+        terms.set_item("red_light", real(&|i| i.reward.red_light))?;
         d.set_item("reward_terms", terms)?;
         Ok(d)
     }

@@ -84,10 +84,11 @@ class UnforeseenEnv(gym.Env):
 
     ## Info
 
-    ``step`` (ticks done), ``collision``, ``goal``, ``timeout`` (bools), ``state`` (the
+    ``step`` (ticks done), ``collision``, ``goal``, ``timeout``, ``red_light`` (bools;
+    ``red_light``: the car's front entered the crosswalk on red this tick), ``state`` (the
     true ``(d, v, L, p)``), ``observed`` (as observed), ``light`` (``"green"``,
     ``"amber"``, ``"red"``), ``light_code`` (0, 1, 2), ``light_time_left`` (s),
-    ``reward_terms`` (``progress``, ``time``, ``goal``, ``crash``).
+    ``reward_terms`` (``progress``, ``time``, ``goal``, ``crash``, ``red_light``).
 
     ## Seeding
 

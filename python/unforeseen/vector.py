@@ -35,7 +35,7 @@ class VectorEnv(_GymVectorEnv):
     threads. ``reset()`` without a seed draws the keys from ``self.np_random``.
 
     ``info`` holds arrays, one entry per env: ``step``, ``collision``, ``goal``,
-    ``timeout``, ``state`` and ``observed`` (``(num_envs, 4)``), ``light`` (str),
+    ``timeout``, ``red_light``, ``state`` and ``observed`` (``(num_envs, 4)``), ``light`` (str),
     ``light_code``, ``light_time_left``, and ``reward_terms`` (a dict of arrays), each
     with its ``_key`` mask (all True).
     """
