@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import unforeseen
@@ -31,6 +32,9 @@ def test_bad_action():
         with pytest.raises(ValueError, match=rf"action {bad} is not one of 0 \(maintain\), 1 \(speed up\), 2 \(slow down\)"):
             env.step(bad)
     env.step(0)  # the env is unchanged and still runs
+    with pytest.raises(TypeError):
+        env.step(1.5)  # not truncated to 1
+    env.step(np.int64(1))  # numpy integers are actions
 
 
 def test_step_out_of_order():

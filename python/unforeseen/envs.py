@@ -154,7 +154,7 @@ class UnforeseenEnv(gym.Env):
         return self._env.reset_next()
 
     def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
-        return self._env.step(int(action))
+        return self._env.step(action)
 
     def render(self) -> np.ndarray | str | None:
         if self.render_mode == "rgb_array":
