@@ -60,7 +60,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     };
     std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
     let result = (|| -> std::io::Result<()> {
-        let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+        let mut builder = tempfile::Builder::new();
+        #[cfg(unix)]
+        builder.permissions(new_file_permissions(path));
+        let mut tmp = builder.tempfile_in(dir)?;
         let _registered = Registered::new(tmp.path());
         tmp.write_all(bytes)?;
         tmp.as_file().sync_all()?;
@@ -83,6 +86,15 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         Ok(())
     })();
     result.map_err(|e| Error::io("write", path, e))
+}
+
+/// The permissions the written file gets: those of the file it replaces, else what a new
+/// file gets under the usual umask (`rw-r--r--`), not the temporary file's private
+/// `rw-------`.
+#[cfg(unix)]
+fn new_file_permissions(path: &Path) -> std::fs::Permissions {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::metadata(path).map_or_else(|_| std::fs::Permissions::from_mode(0o644), |m| m.permissions())
 }
 
 /// A staged write: the temporary file, where it goes, its registration.
@@ -171,6 +183,21 @@ pub fn num(x: f64, digits: usize) -> String {
 
 #[cfg(test)]
 mod tests {
+    #[cfg(unix)]
+    #[test]
+    fn written_files_are_readable_like_new_files_and_keep_a_replaced_files_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.json");
+        super::write_atomic(&path, b"1").unwrap();
+        let mode = |p: &std::path::Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&path), 0o644);
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o640)).unwrap();
+        super::write_atomic(&path, b"2").unwrap();
+        assert_eq!(mode(&path), 0o640);
+        assert_eq!(std::fs::read(&path).unwrap(), b"2");
+    }
+
     use super::*;
 
     #[test]
