@@ -249,7 +249,7 @@ mod tests {
 
     #[test]
     fn stops_for_red_only_where_the_map_has_the_rule() {
-        let mut map = crate::maps::load("intersection").unwrap();
+        let mut map = unforeseen_sim::embedded::load("intersection").unwrap();
         map.reward.red_light = 0.0;
         let sizes = disc().factor_sizes();
         let plain = BrakeOnPedestrian::for_map(&sizes, &map).unwrap();

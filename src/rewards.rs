@@ -73,7 +73,7 @@ mod describe_tests {
 
     #[test]
     fn the_default_reward_is_named_rapid_approach_and_a_cheap_tick_per_metre() {
-        let mut map = crate::maps::load("intersection").unwrap();
+        let mut map = unforeseen_sim::embedded::load("intersection").unwrap();
         assert_eq!(
             describe(&map),
             "rapid approach: 0.5/m of progress, -4.5 per tick, goal +50, crash -25"
