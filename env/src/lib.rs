@@ -217,8 +217,6 @@ pub struct Env {
     world: Option<World>,
     noise: ChaCha8Rng,
     snapshot: Option<Snapshot>,
-    state: State,
-    observed: State,
     info: Option<Info>,
 }
 
@@ -250,7 +248,6 @@ impl Env {
                 ),
             });
         }
-        let zero = State { d: 0, v: 0, l: 0, p: 0 };
         Ok(Env {
             map: map.clone(),
             disc,
@@ -258,8 +255,6 @@ impl Env {
             world: None,
             noise: ChaCha8Rng::seed_from_u64(0),
             snapshot: None,
-            state: zero,
-            observed: zero,
             info: None,
         })
     }
@@ -343,13 +338,23 @@ impl Env {
     }
 
     /// The true discrete state after the last tick.
+    ///
+    /// # Panics
+    /// Before the first [`Env::reset`].
     pub fn state(&self) -> State {
-        self.state
+        self.last().state
     }
 
     /// The observed discrete state after the last tick.
+    ///
+    /// # Panics
+    /// Before the first [`Env::reset`].
     pub fn observed(&self) -> State {
-        self.observed
+        self.last().observed
+    }
+
+    fn last(&self) -> &Info {
+        self.info.as_ref().expect("Env::state called before reset")
     }
 
     /// The info of the last reset or step, if any.
@@ -370,12 +375,12 @@ impl Env {
     fn look(&mut self, events: Events, reward: RewardTerms) -> Info {
         let world = self.world.as_ref().expect("look after reset");
         let snapshot = world.snapshot();
-        self.state = self.disc.state(&snapshot);
-        self.observed = self.disc.observe(self.state, &mut self.noise);
+        let state = self.disc.state(&snapshot);
+        let observed = self.disc.observe(state, &mut self.noise);
         let info = Info {
             step: snapshot.step,
-            state: self.state,
-            observed: self.observed,
+            state,
+            observed,
             light: snapshot.light,
             light_time_left: snapshot.light_time_left,
             events,
@@ -389,8 +394,8 @@ impl Env {
     fn observation(&self) -> Observation {
         match self.config.observation {
             ObservationForm::Discrete => Observation::Discrete {
-                state: self.observed,
-                index: self.disc.encode(self.observed),
+                state: self.observed(),
+                index: self.disc.encode(self.observed()),
             },
             ObservationForm::Kinematic => {
                 let mut v = vec![0.0; kinematic::len(self.config.pedestrian_slots)];

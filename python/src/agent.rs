@@ -73,13 +73,13 @@ pub fn scaled_params(params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParam
             // Text goes the way `--set KEY=TEXT` does (the same parsing and messages);
             // numbers and bools as typed values.
             if let Ok(text) = v.extract::<String>() {
-                unforeseen::overrides::set_one(&mut p, &key, &text).map_err(errors::py)?;
+                unforeseen::overrides::set_one(&mut p, &key, &text).map_err(errors::to_py)?;
             } else {
-                unforeseen::overrides::set_value(&mut p, &key, json_value(&key, &v)?).map_err(errors::py)?;
+                unforeseen::overrides::set_value(&mut p, &key, json_value(&key, &v)?).map_err(errors::to_py)?;
             }
         }
     }
-    unforeseen::overrides::apply(p, &[]).map_err(errors::py)
+    unforeseen::overrides::apply(p, &[]).map_err(errors::to_py)
 }
 
 /// A trained agent (an agent file's content).
@@ -217,7 +217,7 @@ fn scripted_controller(method: &str, map: &str) -> PyResult<PyController> {
     let m = self::method(method)?;
     let map = crate::maps::load(map, None)?;
     let sizes = unforeseen_discretizer::Discretizer::new(&map.bins)
-        .map_err(errors::py)?
+        .map_err(errors::to_py)?
         .factor_sizes()
         .to_vec();
     let c = m.scripted_controller(&sizes).map_err(errors::to_py)?.ok_or_else(|| {
@@ -401,7 +401,7 @@ fn evaluate_json(
         "aggregate": agg,
         "episodes": results,
     }))
-    .map_err(errors::py)
+    .map_err(errors::to_py)
 }
 
 /// Registers the classes and functions.

@@ -43,7 +43,7 @@ pub fn new_env(map: &Map, form: ObservationForm, pedestrian_slots: usize) -> PyR
             pedestrian_slots,
         },
     )
-    .map_err(errors::py)
+    .map_err(errors::to_py)
 }
 
 /// Checks an action given from Python (any integer) and returns it as an index.
@@ -144,7 +144,7 @@ impl PyEnv {
     /// The map as JSON (every field, in SI units).
     #[getter]
     fn map_json(&self) -> PyResult<String> {
-        serde_json::to_string(self.env.map()).map_err(errors::py)
+        serde_json::to_string(self.env.map()).map_err(errors::to_py)
     }
 
     /// "discrete" or "kinematic".
@@ -213,7 +213,7 @@ impl PyEnv {
 
     /// One decision tick: `(observation, reward, terminated, truncated, info)`.
     fn step<'py>(&mut self, py: Python<'py>, action: i64) -> PyResult<Bound<'py, PyTuple>> {
-        let step = self.env.step(action_index(action)?).map_err(errors::py)?;
+        let step = self.env.step(action_index(action)?).map_err(errors::to_py)?;
         (
             observation(py, &step.observation),
             step.reward,
@@ -296,7 +296,7 @@ pub fn rust_loop(
         let mut episodes = 0;
         env.reset(stream_seed(seed, 0));
         for t in 0..steps {
-            let step = env.step(actions[t as usize % actions.len()]).map_err(errors::py)?;
+            let step = env.step(actions[t as usize % actions.len()]).map_err(errors::to_py)?;
             std::hint::black_box(&step);
             if step.terminated || step.truncated {
                 episodes += 1;

@@ -53,11 +53,6 @@ pub fn to_py<E: std::error::Error + 'static>(err: E) -> PyErr {
     }
 }
 
-/// [`to_py`] under the name the binding's call sites use for any library error.
-pub fn py<E: std::error::Error + 'static>(err: E) -> PyErr {
-    to_py(err)
-}
-
 /// A `ValueError` with `message`.
 pub fn value(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())

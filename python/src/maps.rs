@@ -15,7 +15,7 @@ const BASE: &str = "<the map being overridden>";
 
 /// Loads `arg` (a map file or an embedded name) and applies `overrides`.
 pub fn load(arg: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Map> {
-    let map = unforeseen::maps::load(arg).map_err(errors::py)?;
+    let map = unforeseen::maps::load(arg).map_err(errors::to_py)?;
     match overrides {
         Some(o) if !o.is_empty() => {
             let mut fields = Vec::new();
@@ -136,5 +136,5 @@ fn patch(map: &Map, arg: &str, fields: &[(String, String)]) -> PyResult<Map> {
     Map::from_str_named(&origin, &text, &|b| {
         (b == BASE).then(|| (arg.to_string(), base.clone()))
     })
-    .map_err(errors::py)
+    .map_err(errors::to_py)
 }

@@ -99,9 +99,9 @@ fn compare_json(
         train_episodes: agents.first().and_then(|a| a.train_episodes),
         episodes,
         action_selection: format!("{:?}", p.scaling.action_selection),
-        scaled_params: serde_json::to_value(&p).map_err(errors::py)?,
+        scaled_params: serde_json::to_value(&p).map_err(errors::to_py)?,
     };
-    serde_json::to_string(&report).map_err(errors::py)
+    serde_json::to_string(&report).map_err(errors::to_py)
 }
 
 static RUN: AtomicU64 = AtomicU64::new(0);
@@ -168,7 +168,7 @@ fn batch_json(
             sets.push(format!("{key}={joined}"));
         }
     }
-    let params = unforeseen::batch::sweep(&sets).map_err(errors::py)?;
+    let params = unforeseen::batch::sweep(&sets).map_err(errors::to_py)?;
     let axis: Vec<Option<u64>> = agents.iter().map(|a| a.train_seed).collect();
     let identity = format!(
         "python agents {}",
@@ -200,7 +200,7 @@ fn batch_json(
     let _ = std::fs::remove_file(&out);
     let lines = lines.map_err(errors::to_py)?;
     let summary = unforeseen::batch::summarize(&lines);
-    serde_json::to_string(&serde_json::json!({"lines": lines, "summary": summary})).map_err(errors::py)
+    serde_json::to_string(&serde_json::json!({"lines": lines, "summary": summary})).map_err(errors::to_py)
 }
 
 /// Registers the functions.

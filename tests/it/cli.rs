@@ -4,28 +4,10 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn unforeseen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_unforeseen"))
-        .args(args)
-        .output()
-        .expect("run the binary")
-}
-
-fn text(out: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    )
-}
+use crate::common::{output_text as text, run_cli as unforeseen};
 
 fn assert_bad_input(out: &Output, needles: &[&str]) {
-    let all = text(out);
-    assert_eq!(out.status.code(), Some(2), "exit code 2 expected:\n{all}");
-    assert!(!all.contains("panicked"), "panic:\n{all}");
-    for n in needles {
-        assert!(all.contains(n), "message should contain {n:?}:\n{all}");
-    }
+    crate::common::assert_exit(out, 2, needles);
 }
 
 #[test]

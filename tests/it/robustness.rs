@@ -11,26 +11,7 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_unforeseen"))
 }
 
-fn unforeseen(args: &[&str]) -> Output {
-    bin().args(args).output().expect("run the binary")
-}
-
-fn text(out: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    )
-}
-
-fn assert_code(out: &Output, code: i32, needles: &[&str]) {
-    let all = text(out);
-    assert_eq!(out.status.code(), Some(code), "exit code {code} expected:\n{all}");
-    assert!(!all.contains("panicked"), "panic:\n{all}");
-    for n in needles {
-        assert!(all.contains(n), "message should contain {n:?}:\n{all}");
-    }
-}
+use crate::common::{assert_exit as assert_code, output_text as text, run_cli as unforeseen};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
