@@ -34,6 +34,8 @@
 //!   them (the benches' in-loop reasoning tick);
 //! * [`batch`] plans and runs scenario suites and sweeps headless, in parallel and in
 //!   shards;
+//! * [`search`] searches a space of map variations for the fair scenarios where a
+//!   method fails (Sobol stage, cross-entropy stage, minimisation);
 //! * [`error`] is the library's typed error, which every public function returns;
 //! * [`progress`] is how long runs report progress ([`progress::Progress`]); the library
 //!   itself prints nothing;
@@ -61,6 +63,7 @@ pub mod replay;
 pub mod report;
 pub mod rewards;
 pub mod runner;
+pub mod search;
 pub mod seeds;
 pub mod stats;
 pub mod study;

@@ -66,6 +66,7 @@ pub mod outputs;
 pub mod params;
 pub mod plot_sweep;
 pub mod progress;
+pub mod search;
 pub mod signals;
 pub mod table;
 pub mod trace;
@@ -86,6 +87,7 @@ an --out that is not a results file unless --force; no output may be an input):
   batch         results.jsonl and results.summary.json
   plot-sweep    sweep.svg
   export-model  out/model.json
+  search        out/search/: candidates.jsonl, summary.json, search.svg, failures/*.ron
 Progress: bars on a terminal; otherwise one line per phase on stderr (-q: none).
 Architecture and equations: docs/ARCHITECTURE.md in the repository.";
 
@@ -120,6 +122,8 @@ pub enum Command {
     PlotSweep(plot_sweep::PlotSweepArgs),
     /// Cross-check the agent's math on a single-factor model given as JSON (pymdp layout).
     Inspect(inspect::InspectArgs),
+    /// Search a space of map variations for the fair scenarios where a method fails.
+    Search(search::SearchArgs),
     /// Write a trained agent's planning model in the `inspect` JSON layout (for pymdp).
     ExportModel(export_model::ExportModelArgs),
 }
@@ -141,6 +145,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::ExportModel(args) => export_model::run(args),
         Command::Batch(args) => batch::run_cli(args),
         Command::PlotSweep(args) => plot_sweep::run(args),
+        Command::Search(args) => search::run(args),
     }
 }
 

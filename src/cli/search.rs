@@ -1,0 +1,222 @@
+//! `unforeseen search`: search a space of map variations for the fair scenarios where a
+//! method fails (`crate::search`).
+
+use clap::Args;
+use std::path::PathBuf;
+
+use super::progress::{self, Bars};
+use super::train_seeds::TrainSeedArgs;
+use crate::agents::Agent;
+use crate::batch::{Shard, agent_file_identity, trained_agents_identity};
+use crate::maps;
+use crate::methods::Method;
+use crate::protocol::Protocol;
+use crate::search::{self, SearchConfig, Space, Summary};
+use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
+
+/// Arguments of `search`.
+#[derive(Debug, Clone, Args)]
+pub struct SearchArgs {
+    /// Base map (file or embedded name) that the space varies.
+    #[arg(long, value_name = "MAP", default_value = "jaywalk")]
+    pub map: String,
+    /// Space file (RON; maps/README.md, "Space files"), e.g. maps/spaces/jaywalk.ron.
+    #[arg(long, value_name = "FILE")]
+    pub space: PathBuf,
+    /// The method searched for failures.
+    #[arg(long, default_value = "scaled", value_parser = super::method_parser())]
+    pub method: Method,
+    /// The method's evaluation protocol on each candidate.
+    #[arg(long, default_value = "zero-shot", value_parser = super::protocol_parser())]
+    pub protocol: Protocol,
+    /// Candidates of the Sobol and adaptive stages (minimisation tries come on top).
+    #[arg(long, default_value_t = 100)]
+    pub budget: usize,
+    /// Episodes per candidate, for each witness and for the method (per training seed).
+    #[arg(long, default_value_t = 20, value_parser = super::episodes)]
+    pub episodes: u64,
+    /// Run seed: Sobol scrambling, adaptive draws and every episode derive from it.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    /// Share of the budget for the Sobol stage (the unbiased estimate), in (0, 1].
+    #[arg(long, default_value_t = search::DEFAULT_SOBOL_SHARE)]
+    pub sobol_share: f64,
+    /// Rounds of the adaptive (cross-entropy) stage.
+    #[arg(long, default_value_t = search::DEFAULT_ROUNDS)]
+    pub rounds: usize,
+    /// Failures minimised and written as maps.
+    #[arg(long, default_value_t = search::DEFAULT_MAX_FAILURES)]
+    pub max_failures: usize,
+    /// Worker threads (results do not depend on it).
+    #[arg(long, default_value_t = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1))]
+    pub jobs: usize,
+    /// Evaluate only shard I of N of the Sobol stage (no adaptive stage, no
+    /// minimisation); concatenate the shards' candidates.jsonl and finish with --resume.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<Shard>,
+    /// Keep the complete candidates in --out/candidates.jsonl (of the same search) and
+    /// evaluate only the rest.
+    #[arg(long)]
+    pub resume: bool,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/search")]
+    pub out: PathBuf,
+    /// Training episodes when no --agent is given.
+    #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
+    pub train_episodes: u64,
+    /// Agent file from `unforeseen train` (default: train on the embedded intersection map).
+    #[arg(long, value_name = "FILE")]
+    pub agent: Option<PathBuf>,
+    /// Training seeds and the agent cache.
+    #[command(flatten)]
+    pub seeds: TrainSeedArgs,
+    /// No progress bars.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Runs `search`.
+pub fn run(args: SearchArgs) -> anyhow::Result<()> {
+    if !(1..=super::MAX_JOBS).contains(&args.jobs) {
+        return Err(crate::error::Error::flag("--jobs", "expected 1 to 256 worker threads").into());
+    }
+    let base = maps::load(&args.map)?;
+    let space = Space::load(&args.space, &base)?;
+    super::outputs::dir("--out", &args.out)?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs).build()?;
+    let (agents, train_seeds, agents_identity): (Vec<Agent>, Vec<Option<u64>>, String) = if args.method.is_scripted() {
+        (Vec::new(), vec![None], "none (a scripted method)".into())
+    } else {
+        match &args.seeds.train_seeds {
+            Some(seeds) => {
+                let axis: Vec<Option<u64>> = seeds.0.iter().map(|&s| Some(s)).collect();
+                let identity = trained_agents_identity(&maps::load(DEFAULT_TRAIN_MAP)?, &axis, args.train_episodes)?;
+                let agents =
+                    pool.install(|| args.seeds.train(&seeds.0, DEFAULT_TRAIN_MAP, args.train_episodes, args.quiet))?;
+                (agents, axis, identity)
+            }
+            None => {
+                let bundle = pool.install(|| {
+                    super::load_or_train(
+                        args.agent.as_deref(),
+                        DEFAULT_TRAIN_MAP,
+                        args.train_episodes,
+                        args.seed,
+                        args.quiet,
+                    )
+                })?;
+                let identity = match &args.agent {
+                    Some(_) => agent_file_identity(&bundle),
+                    None => trained_agents_identity(
+                        &maps::load(DEFAULT_TRAIN_MAP)?,
+                        &[Some(args.seed)],
+                        args.train_episodes,
+                    )?,
+                };
+                let agent = Agent::from_bundle(bundle);
+                let axis = vec![agent.train_seed];
+                (vec![agent], axis, identity)
+            }
+        }
+    };
+    let command = std::iter::once("unforeseen".to_string())
+        .chain(std::env::args().skip(1))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let cfg = SearchConfig {
+        space: &space,
+        method: args.method,
+        agents: &agents,
+        train_seeds: &train_seeds,
+        agents_identity,
+        protocol: args.protocol,
+        budget: args.budget,
+        episodes: args.episodes,
+        seed: args.seed,
+        jobs: args.jobs,
+        shard: args.shard,
+        sobol_share: args.sobol_share,
+        rounds: args.rounds,
+        max_failures: args.max_failures,
+        command,
+    };
+    cfg.check()?;
+    progress::phase(
+        args.quiet,
+        format_args!(
+            "searching {} ({} parameters over {}) for failures of {} ({}): {} candidates ({} Sobol), {} episodes each, on {} thread(s), into {}",
+            space.name,
+            space.params.len(),
+            base.name,
+            args.method.name(),
+            args.protocol.name(),
+            args.budget,
+            cfg.sobol_count(),
+            args.episodes,
+            args.jobs,
+            args.out.display()
+        ),
+    );
+    let summary = search::run(&cfg, &args.out, args.resume, &Bars::new(args.quiet))?;
+    print_summary(&summary, &args);
+    Ok(())
+}
+
+fn print_summary(s: &Summary, args: &SearchArgs) {
+    let c = &s.counts;
+    outln!(
+        "candidates: {} Sobol, {} adaptive, {} minimisation tries; {} rejected (not valid maps)",
+        c.sobol,
+        c.adaptive,
+        c.minimise,
+        c.rejected
+    );
+    outln!(
+        "evaluated {}: {} fair, {} not survivable, {} not dangerous, {} neither; fair failures: {} Sobol, {} adaptive",
+        c.evaluated,
+        c.fair,
+        c.not_survivable,
+        c.not_dangerous,
+        c.neither,
+        c.failing_fair_sobol,
+        c.failing_fair_adaptive
+    );
+    outln!("fair share of the space (Sobol stage): {}", s.fair_share.text());
+    for e in &s.failure_probability {
+        let who = e.train_seed.map_or("with the given agent".to_string(), |t| format!("training seed {t}"));
+        outln!(
+            "P({} fails | fair), {who}: {}",
+            args.method.name(),
+            e.failure_probability.text()
+        );
+    }
+    if let Some(st) = &s.failure_probability_over_seeds
+        && st.n > 1
+    {
+        let ci = match (st.ci95_low, st.ci95_high) {
+            (Some(l), Some(h)) => format!(" [{:.1}, {:.1}]", 100.0 * l, 100.0 * h),
+            _ => String::new(),
+        };
+        outln!(
+            "over {} training seeds: mean {:.1}%{ci} (95% Student t), range {:.1}..{:.1}%",
+            st.n,
+            100.0 * st.mean,
+            100.0 * st.min,
+            100.0 * st.max
+        );
+    }
+    for f in &s.failures {
+        let changed: Vec<String> = f.changed.iter().map(|(n, _, v)| format!("{n}={v}")).collect();
+        outln!(
+            "failure {}: {} (from candidate {}; changes {})",
+            f.name,
+            f.file.display(),
+            f.found_as,
+            if changed.is_empty() { "nothing".into() } else { changed.join(", ") }
+        );
+    }
+    outln!(
+        "wrote {}/{{candidates.jsonl, summary.json, search.svg, failures/}}",
+        args.out.display()
+    );
+}
