@@ -1,0 +1,300 @@
+//! `unforeseen search`: space files and their errors, candidates as valid maps,
+//! determinism over seeds, jobs and shards, resume, minimisation and fairness. Budgets
+//! are a few candidates of a few episodes, on a small space.
+
+use std::path::Path;
+use unforeseen::agents::Agent;
+use unforeseen::batch::Shard;
+use unforeseen::methods::Method;
+use unforeseen::progress::NoProgress;
+use unforeseen::protocol::Protocol;
+use unforeseen::search::{self, Fairness, SearchConfig, Space, Value, sobol_candidates};
+use unforeseen::survivability::witness;
+use unforeseen_sim::Map;
+
+use crate::common::{assert_exit, bundle, run_cli};
+
+fn jaywalk() -> Map {
+    unforeseen::maps::load("jaywalk").expect("embedded jaywalk")
+}
+
+/// A small space: three parameters of the jaywalk.
+const SMALL: &str = r#"Space(
+    name: "small",
+    params: [
+        (field: "pedestrians[0].trigger.value", range: (2.5, 6.0)),
+        (field: "pedestrians[0].side", choose: ["Near", "Far"]),
+        (field: "vehicle.start_speed", range: (1.0, 5.0)),
+    ],
+)"#;
+
+fn small() -> Space {
+    Space::parse("small.ron", SMALL, &jaywalk()).expect("the small space is valid")
+}
+
+fn shipped() -> Space {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps/spaces/jaywalk.ron");
+    Space::load(&path, &jaywalk()).expect("the shipped space is valid")
+}
+
+/// The diagnostics of a bad space, one per line.
+fn errors(text: &str) -> String {
+    Space::parse("bad.ron", text, &jaywalk()).expect_err("a bad space").to_string()
+}
+
+#[test]
+fn space_file_errors_name_the_file_line_column_and_fix() {
+    let unknown = errors("Space(\n    params: [\n        (field: \"vehicle.start_speed\", rnage: (1.0, 2.0)),\n    ],\n)");
+    assert!(unknown.starts_with("bad.ron:3:"), "{unknown}");
+    assert!(unknown.contains("rnage") && unknown.contains("hint: the fields here are"), "{unknown}");
+
+    let empty = errors("Space(\n  params: [\n    (field: \"vehicle.start_speed\", range: (3.0, 1.0)),\n  ],\n)");
+    assert!(empty.starts_with("bad.ron:3:13: params[0]: an empty range"), "{empty}");
+    assert!(empty.contains("hint: write range: (low, high) with low < high"), "{empty}");
+
+    let outside = errors("Space(params: [\n (field: \"pedestrians[0].speed\", range: (0.5, 20.0)),\n])");
+    assert!(outside.starts_with("bad.ron:2:9: params[0]: the range (0.5, 20) leaves the map limits [0.01, 12] m/s"), "{outside}");
+    assert!(outside.contains("hint: keep the range within"), "{outside}");
+
+    let field = errors("Space(params: [(field: \"vehicle.top_speed\", range: (1.0, 2.0))])");
+    assert!(field.starts_with("bad.ron:1:24: params[0]: unknown field `vehicle.top_speed`"), "{field}");
+    assert!(field.contains("vehicle.max_speed"), "{field}");
+
+    let rule = errors("Space(params: [(field: \"pedestrians[3].speed\", range: (1.0, 2.0))])");
+    assert!(rule.contains("pedestrian rule 3 does not exist"), "{rule}");
+
+    let choice = errors("Space(params: [(field: \"pedestrians[0].side\", choose: [\"Near\", \"Left\"])])");
+    assert!(choice.contains("unknown choice `Left`") && choice.contains("Near, Far, Random"), "{choice}");
+
+    let syntax = errors("Space(params: [(field: \"vehicle.start_speed\", range: (1.0, 2.0)]");
+    assert!(syntax.starts_with("bad.ron:1:"), "{syntax}");
+}
+
+#[test]
+fn every_point_is_a_valid_map_or_a_rejection_with_a_reason() {
+    let space = shipped();
+    let dims = space.params.len();
+    let mut points: Vec<Vec<f64>> = vec![vec![0.0; dims], vec![0.999_999; dims], vec![1.0; dims]];
+    points.extend(sobol_candidates(&space, 3, 0..200).into_iter().map(|c| c.point));
+    for (i, p) in points.iter().enumerate() {
+        let values = space.values_at(p);
+        match space.apply(&values, &format!("p{i}")) {
+            Ok(map) => {
+                // The loader reads the map it writes back as the same map.
+                let text = search::space::map_ron(&map).expect("writes");
+                let again = Map::from_str_named("again.ron", &text, &|_| None).expect("a valid map");
+                assert_eq!(again, map);
+            }
+            Err(reason) => assert!(!reason.is_empty(), "point {i}: a rejection without a reason"),
+        }
+    }
+    // A range whose points can break the map's rules: rejected, with the loader's reason.
+    let risky = "Space(params: [(field: \"pedestrians[0].speed\", range: (11.0, 12.0))])";
+    let space = Space::parse("risky.ron", risky, &jaywalk()).expect("within the limits");
+    let reason = space
+        .apply(&[Value::Num(11.9)], "risky")
+        .expect_err("11.9..12.1 m/s exceeds the speed limit");
+    assert!(reason.contains("pedestrians[0].speed"), "{reason}");
+}
+
+#[test]
+fn the_same_seed_gives_the_same_candidates() {
+    let space = shipped();
+    let a = sobol_candidates(&space, 7, 0..64);
+    assert_eq!(a, sobol_candidates(&space, 7, 0..64));
+    assert_ne!(a, sobol_candidates(&space, 8, 0..64));
+    // A slice of the sequence is the same candidates as in the whole.
+    assert_eq!(&a[10..20], &sobol_candidates(&space, 7, 10..20)[..]);
+}
+
+fn config<'a>(space: &'a Space, agents: &'a [Agent], seeds: &'a [Option<u64>], jobs: usize) -> SearchConfig<'a> {
+    SearchConfig {
+        space,
+        method: Method::QLearning,
+        agents,
+        train_seeds: seeds,
+        agents_identity: "test agent".into(),
+        protocol: Protocol::ZeroShot,
+        budget: 8,
+        episodes: 3,
+        seed: 5,
+        jobs,
+        shard: None,
+        sobol_share: 0.5,
+        rounds: 2,
+        max_failures: 1,
+        command: "test".into(),
+    }
+}
+
+/// The file's text without the one clock-measured figure of each line.
+fn untimed(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).expect("read");
+    text.lines()
+        .map(|l| {
+            let mut v: serde_json::Value = serde_json::from_str(l).expect("json");
+            if let Some(o) = v.as_object_mut() {
+                o.remove("timing_us_per_tick");
+            }
+            v.to_string()
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn summary_untimed(path: &Path) -> String {
+    std::fs::read_to_string(path.join("summary.json")).expect("summary")
+}
+
+#[test]
+fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
+    let space = small();
+    let agents = [Agent::from_bundle(bundle().clone())];
+    let seeds = [agents[0].train_seed];
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (one, two) = (dir.path().join("one"), dir.path().join("two"));
+    let s1 = search::run(&config(&space, &agents, &seeds, 1), &one, false, &NoProgress).expect("runs");
+    let s2 = search::run(&config(&space, &agents, &seeds, 2), &two, false, &NoProgress).expect("runs");
+    assert_eq!(untimed(&one.join("candidates.jsonl")), untimed(&two.join("candidates.jsonl")));
+    let strip = |s: String, d: &Path| s.replace(&d.display().to_string(), "DIR");
+    assert_eq!(strip(summary_untimed(&one), &one), strip(summary_untimed(&two), &two));
+    assert_eq!(s1.counts, s2.counts);
+    std::fs::metadata(one.join("search.svg")).expect("the figure is written");
+    // Every line after the identity is a batch result line.
+    let lines = search::output::read_result_lines(&one.join("candidates.jsonl")).expect("batch lines");
+    assert!(lines.len() % 3 == 0 && lines.len() >= 3 * s1.counts.evaluated, "{}", lines.len());
+    // q-learning drives on in the jaywalk: the search finds a fair failure, and the
+    // minimised scenario is one measured to fail, fairly.
+    assert!(!s1.failures.is_empty(), "q-learning should fail somewhere fair: {:?}", s1.counts);
+    for f in &s1.failures {
+        assert!(f.brake_on_pedestrian_success >= 0.99 && f.never_brake_success <= 0.2, "{f:?}");
+        assert!(f.method_success.iter().all(|&(_, s)| s < 0.5), "{f:?}");
+        // The written map is that scenario: re-run as batch would, it fails again.
+        let map = unforeseen::maps::load_file(&f.file).expect("a valid map file");
+        let results = unforeseen::experiments::evaluate_under(
+            Protocol::ZeroShot,
+            &map,
+            bundle(),
+            &Default::default(),
+            Method::QLearning,
+            3,
+            5,
+            &NoProgress,
+        )
+        .expect("runs");
+        let agg = unforeseen::metrics::Aggregate::of(&results);
+        assert_eq!(Some(agg.success_rate), f.method_success.first().map(|s| s.1));
+        assert!(witness(&map, Method::BrakeOnPedestrian, 3, 5).expect("runs").success_rate >= 0.99);
+    }
+}
+
+#[test]
+fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
+    let space = small();
+    let agents = [Agent::from_bundle(bundle().clone())];
+    let seeds = [agents[0].train_seed];
+    let dir = tempfile::tempdir().expect("tempdir");
+    let whole = dir.path().join("whole");
+    search::run(&config(&space, &agents, &seeds, 2), &whole, false, &NoProgress).expect("runs");
+    let mut parts = String::new();
+    for i in 1..=2 {
+        let d = dir.path().join(format!("shard{i}"));
+        let cfg = SearchConfig {
+            shard: Some(Shard { index: i, count: 2 }),
+            ..config(&space, &agents, &seeds, 2)
+        };
+        let s = search::run(&cfg, &d, false, &NoProgress).expect("runs");
+        assert_eq!(s.counts.adaptive + s.counts.minimise, 0, "a shard runs only the Sobol stage");
+        parts.push_str(&std::fs::read_to_string(d.join("candidates.jsonl")).expect("read"));
+    }
+    let joined = dir.path().join("joined");
+    std::fs::create_dir_all(&joined).expect("mkdir");
+    std::fs::write(joined.join("candidates.jsonl"), &parts).expect("write");
+    // The shards' lines are the whole run's Sobol lines, in order.
+    let sobol_of = |text: String| -> Vec<String> {
+        text.lines()
+            .filter(|l| l.contains("\"stage\":\"sobol\""))
+            .map(str::to_string)
+            .collect()
+    };
+    assert_eq!(
+        sobol_of(untimed(&joined.join("candidates.jsonl"))),
+        sobol_of(untimed(&whole.join("candidates.jsonl")))
+    );
+    // Resumed, the concatenation becomes the whole run's file.
+    search::run(&config(&space, &agents, &seeds, 1), &joined, true, &NoProgress).expect("resumes");
+    assert_eq!(untimed(&joined.join("candidates.jsonl")), untimed(&whole.join("candidates.jsonl")));
+
+    // A killed run (cut mid-line) resumes to the same file; the kept lines stay as written.
+    let killed = dir.path().join("killed");
+    std::fs::create_dir_all(&killed).expect("mkdir");
+    let full = std::fs::read_to_string(whole.join("candidates.jsonl")).expect("read");
+    let cut = &full[..full.len() * 3 / 5];
+    std::fs::write(killed.join("candidates.jsonl"), cut).expect("write");
+    search::run(&config(&space, &agents, &seeds, 2), &killed, true, &NoProgress).expect("resumes");
+    let resumed = std::fs::read_to_string(killed.join("candidates.jsonl")).expect("read");
+    let complete = &cut[..cut.rfind('\n').expect("lines") + 1];
+    assert!(resumed.starts_with(&complete[..complete.len() / 2]), "kept lines are copied byte for byte");
+    assert_eq!(untimed(&killed.join("candidates.jsonl")), untimed(&whole.join("candidates.jsonl")));
+
+    // Another run's file is refused, saying what differs.
+    let other = SearchConfig {
+        seed: 6,
+        ..config(&space, &agents, &seeds, 1)
+    };
+    let err = search::run(&other, &whole, true, &NoProgress).expect_err("another search");
+    assert!(err.to_string().contains("seed: the file has 5, this run 6"), "{err}");
+}
+
+#[test]
+fn fairness_of_known_maps() {
+    let of = |map: &Map| {
+        let b = witness(map, Method::BrakeOnPedestrian, 10, 7).expect("runs");
+        let n = witness(map, Method::NeverBrake, 10, 7).expect("runs");
+        Fairness::of(b.success_rate, n.success_rate)
+    };
+    assert_eq!(of(&jaywalk()), Fairness::Fair);
+    // The same jaywalker stepping out 1.5 s before the car arrives: nobody can stop.
+    let mut late = jaywalk();
+    late.pedestrians[0].trigger = unforeseen_sim::Trigger::CarArrivesWithin(1.5);
+    late.pedestrians[0].side = unforeseen_sim::Side::Near;
+    assert_eq!(of(&late), Fairness::NotSurvivable);
+    // Nobody on the road: driving on is safe.
+    let mut empty = jaywalk();
+    empty.pedestrians.clear();
+    assert_eq!(of(&empty), Fairness::NotDangerous);
+}
+
+#[test]
+fn the_cli_exits_2_on_bad_space_files() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let bad = dir.path().join("bad.ron");
+    std::fs::write(
+        &bad,
+        "Space(\n    params: [\n        (field: \"vehicle.max_brake\", range: (0.0, 3.0)),\n    ],\n)\n",
+    )
+    .expect("write");
+    let out = dir.path().join("out");
+    let run = |space: &Path| {
+        run_cli(&[
+            "search",
+            "--space",
+            space.to_str().expect("utf-8"),
+            "--method",
+            "brake-on-pedestrian",
+            "--budget",
+            "2",
+            "--episodes",
+            "1",
+            "-q",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ])
+    };
+    let shown = format!("{}:3:17: params[0]: the range (0, 3) leaves the map limits", bad.display());
+    assert_exit(&run(&bad), 2, &[&shown, "hint: keep the range within [0.1, 20]"]);
+    std::fs::write(&bad, "Space(params: [(field: \"vehicle.start_speed\", range: (1.0, 2.0), step: 1)])").expect("write");
+    assert_exit(&run(&bad), 2, &[&format!("{}:1:", bad.display()), "step"]);
+    assert_exit(&run(&dir.path().join("missing.ron")), 2, &["missing.ron", "cannot read the space file"]);
+    assert!(!out.join("candidates.jsonl").exists(), "nothing is written for a bad space");
+}
