@@ -91,8 +91,10 @@ pub fn run(args: SearchArgs) -> anyhow::Result<()> {
             Some(seeds) => {
                 let axis: Vec<Option<u64>> = seeds.0.iter().map(|&s| Some(s)).collect();
                 let identity = trained_agents_identity(&maps::load(DEFAULT_TRAIN_MAP)?, &axis, args.train_episodes)?;
-                let agents =
-                    pool.install(|| args.seeds.train(&seeds.0, DEFAULT_TRAIN_MAP, args.train_episodes, args.quiet))?;
+                let agents = pool.install(|| {
+                    args.seeds
+                        .train(&seeds.0, DEFAULT_TRAIN_MAP, args.train_episodes, args.quiet)
+                })?;
                 (agents, axis, identity)
             }
             None => {
@@ -183,7 +185,9 @@ fn print_summary(s: &Summary, args: &SearchArgs) {
     );
     outln!("fair share of the space (Sobol stage): {}", s.fair_share.text());
     for e in &s.failure_probability {
-        let who = e.train_seed.map_or("with the given agent".to_string(), |t| format!("training seed {t}"));
+        let who = e
+            .train_seed
+            .map_or("with the given agent".to_string(), |t| format!("training seed {t}"));
         outln!(
             "P({} fails | fair), {who}: {}",
             args.method.name(),
@@ -212,7 +216,11 @@ fn print_summary(s: &Summary, args: &SearchArgs) {
             f.name,
             f.file.display(),
             f.found_as,
-            if changed.is_empty() { "nothing".into() } else { changed.join(", ") }
+            if changed.is_empty() {
+                "nothing".into()
+            } else {
+                changed.join(", ")
+            }
         );
     }
     outln!(

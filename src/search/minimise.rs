@@ -77,7 +77,11 @@ pub(super) fn minimise_all(
 ) -> Result<(Vec<Minimised>, Vec<Evaluated>), Error> {
     let cfg = runner.cfg;
     let mut failures: Vec<&Evaluated> = all.iter().filter(|e| e.fails_fairly()).collect();
-    failures.sort_by(|a, b| a.score().total_cmp(&b.score()).then(a.candidate.index.cmp(&b.candidate.index)));
+    failures.sort_by(|a, b| {
+        a.score()
+            .total_cmp(&b.score())
+            .then(a.candidate.index.cmp(&b.candidate.index))
+    });
     failures.truncate(cfg.max_failures);
     runner.progress.phase("search minimise", failures.len() as u64);
     let done: Vec<(Minimised, Vec<Evaluated>)> = failures
@@ -102,7 +106,11 @@ pub(super) fn minimise_all(
 }
 
 /// Minimises one failure, the `rank`-th best.
-fn minimise_one(runner: &Runner<'_, '_>, rank: usize, failure: &Evaluated) -> Result<(Minimised, Vec<Evaluated>), Error> {
+fn minimise_one(
+    runner: &Runner<'_, '_>,
+    rank: usize,
+    failure: &Evaluated,
+) -> Result<(Minimised, Vec<Evaluated>), Error> {
     let cfg = runner.cfg;
     let space = cfg.space;
     let first = cfg.budget + rank * steps_per_failure(space);

@@ -273,7 +273,12 @@ impl Candidate {
 
     /// `(parameter, value)` pairs, in the space's order.
     pub fn named_values(&self, space: &Space) -> Vec<(String, Value)> {
-        space.params.iter().map(|p| p.name.clone()).zip(self.values.iter().cloned()).collect()
+        space
+            .params
+            .iter()
+            .map(|p| p.name.clone())
+            .zip(self.values.iter().cloned())
+            .collect()
     }
 }
 
@@ -371,7 +376,10 @@ impl Evaluated {
 
     /// A witness's success rate.
     pub fn witness(&self, role: Role) -> Option<f64> {
-        self.lines.iter().find(|l| l.role == role).map(|l| l.result.success_rate)
+        self.lines
+            .iter()
+            .find(|l| l.role == role)
+            .map(|l| l.result.success_rate)
     }
 }
 
@@ -418,7 +426,10 @@ impl Runner<'_, '_> {
         };
         let named = candidate.named_values(self.cfg.space);
         if let Some(kept) = self.kept.get(&candidate.index) {
-            if let Some(bad) = kept.iter().find(|l| l.parsed.values != named || l.parsed.stage != candidate.stage) {
+            if let Some(bad) = kept
+                .iter()
+                .find(|l| l.parsed.values != named || l.parsed.stage != candidate.stage)
+            {
                 return Err(Error::Results {
                     path: self.out.to_path_buf(),
                     problem: format!(
@@ -459,6 +470,9 @@ impl Runner<'_, '_> {
     }
 }
 
+/// One evaluation of a candidate: its role, method, agent, training seed and figures.
+type Run<'a> = (Role, Method, Option<&'a Agent>, Option<u64>, Aggregate);
+
 /// Evaluates a candidate's map: the two witnesses, then the method for each training
 /// seed, `episodes` episodes each; its lines carry the fairness and failure verdicts.
 pub fn evaluate(
@@ -469,12 +483,18 @@ pub fn evaluate(
 ) -> Result<Vec<CandidateLine>, Error> {
     let params = ScaledParams::default();
     let scripted = |m: Method| -> Result<Aggregate, Error> {
-        Ok(Aggregate::of(&evaluate_scripted(map, m, cfg.episodes, cfg.seed, &NoProgress)?))
+        Ok(Aggregate::of(&evaluate_scripted(
+            map,
+            m,
+            cfg.episodes,
+            cfg.seed,
+            &NoProgress,
+        )?))
     };
     let brake = scripted(Method::BrakeOnPedestrian)?;
     let never = scripted(Method::NeverBrake)?;
     let fair = Fairness::of(brake.success_rate, never.success_rate);
-    let mut runs: Vec<(Role, Method, Option<&Agent>, Option<u64>, Aggregate)> = vec![
+    let mut runs: Vec<Run<'_>> = vec![
         (Role::SurvivableWitness, Method::BrakeOnPedestrian, None, None, brake),
         (Role::DangerousWitness, Method::NeverBrake, None, None, never),
     ];
@@ -667,7 +687,11 @@ pub fn run(cfg: &SearchConfig<'_>, out: &Path, resume: bool, progress: &dyn Prog
     cfg.check()?;
     std::fs::create_dir_all(out).map_err(|e| Error::io("create folder", out, e))?;
     let file = out.join(output::CANDIDATES);
-    let kept = if resume { resume_lines(cfg, &file)? } else { BTreeMap::new() };
+    let kept = if resume {
+        resume_lines(cfg, &file)?
+    } else {
+        BTreeMap::new()
+    };
     let head: String = std::iter::once(output::identity_line(&cfg.identity()))
         .chain(kept.values().flatten().map(|l| l.raw.clone()))
         .collect();

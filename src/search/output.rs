@@ -351,7 +351,13 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
     let changed: Vec<(String, Option<Value>, Value)> = m
         .changed
         .iter()
-        .map(|&i| (space.params[i].name.clone(), space.params[i].base.clone(), e.candidate.values[i].clone()))
+        .map(|&i| {
+            (
+                space.params[i].name.clone(),
+                space.params[i].base.clone(),
+                e.candidate.values[i].clone(),
+            )
+        })
         .collect();
     let method_success: Vec<(Option<u64>, f64)> = e
         .lines
@@ -384,7 +390,10 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
             space.source, space.base.name, m.of, m.tries, m.kept
         ),
     );
-    c(&mut text, "Parameters changed from the base (value, base value):".into());
+    c(
+        &mut text,
+        "Parameters changed from the base (value, base value):".into(),
+    );
     for (name, base, v) in &changed {
         let base = base.as_ref().map_or("none".into(), ToString::to_string);
         c(&mut text, format!("  {name} = {v} (base {base})"));
@@ -457,7 +466,11 @@ fn correlation(x: &[f64], y: &[f64]) -> f64 {
         sxx += (a - mx).powi(2);
         syy += (b - my).powi(2);
     }
-    if sxx <= 0.0 || syy <= 0.0 { 0.0 } else { sxy / (sxx * syy).sqrt() }
+    if sxx <= 0.0 || syy <= 0.0 {
+        0.0
+    } else {
+        sxy / (sxx * syy).sqrt()
+    }
 }
 
 /// The colour of a success rate: red (0) through amber to green (1).
@@ -474,7 +487,10 @@ fn success_colour(s: f64) -> RGBColor {
 fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<String>, Error> {
     let space = cfg.space;
     let evaluated: Vec<&Evaluated> = outcome.candidates.iter().filter(|e| e.fairness().is_some()).collect();
-    let fair: Vec<&&Evaluated> = evaluated.iter().filter(|e| e.fairness() == Some(Fairness::Fair)).collect();
+    let fair: Vec<&&Evaluated> = evaluated
+        .iter()
+        .filter(|e| e.fairness() == Some(Fairness::Fair))
+        .collect();
     let success: Vec<f64> = fair.iter().map(|e| e.mean_success().unwrap_or(1.0)).collect();
     let mut strength: Vec<(usize, f64)> = (0..space.params.len())
         .map(|d| {

@@ -204,7 +204,11 @@ impl Field {
             Field::ObservationNoise => (0.0, 0.999, "(a probability below 1)"),
             Field::CrosswalkX => {
                 let lo = base.vehicle.start_x + base.crosswalk.width / 2.0;
-                (lo, base.road.goal_x - base.crosswalk.width / 2.0, "m (between the car's start and the goal)")
+                (
+                    lo,
+                    base.road.goal_x - base.crosswalk.width / 2.0,
+                    "m (between the car's start and the goal)",
+                )
             }
         }
     }
@@ -339,8 +343,12 @@ impl Space {
                 hint: Some(hint.to_string()),
             }])
         };
-        let meta = std::fs::metadata(path)
-            .map_err(|e| one(format!("cannot read the space file: {e}"), "give the path of a space file (.ron)"))?;
+        let meta = std::fs::metadata(path).map_err(|e| {
+            one(
+                format!("cannot read the space file: {e}"),
+                "give the path of a space file (.ron)",
+            )
+        })?;
         if !meta.is_file() {
             return Err(one("not a regular file".into(), "give the path of a space file (.ron)"));
         }
@@ -350,9 +358,10 @@ impl Space {
                 "a space file lists a few parameters",
             ));
         }
-        let bytes = std::fs::read(path).map_err(|e| one(format!("cannot read the space file: {e}"), "check the path"))?;
-        let text = String::from_utf8(bytes)
-            .map_err(|_| one("not text (invalid UTF-8)".into(), "a space file is RON text"))?;
+        let bytes =
+            std::fs::read(path).map_err(|e| one(format!("cannot read the space file: {e}"), "check the path"))?;
+        let text =
+            String::from_utf8(bytes).map_err(|_| one("not text (invalid UTF-8)".into(), "a space file is RON text"))?;
         Space::parse(&origin, &text, base)
     }
 
@@ -415,7 +424,10 @@ impl Space {
             problems.push(diag(
                 None,
                 "rules",
-                format!("the base's and the space's rules are {n_rules}, more than {}", unforeseen_sim::MAX_SPAWN_RULES),
+                format!(
+                    "the base's and the space's rules are {n_rules}, more than {}",
+                    unforeseen_sim::MAX_SPAWN_RULES
+                ),
                 "add fewer rules".into(),
             ));
         }
@@ -454,7 +466,11 @@ impl Space {
                 && k >= base.light.cycle.len()
             {
                 bad(
-                    format!("the base map's light cycle has {} phase(s), not {}", base.light.cycle.len(), k + 1),
+                    format!(
+                        "the base map's light cycle has {} phase(s), not {}",
+                        base.light.cycle.len(),
+                        k + 1
+                    ),
                     format!("use an index below {}", base.light.cycle.len()),
                 );
                 continue;
@@ -470,7 +486,14 @@ impl Space {
                 (Some(allowed), _, None) => {
                     bad(
                         format!("`{}` is a named field: it takes `choose`", p.field),
-                        format!("write choose: [{}]", allowed.iter().map(|a| format!("\"{a}\"")).collect::<Vec<_>>().join(", ")),
+                        format!(
+                            "write choose: [{}]",
+                            allowed
+                                .iter()
+                                .map(|a| format!("\"{a}\""))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
                     );
                     continue;
                 }
@@ -483,11 +506,17 @@ impl Space {
                 }
                 (Some(allowed), None, Some(names)) => {
                     if names.is_empty() {
-                        bad("an empty `choose`: nothing to choose from".into(), format!("list some of {}", allowed.join(", ")));
+                        bad(
+                            "an empty `choose`: nothing to choose from".into(),
+                            format!("list some of {}", allowed.join(", ")),
+                        );
                         continue;
                     }
                     if let Some(n) = names.iter().find(|n| !allowed.contains(&n.as_str())) {
-                        bad(format!("unknown choice `{n}`"), format!("the choices are {}", allowed.join(", ")));
+                        bad(
+                            format!("unknown choice `{n}`"),
+                            format!("the choices are {}", allowed.join(", ")),
+                        );
                         continue;
                     }
                     if names.iter().enumerate().any(|(j, n)| names[..j].contains(n)) {
@@ -501,7 +530,8 @@ impl Space {
                     if !(lo.is_finite() && hi.is_finite()) || lo >= hi {
                         bad(
                             format!("an empty range ({lo}, {hi}): the low end must be below the high end"),
-                            "write range: (low, high) with low < high; to fix a value, set it in the base map instead".into(),
+                            "write range: (low, high) with low < high; to fix a value, set it in the base map instead"
+                                .into(),
                         );
                         continue;
                     }
@@ -526,9 +556,18 @@ impl Space {
                     }
                 }
             };
-            let rule_of = |r: usize| if r < n_base { &base.pedestrians[r] } else { &file.rules[r - n_base] };
+            let rule_of = |r: usize| {
+                if r < n_base {
+                    &base.pedestrians[r]
+                } else {
+                    &file.rules[r - n_base]
+                }
+            };
             if let Field::Rule(r, RuleField::TriggerValue) = field {
-                let kind_varies = file.params.iter().any(|q| Field::parse(&q.field) == Some(Field::Rule(r, RuleField::TriggerKind)));
+                let kind_varies = file
+                    .params
+                    .iter()
+                    .any(|q| Field::parse(&q.field) == Some(Field::Rule(r, RuleField::TriggerKind)));
                 if !kind_varies && trigger_value(&rule_of(r).trigger).is_none() {
                     bad(
                         format!("pedestrian rule {r}'s trigger {:?} has no number to vary", rule_of(r).trigger),
@@ -793,13 +832,11 @@ fn global_value(map: &Map, f: Field) -> Option<Value> {
 /// The 1-based line and column of the first `"field"` string in `text` outside comments.
 fn locate(text: &str, field: &str) -> Option<(usize, usize)> {
     let needle = format!("\"{field}\"");
-    let mut line = 1;
-    for l in text.lines() {
+    for (line, l) in (1..).zip(text.lines()) {
         let code = l.split("//").next().unwrap_or("");
         if let Some(i) = code.find(&needle) {
             return Some((line, code[..i].chars().count() + 1));
         }
-        line += 1;
     }
     None
 }

@@ -39,32 +39,50 @@ fn shipped() -> Space {
 
 /// The diagnostics of a bad space, one per line.
 fn errors(text: &str) -> String {
-    Space::parse("bad.ron", text, &jaywalk()).expect_err("a bad space").to_string()
+    Space::parse("bad.ron", text, &jaywalk())
+        .expect_err("a bad space")
+        .to_string()
 }
 
 #[test]
 fn space_file_errors_name_the_file_line_column_and_fix() {
-    let unknown = errors("Space(\n    params: [\n        (field: \"vehicle.start_speed\", rnage: (1.0, 2.0)),\n    ],\n)");
+    let unknown =
+        errors("Space(\n    params: [\n        (field: \"vehicle.start_speed\", rnage: (1.0, 2.0)),\n    ],\n)");
     assert!(unknown.starts_with("bad.ron:3:"), "{unknown}");
-    assert!(unknown.contains("rnage") && unknown.contains("hint: the fields here are"), "{unknown}");
+    assert!(
+        unknown.contains("rnage") && unknown.contains("hint: the fields here are"),
+        "{unknown}"
+    );
 
     let empty = errors("Space(\n  params: [\n    (field: \"vehicle.start_speed\", range: (3.0, 1.0)),\n  ],\n)");
     assert!(empty.starts_with("bad.ron:3:13: params[0]: an empty range"), "{empty}");
-    assert!(empty.contains("hint: write range: (low, high) with low < high"), "{empty}");
+    assert!(
+        empty.contains("hint: write range: (low, high) with low < high"),
+        "{empty}"
+    );
 
     let outside = errors("Space(params: [\n (field: \"pedestrians[0].speed\", range: (0.5, 20.0)),\n])");
-    assert!(outside.starts_with("bad.ron:2:9: params[0]: the range (0.5, 20) leaves the map limits [0.01, 12] m/s"), "{outside}");
+    assert!(
+        outside.starts_with("bad.ron:2:9: params[0]: the range (0.5, 20) leaves the map limits [0.01, 12] m/s"),
+        "{outside}"
+    );
     assert!(outside.contains("hint: keep the range within"), "{outside}");
 
     let field = errors("Space(params: [(field: \"vehicle.top_speed\", range: (1.0, 2.0))])");
-    assert!(field.starts_with("bad.ron:1:24: params[0]: unknown field `vehicle.top_speed`"), "{field}");
+    assert!(
+        field.starts_with("bad.ron:1:24: params[0]: unknown field `vehicle.top_speed`"),
+        "{field}"
+    );
     assert!(field.contains("vehicle.max_speed"), "{field}");
 
     let rule = errors("Space(params: [(field: \"pedestrians[3].speed\", range: (1.0, 2.0))])");
     assert!(rule.contains("pedestrian rule 3 does not exist"), "{rule}");
 
     let choice = errors("Space(params: [(field: \"pedestrians[0].side\", choose: [\"Near\", \"Left\"])])");
-    assert!(choice.contains("unknown choice `Left`") && choice.contains("Near, Far, Random"), "{choice}");
+    assert!(
+        choice.contains("unknown choice `Left`") && choice.contains("Near, Far, Random"),
+        "{choice}"
+    );
 
     let syntax = errors("Space(params: [(field: \"vehicle.start_speed\", range: (1.0, 2.0)]");
     assert!(syntax.starts_with("bad.ron:1:"), "{syntax}");
@@ -155,19 +173,33 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
     let (one, two) = (dir.path().join("one"), dir.path().join("two"));
     let s1 = search::run(&config(&space, &agents, &seeds, 1), &one, false, &NoProgress).expect("runs");
     let s2 = search::run(&config(&space, &agents, &seeds, 2), &two, false, &NoProgress).expect("runs");
-    assert_eq!(untimed(&one.join("candidates.jsonl")), untimed(&two.join("candidates.jsonl")));
+    assert_eq!(
+        untimed(&one.join("candidates.jsonl")),
+        untimed(&two.join("candidates.jsonl"))
+    );
     let strip = |s: String, d: &Path| s.replace(&d.display().to_string(), "DIR");
     assert_eq!(strip(summary_untimed(&one), &one), strip(summary_untimed(&two), &two));
     assert_eq!(s1.counts, s2.counts);
     std::fs::metadata(one.join("search.svg")).expect("the figure is written");
     // Every line after the identity is a batch result line.
     let lines = search::output::read_result_lines(&one.join("candidates.jsonl")).expect("batch lines");
-    assert!(lines.len() % 3 == 0 && lines.len() >= 3 * s1.counts.evaluated, "{}", lines.len());
+    assert!(
+        lines.len().is_multiple_of(3) && lines.len() >= 3 * s1.counts.evaluated,
+        "{}",
+        lines.len()
+    );
     // q-learning drives on in the jaywalk: the search finds a fair failure, and the
     // minimised scenario is one measured to fail, fairly.
-    assert!(!s1.failures.is_empty(), "q-learning should fail somewhere fair: {:?}", s1.counts);
+    assert!(
+        !s1.failures.is_empty(),
+        "q-learning should fail somewhere fair: {:?}",
+        s1.counts
+    );
     for f in &s1.failures {
-        assert!(f.brake_on_pedestrian_success >= 0.99 && f.never_brake_success <= 0.2, "{f:?}");
+        assert!(
+            f.brake_on_pedestrian_success >= 0.99 && f.never_brake_success <= 0.2,
+            "{f:?}"
+        );
         assert!(f.method_success.iter().all(|&(_, s)| s < 0.5), "{f:?}");
         // The written map is that scenario: re-run as batch would, it fails again.
         let map = unforeseen::maps::load_file(&f.file).expect("a valid map file");
@@ -184,7 +216,12 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
         .expect("runs");
         let agg = unforeseen::metrics::Aggregate::of(&results);
         assert_eq!(Some(agg.success_rate), f.method_success.first().map(|s| s.1));
-        assert!(witness(&map, Method::BrakeOnPedestrian, 3, 5).expect("runs").success_rate >= 0.99);
+        assert!(
+            witness(&map, Method::BrakeOnPedestrian, 3, 5)
+                .expect("runs")
+                .success_rate
+                >= 0.99
+        );
     }
 }
 
@@ -204,7 +241,11 @@ fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
             ..config(&space, &agents, &seeds, 2)
         };
         let s = search::run(&cfg, &d, false, &NoProgress).expect("runs");
-        assert_eq!(s.counts.adaptive + s.counts.minimise, 0, "a shard runs only the Sobol stage");
+        assert_eq!(
+            s.counts.adaptive + s.counts.minimise,
+            0,
+            "a shard runs only the Sobol stage"
+        );
         parts.push_str(&std::fs::read_to_string(d.join("candidates.jsonl")).expect("read"));
     }
     let joined = dir.path().join("joined");
@@ -223,7 +264,10 @@ fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
     );
     // Resumed, the concatenation becomes the whole run's file.
     search::run(&config(&space, &agents, &seeds, 1), &joined, true, &NoProgress).expect("resumes");
-    assert_eq!(untimed(&joined.join("candidates.jsonl")), untimed(&whole.join("candidates.jsonl")));
+    assert_eq!(
+        untimed(&joined.join("candidates.jsonl")),
+        untimed(&whole.join("candidates.jsonl"))
+    );
 
     // A killed run (cut mid-line) resumes to the same file; the kept lines stay as written.
     let killed = dir.path().join("killed");
@@ -234,8 +278,14 @@ fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
     search::run(&config(&space, &agents, &seeds, 2), &killed, true, &NoProgress).expect("resumes");
     let resumed = std::fs::read_to_string(killed.join("candidates.jsonl")).expect("read");
     let complete = &cut[..cut.rfind('\n').expect("lines") + 1];
-    assert!(resumed.starts_with(&complete[..complete.len() / 2]), "kept lines are copied byte for byte");
-    assert_eq!(untimed(&killed.join("candidates.jsonl")), untimed(&whole.join("candidates.jsonl")));
+    assert!(
+        resumed.starts_with(&complete[..complete.len() / 2]),
+        "kept lines are copied byte for byte"
+    );
+    assert_eq!(
+        untimed(&killed.join("candidates.jsonl")),
+        untimed(&whole.join("candidates.jsonl"))
+    );
 
     // Another run's file is refused, saying what differs.
     let other = SearchConfig {
@@ -291,10 +341,24 @@ fn the_cli_exits_2_on_bad_space_files() {
             out.to_str().expect("utf-8"),
         ])
     };
-    let shown = format!("{}:3:17: params[0]: the range (0, 3) leaves the map limits", bad.display());
+    let shown = format!(
+        "{}:3:17: params[0]: the range (0, 3) leaves the map limits",
+        bad.display()
+    );
     assert_exit(&run(&bad), 2, &[&shown, "hint: keep the range within [0.1, 20]"]);
-    std::fs::write(&bad, "Space(params: [(field: \"vehicle.start_speed\", range: (1.0, 2.0), step: 1)])").expect("write");
+    std::fs::write(
+        &bad,
+        "Space(params: [(field: \"vehicle.start_speed\", range: (1.0, 2.0), step: 1)])",
+    )
+    .expect("write");
     assert_exit(&run(&bad), 2, &[&format!("{}:1:", bad.display()), "step"]);
-    assert_exit(&run(&dir.path().join("missing.ron")), 2, &["missing.ron", "cannot read the space file"]);
-    assert!(!out.join("candidates.jsonl").exists(), "nothing is written for a bad space");
+    assert_exit(
+        &run(&dir.path().join("missing.ron")),
+        2,
+        &["missing.ron", "cannot read the space file"],
+    );
+    assert!(
+        !out.join("candidates.jsonl").exists(),
+        "nothing is written for a bad space"
+    );
 }
