@@ -578,6 +578,7 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
             .y_desc(y_desc)
             .x_labels(12)
             .y_labels(12)
+            .light_line_style(RGBColor(238, 238, 238))
             .x_label_formatter(&fx)
             .y_label_formatter(&fy)
             .draw()
@@ -619,23 +620,39 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
             }))
             .map_err(plot_err)?;
         // The key, beside the chart.
-        let lines: Vec<(Option<RGBColor>, String)> = vec![
-            (Some(success_colour(0.0)), "fair, method success 0%".into()),
-            (Some(success_colour(0.5)), "fair, method success 50%".into()),
-            (Some(success_colour(1.0)), "fair, method success 100%".into()),
-            (None, "ring: fair failure (< 50%)".into()),
-            (None, "square: minimised failure".into()),
-            (Some(grey), "cross: unfair (not survivable".into()),
-            (None, "  or not dangerous)".into()),
-            (None, format!("{} candidates evaluated,", evaluated.len())),
-            (None, format!("{} fair; {} episodes each", fair.len(), cfg.episodes)),
+        enum Mark {
+            Dot(RGBColor),
+            Ring,
+            Square,
+            Cross,
+            None,
+        }
+        let lines: Vec<(Mark, String)> = vec![
+            (Mark::Dot(success_colour(0.0)), "fair, method success 0%".into()),
+            (Mark::Dot(success_colour(0.5)), "fair, method success 50%".into()),
+            (Mark::Dot(success_colour(1.0)), "fair, method success 100%".into()),
+            (Mark::Ring, "fair failure (success < 50%)".into()),
+            (Mark::Square, "minimised failure".into()),
+            (Mark::Cross, "unfair (not survivable".into()),
+            (Mark::None, "or not dangerous)".into()),
+            (Mark::None, String::new()),
+            (Mark::None, format!("{} candidates evaluated,", evaluated.len())),
+            (
+                Mark::None,
+                format!("{} fair; {} episodes each", fair.len(), cfg.episodes),
+            ),
         ];
-        for (i, (colour, text)) in lines.iter().enumerate() {
+        for (i, (mark, text)) in lines.iter().enumerate() {
             let y = 60 + 20 * i as i32;
-            if let Some(c) = colour {
-                key.draw(&Circle::new((14, y), 5, c.filled())).map_err(plot_err)?;
+            match mark {
+                Mark::Dot(c) => key.draw(&Circle::new((14, y), 5, c.filled())),
+                Mark::Ring => key.draw(&Circle::new((14, y), 7, BLACK.stroke_width(1))),
+                Mark::Square => key.draw(&Rectangle::new([(7, y - 7), (21, y + 7)], BLACK.stroke_width(2))),
+                Mark::Cross => key.draw(&Cross::new((14, y), 3, grey.stroke_width(1))),
+                Mark::None => Ok(()),
             }
-            key.draw(&Text::new(text.clone(), (26, y - 7), ("sans-serif", 13)))
+            .map_err(plot_err)?;
+            key.draw(&Text::new(text.clone(), (28, y - 7), ("sans-serif", 13)))
                 .map_err(plot_err)?;
         }
         Ok(())
