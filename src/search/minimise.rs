@@ -1,5 +1,6 @@
 //! Minimisation: the simplest failing scenario near each failure found. For a fair
-//! failure, each parameter in the space's order is moved back to the base map's value;
+//! failure, each parameter in the space's order is moved back to the base map's value
+//! (in up to [`PASSES`] passes, stopping after a pass that kept nothing);
 //! if the candidate there still fails fairly (fair, and the method's mean success under
 //! 50%) the move is kept, otherwise up to [`HALVINGS`] moves halfway toward the base are
 //! tried, keeping each that still fails. Each try is a fresh candidate (new episodes),
@@ -21,6 +22,10 @@ use crate::error::Error;
 /// Moves halfway toward the base tried after a move all the way fails.
 pub const HALVINGS: usize = 2;
 
+/// Passes over the parameters (a move that failed in the first pass may succeed once
+/// other parameters are back at the base).
+pub const PASSES: usize = 2;
+
 /// A failure and its minimised scenario.
 #[derive(Debug, Clone)]
 pub struct Minimised {
@@ -38,7 +43,7 @@ pub struct Minimised {
 
 /// Tries per failure at most.
 pub fn steps_per_failure(space: &Space) -> usize {
-    space.params.len() * (1 + HALVINGS)
+    space.params.len() * (1 + HALVINGS) * PASSES
 }
 
 /// The parameters of `values` that differ from the base's value (or that the base has
@@ -132,28 +137,34 @@ fn minimise_one(
         tries.push(e.clone());
         Ok(e)
     };
-    for (d, p) in space.params.iter().enumerate() {
-        let Some(base) = p.base.clone() else { continue };
-        if current.candidate.values[d] == base {
-            continue;
-        }
-        let e = attempt(&current, d, base.clone(), &mut step)?;
-        if e.fails_fairly() {
-            current = e;
-            kept += 1;
-            continue;
-        }
-        for _ in 0..HALVINGS {
-            let Some(mid) = halfway(&p.domain, &current.candidate.values[d], &base) else {
-                break;
-            };
-            let e = attempt(&current, d, mid, &mut step)?;
+    for _ in 0..PASSES {
+        let before = kept;
+        for (d, p) in space.params.iter().enumerate() {
+            let Some(base) = p.base.clone() else { continue };
+            if current.candidate.values[d] == base {
+                continue;
+            }
+            let e = attempt(&current, d, base.clone(), &mut step)?;
             if e.fails_fairly() {
                 current = e;
                 kept += 1;
-            } else {
-                break;
+                continue;
             }
+            for _ in 0..HALVINGS {
+                let Some(mid) = halfway(&p.domain, &current.candidate.values[d], &base) else {
+                    break;
+                };
+                let e = attempt(&current, d, mid, &mut step)?;
+                if e.fails_fairly() {
+                    current = e;
+                    kept += 1;
+                } else {
+                    break;
+                }
+            }
+        }
+        if kept == before {
+            break;
         }
     }
     let changed = changed(space, &current.candidate.values);

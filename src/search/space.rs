@@ -802,7 +802,8 @@ fn rule_value(rule: &SpawnRule, f: RuleField, in_base: bool) -> Option<Value> {
         RuleField::Speed => num(rule.speed.0),
         RuleField::Delay => num(rule.delay.0),
         RuleField::XOffset => num(rule.x_offset.0),
-        RuleField::PauseAfter => rule.pause.map(|p| Value::Num(p.after)),
+        // No pause is a pause of 0 s (after 0 m).
+        RuleField::PauseAfter => num(rule.pause.map_or(0.0, |p| p.after)),
         RuleField::PauseDuration => num(rule.pause.map_or(0.0, |p| p.duration)),
         RuleField::Probability => num(rule.probability),
         RuleField::Radius => num(rule.radius),

@@ -63,7 +63,7 @@ fn space_file_errors_name_the_file_line_column_and_fix() {
 
     let outside = errors("Space(params: [\n (field: \"pedestrians[0].speed\", range: (0.5, 20.0)),\n])");
     assert!(
-        outside.starts_with("bad.ron:2:9: params[0]: the range (0.5, 20) leaves the map limits [0.01, 12] m/s"),
+        outside.starts_with("bad.ron:2:10: params[0]: the range (0.5, 20) leaves the map limits [0.01, 12] m/s"),
         "{outside}"
     );
     assert!(outside.contains("hint: keep the range within"), "{outside}");
