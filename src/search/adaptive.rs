@@ -7,8 +7,8 @@
 //! cells for a count or a choice. It starts uniform and, after each round, is refitted
 //! to the *elite* candidates evaluated so far:
 //!
-//! * a candidate's score is the method's mean success rate over the training seeds
-//!   when the candidate is fair, and +∞ when it is not (an unfair failure is worth
+//! * a candidate's score is the method's lowest success rate over the training seeds
+//!   (its worst agent) when the candidate is fair, and +∞ when it is not (an unfair failure is worth
 //!   nothing) or was rejected;
 //! * the elite is the best [`ELITE_SHARE`] of the scored candidates (at least
 //!   [`MIN_ELITE`]), lowest score first, ties by candidate index;

@@ -6,8 +6,9 @@
 //! * **dangerous**: never-brake fails in at least 80% of them (succeeds in at most 20%).
 //!
 //! A candidate that is both is *fair*; the others are reported as unfair and never
-//! counted as failures. A method *fails* a fair candidate when its success rate is
-//! under [`FAILURE_SUCCESS`] (50%).
+//! counted as failures. A trained agent *fails* a fair candidate when its success rate
+//! is under [`FAILURE_SUCCESS`] (50%); the search counts a candidate as a failure of the
+//! method when at least one of its agents (training seeds) fails it.
 
 use serde::{Deserialize, Serialize};
 

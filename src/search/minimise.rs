@@ -1,13 +1,13 @@
 //! Minimisation: the simplest failing scenario near each failure found. For a fair
 //! failure, each parameter in the space's order is moved back to the base map's value
 //! (in up to [`PASSES`] passes, stopping after a pass that kept nothing);
-//! if the candidate there still fails fairly (fair, and the method's mean success under
-//! 50%) the move is kept, otherwise up to [`HALVINGS`] moves halfway toward the base are
+//! if the candidate there still fails fairly (fair, and the method's success under 50%
+//! for at least one training seed) the move is kept, otherwise up to [`HALVINGS`] moves halfway toward the base are
 //! tried, keeping each that still fails. Each try is a fresh candidate (new episodes),
 //! evaluated and written like any other; the result is the last try that failed, or the
 //! failure itself when none did, so a minimised scenario is always one measured to fail.
 //!
-//! The best failures (lowest mean success, ties by candidate number) are minimised, up
+//! The best failures (lowest worst-seed success, ties by candidate number) are minimised, up
 //! to [`super::SearchConfig::max_failures`], in parallel; two whose minimised scenarios
 //! change the same set of parameters count as one failure (the better one is kept).
 //! Step `s` of the `r`-th failure is candidate `budget + r × steps + s`, where `steps`

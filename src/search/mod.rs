@@ -5,7 +5,10 @@
 //! A [`Space`] names which fields of a base map vary and over what ([`space`]). The
 //! search evaluates *candidates*, points of the space laid over the base map, each with
 //! K episodes of the two fairness witnesses and of the method (for each training seed),
-//! in three stages:
+//! in three stages. A fair candidate is a *failure* of the method when at least one of its
+//! trained agents (training seeds) succeeds in under 50% of the episodes: each agent is
+//! one draw of the method.
+//!
 //!
 //! 1. **Sobol stage** (candidates `0..n1`, `n1 = ceil(budget × sobol_share)`): points of
 //!    a scrambled Sobol sequence ([`sampler`]), uniform on the unit cube, so the share of
@@ -324,7 +327,7 @@ pub struct CandidateLine {
     pub values: Vec<(String, Value)>,
     /// What the witnesses say of it.
     pub fairness: Fairness,
-    /// For the method's line: the candidate is fair and the method's success is under 50%.
+    /// For the method's line: the candidate is fair and this agent's success is under 50%.
     pub fails: bool,
     /// The evaluation, as a batch line.
     #[serde(flatten)]
@@ -361,14 +364,20 @@ impl Evaluated {
         (!s.is_empty()).then(|| s.iter().sum::<f64>() / s.len() as f64)
     }
 
-    /// Fair, and the method's mean success over training seeds is under 50%.
-    pub fn fails_fairly(&self) -> bool {
-        self.fairness().is_some_and(Fairness::is_fair) && self.mean_success().is_some_and(fairness::fails)
+    /// The method's lowest success over training seeds (None when rejected): the agent
+    /// that fares worst, since each trained agent is one draw of the method.
+    pub fn worst_success(&self) -> Option<f64> {
+        self.method_success().into_iter().reduce(f64::min)
     }
 
-    /// The adaptive stage's score: mean success when fair, +∞ otherwise.
+    /// Fair, and the method's success is under 50% for at least one training seed.
+    pub fn fails_fairly(&self) -> bool {
+        self.fairness().is_some_and(Fairness::is_fair) && self.worst_success().is_some_and(fairness::fails)
+    }
+
+    /// The adaptive stage's score: the worst seed's success when fair, +∞ otherwise.
     pub fn score(&self) -> f64 {
-        match (self.fairness(), self.mean_success()) {
+        match (self.fairness(), self.worst_success()) {
             (Some(Fairness::Fair), Some(s)) => s,
             _ => f64::INFINITY,
         }

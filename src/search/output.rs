@@ -14,9 +14,9 @@
 //!   seeds with a Student-t interval; the share of the space that is fair; the counts of
 //!   candidates by stage and verdict; the rejected points with their reasons; the
 //!   failures found.
-//! * `search.svg`: the method's success over the two parameters that matter most (the
-//!   largest |correlation| between a parameter's coordinate and the method's mean
-//!   success over fair candidates), unfair candidates in grey, failures ringed and the
+//! * `search.svg`: the success of the method's worst agent (training seed) over the two
+//!   parameters that matter most (the largest |correlation| between a parameter's
+//!   coordinate and that success over fair candidates), unfair candidates in grey, failures ringed and the
 //!   minimised failures as squares.
 
 use plotters::prelude::*;
@@ -137,7 +137,7 @@ pub struct Counts {
     pub not_dangerous: usize,
     /// Of those: neither survivable nor dangerous.
     pub neither: usize,
-    /// Fair candidates the method fails (mean over training seeds under 50%), Sobol stage.
+    /// Fair candidates the method fails (some training seed's success under 50%), Sobol stage.
     pub failing_fair_sobol: usize,
     /// The same, adaptive stage.
     pub failing_fair_adaptive: usize,
@@ -199,8 +199,9 @@ pub struct Summary {
     /// The per-seed failure probabilities over the training seeds: mean, Student-t
     /// 95% interval, range (None without fair candidates).
     pub failure_probability_over_seeds: Option<Stat>,
-    /// P(the method's mean success over the seeds is under 50% | fair), Sobol stage.
-    pub failure_probability_pooled: Proportion,
+    /// P(at least one training seed's agent fails | fair), Sobol stage (the candidates
+    /// the search counts as failures, [`Evaluated::fails_fairly`]).
+    pub failure_probability_any_seed: Proportion,
     /// The two parameters the figure shows.
     pub figure_parameters: Vec<String>,
     /// The minimised failures, best first.
@@ -299,7 +300,7 @@ pub(super) fn write_all(cfg: &SearchConfig<'_>, out: &Path, outcome: &Outcome) -
         space_file: space.source.clone(),
         counts,
         fair_share: Proportion::wilson(fair_sobol.len(), evaluated_sobol),
-        failure_probability_pooled: Proportion::wilson(
+        failure_probability_any_seed: Proportion::wilson(
             fair_sobol.iter().filter(|e| e.fails_fairly()).count(),
             fair_sobol.len(),
         ),
@@ -491,7 +492,7 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
         .iter()
         .filter(|e| e.fairness() == Some(Fairness::Fair))
         .collect();
-    let success: Vec<f64> = fair.iter().map(|e| e.mean_success().unwrap_or(1.0)).collect();
+    let success: Vec<f64> = fair.iter().map(|e| e.worst_success().unwrap_or(1.0)).collect();
     let mut strength: Vec<(usize, f64)> = (0..space.params.len())
         .map(|d| {
             let x: Vec<f64> = fair.iter().map(|e| e.candidate.point[d]).collect();
@@ -554,7 +555,7 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
     let (y0, y1) = axis(dy);
     let minimised: Vec<&Evaluated> = outcome.failures.iter().map(|m| &m.result).collect();
     let title = format!(
-        "{} ({}) on {}: success over the fair candidates",
+        "{} ({}) on {}: success of the worst agent, fair candidates",
         cfg.method.name(),
         cfg.protocol.name(),
         space.name
@@ -569,7 +570,7 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(plot_err)?;
         let x_desc = dx.map_or("".to_string(), |d| space.params[d].name.clone());
-        let y_desc = dy.map_or("method success".to_string(), |d| space.params[d].name.clone());
+        let y_desc = dy.map_or("worst agent's success".to_string(), |d| space.params[d].name.clone());
         let fx = |x: &f64| dx.map_or(tick_label(*x), |d| label(d, *x));
         let fy = |y: &f64| dy.map_or(tick_label(*y), |d| label(d, *y));
         chart
@@ -587,7 +588,7 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
             let x = dx.map_or(0.5, |d| position(e, d));
             let y = match dy {
                 Some(d) => position(e, d),
-                None => e.mean_success().unwrap_or(0.0),
+                None => e.worst_success().unwrap_or(0.0),
             };
             (x, y)
         };
@@ -602,7 +603,7 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
             .map_err(plot_err)?;
         chart
             .draw_series(fair.iter().map(|e| {
-                let s = e.mean_success().unwrap_or(1.0);
+                let s = e.worst_success().unwrap_or(1.0);
                 Circle::new(at(e), 4, success_colour(s).filled())
             }))
             .map_err(plot_err)?;
@@ -628,9 +629,12 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
             None,
         }
         let lines: Vec<(Mark, String)> = vec![
-            (Mark::Dot(success_colour(0.0)), "fair, method success 0%".into()),
-            (Mark::Dot(success_colour(0.5)), "fair, method success 50%".into()),
-            (Mark::Dot(success_colour(1.0)), "fair, method success 100%".into()),
+            (Mark::Dot(success_colour(0.0)), "fair, worst agent's success 0%".into()),
+            (Mark::Dot(success_colour(0.5)), "fair, worst agent's success 50%".into()),
+            (
+                Mark::Dot(success_colour(1.0)),
+                "fair, worst agent's success 100%".into(),
+            ),
             (Mark::Ring, "fair failure (success < 50%)".into()),
             (Mark::Square, "minimised failure".into()),
             (Mark::Cross, "unfair (not survivable".into()),
