@@ -198,7 +198,8 @@ fn print_summary(s: &Summary, args: &SearchArgs) {
         && st.n > 1
     {
         let ci = match (st.ci95_low, st.ci95_high) {
-            (Some(l), Some(h)) => format!(" [{:.1}, {:.1}]", 100.0 * l, 100.0 * h),
+            // A probability's interval is cut to [0, 1] (the t interval over three seeds can reach past it).
+            (Some(l), Some(h)) => format!(" [{:.1}, {:.1}]", 100.0 * l.max(0.0), 100.0 * h.min(1.0)),
             _ => String::new(),
         };
         outln!(
