@@ -116,7 +116,8 @@ impl PyScaledHabitAgent {
                 let shape = t.shape();
                 if shape != [n, na] {
                     return Err(errors::value(format!(
-                        "habit table of shape {shape:?}: expected ({n}, {na}) (states x actions of the agent's world model)"
+                        "habit table of shape ({}, {}): expected ({n}, {na}) (states x actions of the agent's world model)",
+                        shape[0], shape[1]
                     )));
                 }
                 let probs: Vec<f64> = t.as_array().iter().copied().collect();
