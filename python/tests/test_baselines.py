@@ -29,6 +29,8 @@ def test_small_budget_dqn_trains_saves_loads_and_wraps(agent, tmp_path):
                                 num_envs=2, hidden=(16,))
     policy, info = baselines.train(cfg, seed=1)
     assert info["steps"] == 400 and info["episodes"] > 0
+    # The policy file's numpy network computes what skrl's network does (float32 there).
+    assert info["max_abs_diff_vs_skrl"] < 1e-4
     obs = np.zeros(27)
     p = policy.probs(obs)
     assert p.shape == (3,) and abs(p.sum() - 1) < 1e-12 and (p > 0).all()
@@ -41,6 +43,18 @@ def test_small_budget_dqn_trains_saves_loads_and_wraps(agent, tmp_path):
     wrapped = unforeseen.evaluate(lambda s: unforeseen.ScaledWrapper(habit=back, agent=agent), ["jaywalk"], [1],
                                   episodes=2, protocol="continual")
     assert wrapped[0]["method"] == "scaled+dqn-kinematic" and wrapped[0]["inference_rate"] > 0
+
+
+@deep
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_small_budget_ppo_trains_on_the_discrete_observation():
+    cfg = baselines.TrainConfig(algo="ppo", observation="discrete", timesteps=256, num_envs=2, rollouts=32,
+                                hidden=(16,))
+    policy, info = baselines.train(cfg, seed=2)
+    assert info["max_abs_diff_vs_skrl"] < 1e-4
+    p = policy.probs(np.array([3, 1, 1, 0]))
+    assert abs(p.sum() - 1) < 1e-12 and policy.method == "ppo-discrete"
 
 
 def test_a_damaged_policy_file_is_refused(tmp_path):

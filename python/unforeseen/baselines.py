@@ -53,7 +53,7 @@ class TrainConfig:
     observation: str = "kinematic"
     map: str = "intersection"
     #: Environment steps in total (over all envs).
-    timesteps: int = 40_000
+    timesteps: int = 10_000
     num_envs: int = 4
     hidden: tuple[int, ...] = (64, 64)
     learning_rate: float = 1e-3
@@ -257,10 +257,22 @@ def train(cfg: TrainConfig, seed: int, progress: bool = False) -> tuple[DeepPoli
     pre = agent._observation_preprocessor
     mean = np.asarray(jax.device_get(pre.state_dict.params["running_mean"]), dtype=np.float64)
     var = np.asarray(jax.device_get(pre.state_dict.params["running_variance"]), dtype=np.float64)
+    policy = DeepPolicy(weights, mean, var, cfg.algo, cfg.observation)
+    # The numpy forward pass against skrl's own on the envs' current observations.
+    obs = env.reset()[0]
+    inputs = {"observations": pre(obs)}
+    if cfg.algo == "dqn":
+        ref = agent.q_network.act(inputs, role="q_network")[0]
+    else:
+        ref = agent.policy.act(inputs, role="policy")[1]["net_output"]
+    ref = np.asarray(jax.device_get(ref), dtype=np.float64)
+    mine = np.stack([policy.logits(o) for o in np.asarray(jax.device_get(obs))])
     vec.close()
     info = {"seed": seed, "steps": steps * cfg.num_envs, "episodes": episodes[0], "seconds": seconds,
+            "max_abs_diff_vs_skrl": float(np.abs(mine - ref).max()),
             "config": {k: (list(v) if isinstance(v, tuple) else v) for k, v in dataclasses.asdict(cfg).items()}}
-    return DeepPolicy(weights, mean, var, cfg.algo, cfg.observation, meta=info), info
+    policy.meta = info
+    return policy, info
 
 
 def success_on(policy: Any, map: str = "intersection", episodes: int = 100, seed: int = 7) -> float:
