@@ -45,18 +45,6 @@ def test_small_budget_dqn_trains_saves_loads_and_wraps(agent, tmp_path):
     assert wrapped[0]["method"] == "scaled+dqn-kinematic" and wrapped[0]["inference_rate"] > 0
 
 
-@deep
-@pytest.mark.filterwarnings("ignore::DeprecationWarning")
-@pytest.mark.filterwarnings("ignore::UserWarning")
-def test_small_budget_ppo_trains_on_the_discrete_observation():
-    cfg = baselines.TrainConfig(algo="ppo", observation="discrete", timesteps=256, num_envs=2, rollouts=32,
-                                hidden=(16,))
-    policy, info = baselines.train(cfg, seed=2)
-    assert info["max_abs_diff_vs_skrl"] < 1e-4
-    p = policy.probs(np.array([3, 1, 1, 0]))
-    assert abs(p.sum() - 1) < 1e-12 and policy.method == "ppo-discrete"
-
-
 def test_a_damaged_policy_file_is_refused(tmp_path):
     bad = tmp_path / "bad.npz"
     bad.write_bytes(b"not a policy")
