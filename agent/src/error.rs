@@ -124,6 +124,9 @@ pub enum AgentError {
         /// The size of the indexed set.
         size: usize,
     },
+    /// A habit's probabilities or prior strength are unusable (§V-C, [`crate::habit`]).
+    #[error("invalid habit: {0}")]
+    InvalidHabit(String),
 }
 
 /// Errors loading a persisted [`crate::persist::AgentBundle`].

@@ -16,6 +16,7 @@
 use crate::controller::{Controller, Decision, Dist, Ending};
 use crate::error::AgentError;
 use crate::gate::StateGate;
+use crate::habit::{Habit, PolicyHabit, TableHabit};
 use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
@@ -56,15 +57,16 @@ pub struct ReasoningTrace {
     pub kl_final: f64,
 }
 
-/// The scaled active-inference agent (docs/ARCHITECTURE.md §4, §5).
+/// The scaled active-inference agent (docs/ARCHITECTURE.md §4, §5), with habit `H`
+/// ([`crate::habit`]): the paper's Q-table habit by default, or an external policy.
 #[derive(Debug, Clone)]
-pub struct ScaledAgent {
+pub struct ScaledAgent<H: Habit = TableHabit> {
     model: WorldModel,
     params: CheckedScaledParams,
     n_states: usize,
     n_actions: usize,
-    /// Policy counts `ν`, `[s * n_actions + u]`.
-    nu: Vec<f64>,
+    /// The habit `π_o` (§V-C).
+    habit: H,
     /// The surprise gate on the state (`None` with [`GateMode::OneStep`]).
     gate: Option<StateGate>,
     rng: ChaCha8Rng,
@@ -89,7 +91,7 @@ pub struct ScaledAgent {
     last: ReasoningTrace,
 }
 
-impl ScaledAgent {
+impl ScaledAgent<TableHabit> {
     /// Build the agent from a trained world model and Q-table: `ν = ν0 σ(Q[s,·]/T)` (docs/ARCHITECTURE.md §4.8).
     /// Checks `params` ([`ScaledParams::check`]) and builds the agent with
     /// [`ScaledAgent::with_checked`].
@@ -100,10 +102,71 @@ impl ScaledAgent {
     /// Build the agent from checked parameters; first checks their factor names against
     /// the model ([`CheckedScaledParams::check_factors`]).
     pub fn with_checked(
-        mut model: WorldModel,
+        model: WorldModel,
         q: &QLearning,
         params: CheckedScaledParams,
     ) -> Result<ScaledAgent, AgentError> {
+        let habit = TableHabit::from_q(
+            q.table(),
+            q.n_actions(),
+            params.learning.nu0,
+            params.learning.nu_temperature,
+        );
+        if q.n_states() != model.n_states() {
+            return Err(AgentError::SizeMismatch {
+                what: "Q-table states vs world-model states".into(),
+                expected: model.n_states(),
+                found: q.n_states(),
+            });
+        }
+        if q.n_actions() != model.n_actions() {
+            return Err(AgentError::SizeMismatch {
+                what: "Q-table actions vs world-model actions".into(),
+                expected: model.n_actions(),
+                found: q.n_actions(),
+            });
+        }
+        ScaledAgent::with_habit(model, habit, params)
+    }
+
+    /// Policy counts `ν`, `[s * n_actions + u]` (§V-C).
+    pub fn nu(&self) -> &[f64] {
+        self.habit.nu()
+    }
+    /// `π_o(·|s)` (Dirichlet mean of `ν`, §V-C).
+    pub fn pi_o(&self, s: usize) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_actions];
+        self.habit.pi_o_state(0, s, &mut out);
+        out
+    }
+}
+
+impl ScaledAgent<PolicyHabit> {
+    /// Decides on `obs` with the external policy's probabilities `probs` at this tick's
+    /// observation as the habit's (the scaled agent as a test-time safety layer around any
+    /// policy, [`crate::habit`]). Refuses probabilities of the wrong length, negative, not
+    /// finite or not summing to 1.
+    pub fn act_with(&mut self, obs: usize, probs: &[f64]) -> Result<Decision, AgentError> {
+        // The habit keeps one entry per tick of the episode: a tick decided without
+        // probabilities (Controller::act) is filled with uniform ones first.
+        while self.habit.ticks() < self.hist_obs.len() {
+            let uniform = vec![1.0 / self.n_actions as f64; self.n_actions];
+            self.habit.push(&uniform)?;
+        }
+        self.habit.push(probs)?;
+        Ok(self.act(obs))
+    }
+}
+
+impl<H: Habit> ScaledAgent<H> {
+    /// Build the agent around `habit` from checked parameters; first checks their factor
+    /// names against the model ([`CheckedScaledParams::check_factors`]) and the habit's
+    /// sizes against the model's.
+    pub fn with_habit(
+        mut model: WorldModel,
+        habit: H,
+        params: CheckedScaledParams,
+    ) -> Result<ScaledAgent<H>, AgentError> {
         params.check_factors(model.structure())?;
         let pooling = (!params.planning.persistence_ignores.is_empty()).then_some((
             params.gate.gate_factor.as_str(),
@@ -120,21 +183,20 @@ impl ScaledAgent {
             )
             .into());
         }
-        if q.n_states() != n {
+        if habit.n_states() != n {
             return Err(AgentError::SizeMismatch {
-                what: "Q-table states vs world-model states".into(),
+                what: "habit states vs world-model states".into(),
                 expected: n,
-                found: q.n_states(),
+                found: habit.n_states(),
             });
         }
-        if q.n_actions() != na {
+        if habit.n_actions() != na {
             return Err(AgentError::SizeMismatch {
-                what: "Q-table actions vs world-model actions".into(),
+                what: "habit actions vs world-model actions".into(),
                 expected: na,
-                found: q.n_actions(),
+                found: habit.n_actions(),
             });
         }
-        let nu = learning::nu_from_q(q.table(), na, params.learning.nu0, params.learning.nu_temperature);
         let gate = match params.gate.mode {
             GateMode::State => Some(StateGate::from_model(
                 &model,
@@ -166,7 +228,7 @@ impl ScaledAgent {
             params,
             n_states: n,
             n_actions: na,
-            nu,
+            habit,
             gate,
         })
     }
@@ -179,15 +241,9 @@ impl ScaledAgent {
     pub fn params(&self) -> &ScaledParams {
         &self.params
     }
-    /// Policy counts `ν`, `[s * n_actions + u]` (§V-C).
-    pub fn nu(&self) -> &[f64] {
-        &self.nu
-    }
-    /// `π_o(·|s)` (Dirichlet mean of `ν`, §V-C).
-    pub fn pi_o(&self, s: usize) -> Vec<f64> {
-        let mut out = vec![0.0; self.n_actions];
-        learning::pi_o_state(&self.nu, self.n_actions, s, &mut out);
-        out
+    /// The habit `π_o` (§V-C).
+    pub fn habit(&self) -> &H {
+        &self.habit
     }
     /// The surprise gate on the state, if the agent uses one (§VI, Fig. 9a-b).
     pub fn gate(&self) -> Option<&StateGate> {
@@ -277,7 +333,7 @@ impl ScaledAgent {
             &self.q_cur,
             self.params.planning.gamma,
         );
-        learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
+        self.habit.pi_o_belief(t, &self.q_cur, &mut self.pi);
         let tr = &mut self.last;
         tr.free_energy = out.free_energy;
         tr.vmp_iters = out.iterations;
@@ -317,7 +373,7 @@ impl ScaledAgent {
     }
 }
 
-impl Controller for ScaledAgent {
+impl<H: Habit> Controller for ScaledAgent<H> {
     fn name(&self) -> &'static str {
         "scaled"
     }
@@ -333,6 +389,7 @@ impl Controller for ScaledAgent {
         self.final_obs = None;
         self.prev_one_hot = None;
         self.tree.invalidate();
+        self.habit.begin_episode();
     }
 
     fn act(&mut self, obs: usize) -> Decision {
@@ -375,9 +432,9 @@ impl Controller for ScaledAgent {
         if reasoned {
             scaling_iters = self.reason(obs, th);
         } else if gm.a_identity {
-            learning::pi_o_state(&self.nu, self.n_actions, obs, &mut self.pi);
+            self.habit.pi_o_state(t, obs, &mut self.pi);
         } else {
-            learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
+            self.habit.pi_o_belief(t, &self.q_cur, &mut self.pi);
         }
         let pi = std::mem::take(&mut self.pi);
         let action = self.select(&pi);
@@ -432,7 +489,7 @@ impl Controller for ScaledAgent {
             if self.hist_reasoned[k] {
                 taken.fill(0.0);
                 taken[self.hist_act[k]] = 1.0;
-                learning::update_nu(&mut self.nu, na, q, &taken, lr);
+                self.habit.learn(q, &taken, lr);
             }
             if k > 0 {
                 let qp = &self.hist_q[(k - 1) * n..k * n];
@@ -445,7 +502,7 @@ impl Controller for ScaledAgent {
             let mut habit = vec![0.0; na];
             for k in (0..steps).filter(|&k| self.hist_reasoned[k]) {
                 let q = &self.hist_q[k * n..(k + 1) * n];
-                learning::pi_o_belief(&self.nu, na, q, &mut habit);
+                self.habit.pi_o_belief(k, q, &mut habit);
                 let e = endorsement(&self.hist_pi[k * na..(k + 1) * na], argmax(&habit));
                 let s = argmax(q);
                 if self.params.gate.gate_learning == GateLearning::Endorsed {

@@ -12,6 +12,7 @@
 //! * [`render`]: the top-down frame (tiny-skia) and the text line;
 //! * [`agent`]: training, agent files, every method's controller, evaluation;
 //! * [`results`]: `compare` and `batch` as the JSON data their files hold;
+//! * [`wrapper`]: the scaled agent around any habit, and the batch summary of a results file;
 //! * [`errors`]: Rust errors as Python exceptions (`ValueError` for what the user can fix).
 
 mod agent;
@@ -21,6 +22,7 @@ mod maps;
 mod render;
 mod results;
 mod vector;
+mod wrapper;
 
 use pyo3::prelude::*;
 
@@ -45,5 +47,6 @@ fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     vector::register(m)?;
     agent::register(m)?;
     results::register(m)?;
+    wrapper::register(m)?;
     Ok(())
 }

@@ -22,7 +22,9 @@ import gymnasium as gym
 from . import _unforeseen
 from ._unforeseen import Agent, Controller, embedded_maps, load_agent, scripted_controller, stream_seed, train_agents
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
+from .evaluate import evaluate, summarize
 from .vector import VectorEnv
+from .wrapper import ScaledWrapper, q_table_habit
 
 __version__ = _unforeseen.version()
 
@@ -31,6 +33,7 @@ __all__ = [
     "LIGHTS",
     "Agent",
     "Controller",
+    "ScaledWrapper",
     "UnforeseenEnv",
     "VectorEnv",
     "batch",
@@ -38,12 +41,15 @@ __all__ = [
     "embedded_maps",
     "env_id",
     "eval_seeds",
+    "evaluate",
     "evaluate_builtin",
     "load_agent",
     "make_env",
+    "q_table_habit",
     "rollout",
     "scripted_controller",
     "stream_seed",
+    "summarize",
     "train",
     "train_agents",
 ]

@@ -15,6 +15,7 @@ __all__ = [
     "Agent",
     "Controller",
     "Env",
+    "ScaledHabitAgent",
     "VectorEnv",
     "compare_json",
     "batch_json",
@@ -22,9 +23,11 @@ __all__ = [
     "eval_seeds",
     "evaluate_json",
     "load_agent",
+    "q_table_habit",
     "rust_loop",
     "scripted_controller",
     "stream_seed",
+    "summarize_json",
     "train",
     "version",
 ]
@@ -175,3 +178,26 @@ def compare_json(**kwargs: Any) -> str:
     """compare.json's data as JSON text."""
 def batch_json(maps: Sequence[str], **kwargs: Any) -> str:
     """A batch run's result lines as a JSON list."""
+
+@final
+class ScaledHabitAgent:
+    """The scaled agent of ``agent`` around a habit: ``habit_table`` (``(n_states,
+    n_actions)`` probabilities per state) or, without one, the probabilities given to
+    ``act`` each tick (``unforeseen_agent::habit``)."""
+
+    def __init__(self, agent: Agent, habit_table: npt.NDArray[np.float64] | None = None, **params: Any) -> None: ...
+    @property
+    def external(self) -> bool: ...
+    def begin_episode(self, seed: int) -> None: ...
+    def act(
+        self, observed: int | Sequence[int], probs: npt.NDArray[np.float64] | None = None
+    ) -> tuple[int, dict[str, Any]]: ...
+    def observe(self, reward: float, next_observed: int | Sequence[int], terminated: bool, truncated: bool) -> None: ...
+    def end_episode(self) -> None: ...
+    def habit_counts(self) -> npt.NDArray[np.float64]:
+        """Corrections learning added to an external habit (a table's counts ``ν``)."""
+
+def q_table_habit(agent: Agent, **params: Any) -> npt.NDArray[np.float64]:
+    """``σ(Q[s, ·]/T)`` of ``agent``'s Q-table, ``(n_states, n_actions)``."""
+def summarize_json(path: str) -> str:
+    """The batch summary over training seeds of a results file, as JSON text."""

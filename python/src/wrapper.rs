@@ -1,0 +1,257 @@
+//! The scaled agent around any habit (`unforeseen.ScaledWrapper`): the world model, the
+//! surprise gate, reasoning, scaling and test-time learning of an agent file's scaled
+//! agent, with `π_o` from a table of per-state probabilities ([`TableHabit`], the
+//! Q-table's by default) or from an external policy's probabilities each tick
+//! ([`PolicyHabit`]; [`unforeseen_agent::habit`] documents how learning corrects it).
+//! Also the batch summary of a results file ([`unforeseen::batch::summarize`]), so that
+//! lines written from Python are read the way `unforeseen batch` reads its own.
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use unforeseen_agent::controller::{Controller, Decision, Ending};
+use unforeseen_agent::habit::{PolicyHabit, TableHabit};
+use unforeseen_agent::scaled::ScaledAgent;
+
+use crate::agent::{PyAgent, scaled_params};
+use crate::errors;
+
+/// The agent, with either kind of habit.
+enum Wrapped {
+    Table(Box<ScaledAgent<TableHabit>>),
+    Policy(Box<ScaledAgent<PolicyHabit>>),
+}
+
+impl Wrapped {
+    fn controller(&mut self) -> &mut dyn Controller {
+        match self {
+            Wrapped::Table(a) => a.as_mut(),
+            Wrapped::Policy(a) => a.as_mut(),
+        }
+    }
+}
+
+fn agent_error(e: unforeseen_agent::error::AgentError) -> PyErr {
+    errors::value(format!("scaled wrapper: {e}"))
+}
+
+/// The scaled agent of `agent` around a habit: `habit_table` (an `(n_states, n_actions)`
+/// array of probabilities per state), or, without one, the probabilities passed to `act`
+/// each tick. Keywords are the scaled agent's parameters (the keys of `--set`).
+#[pyclass(name = "ScaledHabitAgent", module = "unforeseen._unforeseen")]
+pub struct PyScaledHabitAgent {
+    inner: Mutex<Wrapped>,
+    sizes: Vec<usize>,
+    external: bool,
+}
+
+impl PyScaledHabitAgent {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Wrapped> {
+        self.inner.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// `(d, v, L, p)` (or a joint index) as the joint index.
+    fn index(&self, obs: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let n: usize = self.sizes.iter().product();
+        if let Ok(i) = obs.extract::<i64>() {
+            return usize::try_from(i).ok().filter(|i| *i < n).ok_or_else(|| {
+                errors::value(format!(
+                    "observed {i}: expected a joint index in 0..{n} or (d, v, L, p)"
+                ))
+            });
+        }
+        let factors: Vec<i64> = obs
+            .try_iter()
+            .and_then(|it| it.map(|x| x?.extract::<i64>()).collect::<PyResult<Vec<_>>>())
+            .map_err(|_| errors::value(format!("observed {obs}: expected (d, v, L, p), e.g. info['observed']")))?;
+        if factors.len() != self.sizes.len() {
+            return Err(errors::value(format!(
+                "observed {obs}: expected {} factors (d, v, L, p)",
+                self.sizes.len()
+            )));
+        }
+        let mut index = 0;
+        for (&f, &size) in factors.iter().zip(&self.sizes) {
+            let f = usize::try_from(f)
+                .ok()
+                .filter(|f| *f < size)
+                .ok_or_else(|| errors::value(format!("observed {obs}: factor sizes are {:?}", self.sizes)))?;
+            index = index * size + f;
+        }
+        Ok(index)
+    }
+}
+
+fn decision_dict<'py>(py: Python<'py>, d: &Decision) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("action", d.action)?;
+    out.set_item("reasoned", d.reasoned)?;
+    out.set_item("surprise", d.surprise)?;
+    out.set_item("theta", d.theta)?;
+    out.set_item("policy", d.policy.to_vec())?;
+    out.set_item("psi", d.psi.as_deref().map(<[f64]>::to_vec))?;
+    out.set_item("scaling_iters", d.scaling_iters)?;
+    Ok(out)
+}
+
+#[pymethods]
+impl PyScaledHabitAgent {
+    #[new]
+    #[pyo3(signature = (agent, habit_table = None, **params))]
+    fn new(
+        agent: &PyAgent,
+        habit_table: Option<PyReadonlyArray2<'_, f64>>,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let p = scaled_params(params)?;
+        let checked = p.check().map_err(|e| errors::value(e.to_string()))?;
+        let model = agent.bundle.world_model.clone();
+        let (n, na) = (model.n_states(), model.n_actions());
+        let nu0 = checked.learning.nu0;
+        let (inner, external) = match habit_table {
+            Some(t) => {
+                let shape = t.shape();
+                if shape != [n, na] {
+                    return Err(errors::value(format!(
+                        "habit table of shape ({}, {}): expected ({n}, {na}) (states x actions of the agent's world model)",
+                        shape[0], shape[1]
+                    )));
+                }
+                let probs: Vec<f64> = t.as_array().iter().copied().collect();
+                let habit = TableHabit::from_probs(&probs, na, nu0).map_err(agent_error)?;
+                let a = ScaledAgent::with_habit(model, habit, checked).map_err(agent_error)?;
+                (Wrapped::Table(Box::new(a)), false)
+            }
+            None => {
+                let habit = PolicyHabit::new(n, na, nu0).map_err(agent_error)?;
+                let a = ScaledAgent::with_habit(model, habit, checked).map_err(agent_error)?;
+                (Wrapped::Policy(Box::new(a)), true)
+            }
+        };
+        Ok(PyScaledHabitAgent {
+            inner: Mutex::new(inner),
+            sizes: agent.bundle.world_model.structure().sizes(),
+            external,
+        })
+    }
+
+    /// Whether the habit's probabilities come with each `act` (no habit table).
+    #[getter]
+    fn external(&self) -> bool {
+        self.external
+    }
+
+    /// Starts an episode: clears beliefs and the habit's per-tick inputs, seeds sampling.
+    fn begin_episode(&self, seed: u64) {
+        self.lock().controller().begin_episode(seed);
+    }
+
+    /// Decides on `observed` (`(d, v, L, p)` as observed, e.g. `info["observed"]`, or a
+    /// joint index) with `probs`, the habit's action probabilities at this tick's
+    /// observation (required without a habit table, refused with one):
+    /// `(action, decision)`, the decision as `Controller.act` gives it.
+    #[pyo3(signature = (observed, probs = None))]
+    fn act<'py>(
+        &self,
+        py: Python<'py>,
+        observed: &Bound<'py, PyAny>,
+        probs: Option<PyReadonlyArray1<'py, f64>>,
+    ) -> PyResult<(usize, Bound<'py, PyDict>)> {
+        let i = self.index(observed)?;
+        let d = match (&mut *self.lock(), probs) {
+            (Wrapped::Table(a), None) => a.act(i),
+            (Wrapped::Table(_), Some(_)) => {
+                return Err(errors::value(
+                    "probs given to a wrapper built with a habit table: give one or the other",
+                ));
+            }
+            (Wrapped::Policy(a), Some(p)) => a.act_with(i, p.as_slice()?).map_err(agent_error)?,
+            (Wrapped::Policy(_), None) => {
+                return Err(errors::value(
+                    "probs missing: a wrapper without a habit table takes the habit's probabilities each tick",
+                ));
+            }
+        };
+        Ok((d.action, decision_dict(py, &d)?))
+    }
+
+    /// The outcome of the last action: reward, next observed state, the episode's flags.
+    fn observe(
+        &self,
+        reward: f64,
+        next_observed: &Bound<'_, PyAny>,
+        terminated: bool,
+        truncated: bool,
+    ) -> PyResult<()> {
+        let i = self.index(next_observed)?;
+        self.lock()
+            .controller()
+            .observe(reward, i, Ending::from_flags(terminated, truncated));
+        Ok(())
+    }
+
+    /// Ends the episode: test-time learning (§V), the habit's corrections included.
+    fn end_episode(&self) {
+        self.lock().controller().end_episode();
+    }
+
+    /// The corrections test-time learning added to an external habit, `(n_states,
+    /// n_actions)`; for a habit table, its counts `ν`.
+    fn habit_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let counts = match &*self.lock() {
+            Wrapped::Table(a) => a.habit().nu().to_vec(),
+            Wrapped::Policy(a) => a.habit().corrections().to_vec(),
+        };
+        let n_states: usize = self.sizes.iter().product();
+        let n_actions = counts.len() / n_states;
+        let rows: Vec<Vec<f64>> = counts.chunks(n_actions).map(<[f64]>::to_vec).collect();
+        PyArray2::from_vec2(py, &rows).map_err(|e| errors::value(e.to_string()))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "ScaledHabitAgent(habit={})",
+            if self.external { "external policy" } else { "table" }
+        )
+    }
+}
+
+/// The Q-table's habit probabilities `σ(Q[s,·]/T)` of `agent`, `(n_states, n_actions)`,
+/// computed as the scaled agent computes them (`T` is `nu_temperature`, a keyword like
+/// the scaled agent's parameters).
+#[pyfunction]
+#[pyo3(signature = (agent, **params))]
+fn q_table_habit<'py>(
+    py: Python<'py>,
+    agent: &PyAgent,
+    params: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let p = scaled_params(params)?;
+    let q = &agent.bundle.q_learning;
+    let probs = unforeseen_agent::learning::nu_from_q(q.table(), q.n_actions(), 1.0, p.learning.nu_temperature);
+    let rows: Vec<Vec<f64>> = probs.chunks(q.n_actions()).map(<[f64]>::to_vec).collect();
+    let arr = PyArray2::from_vec2(py, &rows).map_err(|e| errors::value(e.to_string()))?;
+    Ok(arr)
+}
+
+/// The batch summary over training seeds of a results file (`unforeseen batch`'s
+/// `results.summary.json` rows), as JSON text: lines written by `unforeseen.evaluate`
+/// are read by the same code as the command line's.
+#[pyfunction]
+fn summarize_json(py: Python<'_>, path: PathBuf) -> PyResult<String> {
+    let lines = py
+        .detach(|| unforeseen::batch::read_lines(&path))
+        .map_err(errors::to_py)?;
+    serde_json::to_string(&unforeseen::batch::summarize(&lines)).map_err(errors::to_py)
+}
+
+/// Registers the classes and functions.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyScaledHabitAgent>()?;
+    m.add_function(wrap_pyfunction!(q_table_habit, m)?)?;
+    m.add_function(wrap_pyfunction!(summarize_json, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,59 @@
+"""Deep-RL baselines (skrl, JAX): a small-budget training run gives a policy that
+evaluates, saves, loads and wraps; skipped without the `deep` extra (CI installs it)."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+import unforeseen
+from unforeseen import baselines
+
+deep = pytest.mark.skipif(not baselines.have_deep_extra(),
+                          reason="the deep extra (skrl[jax]) is not installed: pip install './python[deep]'")
+
+
+def test_ci_has_the_deep_extra():
+    # CI sets UNFORESEEN_REQUIRE_DEEP=1 so that the training smoke test cannot be skipped there.
+    if os.environ.get("UNFORESEEN_REQUIRE_DEEP") == "1":
+        assert baselines.have_deep_extra(), "CI must install the deep extra: pip install './python[deep]'"
+
+
+@deep
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_small_budget_dqn_trains_saves_loads_and_wraps(agent, tmp_path):
+    cfg = baselines.TrainConfig(algo="dqn", observation="kinematic", timesteps=400, learning_starts=100,
+                                num_envs=2, hidden=(16,))
+    policy, info = baselines.train(cfg, seed=1)
+    assert info["steps"] == 400 and info["episodes"] > 0
+    # The policy file's numpy network computes what skrl's network does (float32 there).
+    assert info["max_abs_diff_vs_skrl"] < 1e-4
+    obs = np.zeros(27)
+    p = policy.probs(obs)
+    assert p.shape == (3,) and abs(p.sum() - 1) < 1e-12 and (p > 0).all()
+    path = tmp_path / "dqn.npz"
+    policy.save(path)
+    back = baselines.load_policy(path)
+    assert np.array_equal(back.probs(obs), p) and back.method == "dqn-kinematic"
+    lines = unforeseen.evaluate({1: back}, ["jaywalk"], [1], episodes=2, protocol="zero-shot")
+    assert lines[0]["method"] == "dqn-kinematic" and lines[0]["inference_rate"] == 0
+    wrapped = unforeseen.evaluate(lambda s: unforeseen.ScaledWrapper(habit=back, agent=agent), ["jaywalk"], [1],
+                                  episodes=2, protocol="continual")
+    assert wrapped[0]["method"] == "scaled+dqn-kinematic" and wrapped[0]["inference_rate"] > 0
+
+
+def test_a_damaged_policy_file_is_refused(tmp_path):
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(b"not a policy")
+    with pytest.raises(ValueError, match="not a policy file"):
+        baselines.load_policy(bad)
+
+
+def test_the_command_line_says_what_is_missing(tmp_path, capsys):
+    code = baselines.main(["evaluate", "--seeds", "1", "--policies", str(tmp_path), "--maps", "jaywalk",
+                           "--out", str(tmp_path / "r.jsonl")])
+    assert code == 2
+    assert "no policy file" in capsys.readouterr().err
