@@ -48,21 +48,48 @@ pub fn terminal_states(map: &Map, disc: &Discretizer) -> Vec<usize> {
         .collect()
 }
 
+/// Distance bins that lie wholly at or past the crosswalk's near edge and before the goal:
+/// a car observed in one of them has entered the crosswalk (its front crossed the near
+/// edge). Empty unless an edge of `bins.distance_edges` lies at or before the near edge
+/// (e.g. `[0, 26, 60]` for the default crosswalk: d = 1 is (0, 26] m, from the near edge
+/// on). docs/ARCHITECTURE.md §4.3.
+pub fn entered_bins(map: &Map, disc: &Discretizer) -> Vec<usize> {
+    let near = map.crosswalk_distance_to_goal().0;
+    let edges = &map.bins.distance_edges;
+    // Bin d >= 1 holds distances (edges[d - 1], edges[d]]; the last bin is unbounded.
+    (1..disc.factor_sizes()[0])
+        .filter(|&d| edges.get(d).is_some_and(|&hi| hi <= near))
+        .collect()
+}
+
 /// R(s) for every joint state: the goal reward where the car has arrived (d = 0), the
 /// crash penalty in crash-risk states (a pedestrian on the crosswalk while the car is
-/// moving in a crosswalk bin), and zero elsewhere.
+/// moving in a crosswalk bin), and zero elsewhere. On a map with the red-light rule
+/// (`reward.red_light != 0`) the rule's penalty is added in every state with the light
+/// red or amber (L = 0) and the car in an [`entered_bins`] bin (docs/ARCHITECTURE.md
+/// §4.3): entering the crosswalk on L = 0 costs it, and once entered, every tick there on
+/// L = 0 costs it again, so the planner neither enters on red nor stops past the edge.
 pub fn state_rewards(map: &Map, disc: &Discretizer) -> Vec<f64> {
     let risky = crosswalk_bins(map, disc);
+    let entered = if map.reward.red_light != 0.0 {
+        entered_bins(map, disc)
+    } else {
+        Vec::new()
+    };
     (0..disc.n_states())
         .map(|s| {
             let st = disc.decode(s);
-            if st.d == 0 {
+            let mut r = if st.d == 0 {
                 map.reward.goal
             } else if st.p == 1 && st.v > 0 && risky.contains(&st.d) {
                 map.reward.crash
             } else {
                 0.0
+            };
+            if st.d > 0 && st.l == 0 && entered.contains(&st.d) {
+                r += map.reward.red_light;
             }
+            r
         })
         .collect()
 }
