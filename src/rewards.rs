@@ -3,6 +3,7 @@
 //! of its planning model, and a one-line description of a map's reward. The per-tick
 //! reward the env pays is [`unforeseen_env::RewardTerms`].
 
+use unforeseen_agent::model::TransitionCost;
 use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::Map;
 
@@ -64,34 +65,47 @@ pub fn entered_bins(map: &Map, disc: &Discretizer) -> Vec<usize> {
 
 /// R(s) for every joint state: the goal reward where the car has arrived (d = 0), the
 /// crash penalty in crash-risk states (a pedestrian on the crosswalk while the car is
-/// moving in a crosswalk bin), and zero elsewhere. On a map with the red-light rule
-/// (`reward.red_light != 0`) the rule's penalty is added in every state with the light
-/// red or amber (L = 0) and the car in an [`entered_bins`] bin (docs/ARCHITECTURE.md
-/// §4.3): entering the crosswalk on L = 0 costs it, and once entered, every tick there on
-/// L = 0 costs it again, so the planner neither enters on red nor stops past the edge.
+/// moving in a crosswalk bin), and zero elsewhere. The red-light rule is not a state
+/// preference but one over transitions ([`red_light_cost`]).
 pub fn state_rewards(map: &Map, disc: &Discretizer) -> Vec<f64> {
     let risky = crosswalk_bins(map, disc);
-    let entered = if map.reward.red_light != 0.0 {
-        entered_bins(map, disc)
-    } else {
-        Vec::new()
-    };
     (0..disc.n_states())
         .map(|s| {
             let st = disc.decode(s);
-            let mut r = if st.d == 0 {
+            if st.d == 0 {
                 map.reward.goal
             } else if st.p == 1 && st.v > 0 && risky.contains(&st.d) {
                 map.reward.crash
             } else {
                 0.0
-            };
-            if st.d > 0 && st.l == 0 && entered.contains(&st.d) {
-                r += map.reward.red_light;
             }
-            r
         })
         .collect()
+}
+
+/// The red-light rule as the planner's preference over transitions (docs/ARCHITECTURE.md
+/// §4.3): a step from a state before the crosswalk's near edge on L = 0 (red or amber,
+/// not arrived) to a state in an [`entered_bins`] bin on L = 0 costs `-red_light / tau_c`
+/// nats of expected free energy, the scale of `C = log_softmax(R / tau_c)`. `None` on a
+/// map without the rule, or whose bins cannot tell the approach from the crosswalk
+/// (no [`entered_bins`]; the default bins).
+pub fn red_light_cost(map: &Map, disc: &Discretizer, tau_c: f64) -> Option<TransitionCost> {
+    if map.reward.red_light == 0.0 {
+        return None;
+    }
+    let entered = entered_bins(map, disc);
+    if entered.is_empty() {
+        return None;
+    }
+    let states: Vec<_> = (0..disc.n_states()).map(|s| disc.decode(s)).collect();
+    Some(TransitionCost {
+        from: states
+            .iter()
+            .map(|st| st.d > 0 && st.l == 0 && !entered.contains(&st.d))
+            .collect(),
+        to: states.iter().map(|st| st.l == 0 && entered.contains(&st.d)).collect(),
+        cost: -map.reward.red_light / tau_c,
+    })
 }
 
 #[cfg(test)]

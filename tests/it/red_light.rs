@@ -1,5 +1,5 @@
 //! The red-light rule where the planner knows it (docs/ARCHITECTURE.md §4.3): the
-//! rule-aware preferences R(s) on `maps/red_light/`, rule-free maps unchanged, the
+//! rule-aware planner on `maps/red_light/` (a preference over transitions), rule-free maps unchanged, the
 //! `max_red_light` expectation, and `batch --train-map`.
 
 use std::path::{Path, PathBuf};
@@ -7,7 +7,7 @@ use unforeseen::batch::check_expectations;
 use unforeseen::methods::Method;
 use unforeseen::metrics::Aggregate;
 use unforeseen::protocol::Protocol;
-use unforeseen::rewards::{entered_bins, state_rewards};
+use unforeseen::rewards::{entered_bins, red_light_cost, state_rewards};
 use unforeseen_discretizer::{Discretizer, State};
 
 use crate::common::{assert_exit, run_cli};
@@ -20,37 +20,42 @@ fn load(rel: &str) -> unforeseen_sim::Map {
     unforeseen::maps::load(shipped(rel).to_str().unwrap()).expect("shipped map")
 }
 
-/// R at (d, v, L, p) on `map`.
-fn r_at(map: &unforeseen_sim::Map, d: usize, v: usize, l: usize, p: usize) -> f64 {
-    let disc = Discretizer::new(&map.bins).unwrap();
-    state_rewards(map, &disc)[disc.encode(State { d, v, l, p })]
-}
-
 #[test]
-fn the_planner_pays_the_red_light_rule_past_the_near_edge_on_red() {
+fn the_planner_pays_for_entering_the_crosswalk_on_red() {
     let map = load("red_light/intersection.ron");
     let disc = Discretizer::new(&map.bins).unwrap();
     // Edges [0, 26, 60]: d = 1 is (0, 26] m to go, from the near edge (26 m) to the goal.
     assert_eq!(map.bins.distance_edges, [0.0, 26.0, 60.0]);
     assert_eq!(entered_bins(&map, &disc), [1]);
-    let (goal, crash, red) = (map.reward.goal, map.reward.crash, map.reward.red_light);
-    assert_eq!((goal, crash, red), (50.0, -25.0, -100.0));
-    // Hand-worked: at full speed (v = 3) past the near edge on red, nobody there: -100.
-    assert_eq!(r_at(&map, 1, 3, 0, 0), -100.0);
-    // The same with a pedestrian on the crosswalk: the crash risk and the rule, -125,
-    // below standing there on red (-100), so the planner still prefers stopping.
-    assert_eq!(r_at(&map, 1, 3, 0, 1), -125.0);
-    assert_eq!(r_at(&map, 1, 0, 0, 1), -100.0);
-    // Green past the edge: only the crash risk; before the edge on red: nothing; arrived: the goal.
-    assert_eq!(r_at(&map, 1, 3, 1, 1), -25.0);
-    assert_eq!(r_at(&map, 1, 3, 1, 0), 0.0);
-    assert_eq!(r_at(&map, 2, 3, 0, 0), 0.0);
-    assert_eq!(r_at(&map, 2, 0, 0, 1), 0.0);
-    assert_eq!(r_at(&map, 0, 3, 0, 1), 50.0);
-    // C = log_softmax(R): entering on red is 100 nats less preferred than waiting before it.
-    let c = unforeseen_agent::maths::log_softmax(&state_rewards(&map, &disc));
-    let at = |d, v, l, p| c[disc.encode(State { d, v, l, p })];
-    assert!((at(2, 3, 0, 0) - at(1, 3, 0, 0) - 100.0).abs() < 1e-9);
+    let rule = red_light_cost(&map, &disc, 1.0).expect("the rule with an edge at the near edge");
+    assert_eq!(rule.cost, 100.0, "-red_light / tau_c nats");
+    assert_eq!(red_light_cost(&map, &disc, 2.0).unwrap().cost, 50.0);
+    let at = |d, v, l, p| disc.encode(State { d, v, l, p });
+    // From: before the near edge on red or amber; to: past it on red or amber.
+    assert!(rule.from[at(2, 3, 0, 0)] && rule.from[at(3, 0, 0, 1)]);
+    assert!(!rule.from[at(2, 3, 1, 0)] && !rule.from[at(1, 3, 0, 0)] && !rule.from[at(0, 3, 0, 0)]);
+    assert!(rule.to[at(1, 3, 0, 0)] && rule.to[at(1, 0, 0, 1)]);
+    assert!(!rule.to[at(1, 3, 1, 0)] && !rule.to[at(2, 3, 0, 0)] && !rule.to[at(0, 3, 0, 0)]);
+    // The state preferences stay the paper's: R(s) is the rule-free map's, bit for bit.
+    let mut free = map.clone();
+    free.reward.red_light = 0.0;
+    assert!(red_light_cost(&free, &disc, 1.0).is_none());
+    let bits = |m: &unforeseen_sim::Map| state_rewards(m, &disc).iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&map), bits(&free));
+    // The trained agent carries it: its planning model has the rule, a rule-free one not.
+    let cfg = unforeseen::training::TrainConfig::new(5, 1);
+    let (agent, _) = unforeseen::training::train(&map, &cfg).unwrap();
+    assert_eq!(agent.world_model.generative().transition_cost.as_ref(), Some(&rule));
+    assert_eq!(
+        agent.world_model.planning_generative().transition_cost.as_ref(),
+        Some(&rule)
+    );
+    let (free_agent, _) = unforeseen::training::train(&free, &cfg).unwrap();
+    assert!(free_agent.world_model.generative().transition_cost.is_none());
+    // ...and keeps it through its file.
+    let back = unforeseen_agent::persist::AgentBundle::from_ron_str(&agent.to_ron_string()).unwrap();
+    assert_eq!(back.world_model.generative().transition_cost.as_ref(), Some(&rule));
+    assert!(!free_agent.to_ron_string().contains("transition_cost"));
 }
 
 #[test]
