@@ -3,6 +3,7 @@
 //! of its planning model, and a one-line description of a map's reward. The per-tick
 //! reward the env pays is [`unforeseen_env::RewardTerms`].
 
+use unforeseen_agent::model::TransitionCost;
 use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::Map;
 
@@ -48,9 +49,24 @@ pub fn terminal_states(map: &Map, disc: &Discretizer) -> Vec<usize> {
         .collect()
 }
 
+/// Distance bins that lie wholly at or past the crosswalk's near edge and before the goal:
+/// a car observed in one of them has entered the crosswalk (its front crossed the near
+/// edge). Empty unless an edge of `bins.distance_edges` lies at or before the near edge
+/// (e.g. `[0, 26, 60]` for the default crosswalk: d = 1 is (0, 26] m, from the near edge
+/// on). docs/ARCHITECTURE.md §4.3.
+pub fn entered_bins(map: &Map, disc: &Discretizer) -> Vec<usize> {
+    let near = map.crosswalk_distance_to_goal().0;
+    let edges = &map.bins.distance_edges;
+    // Bin d >= 1 holds distances (edges[d - 1], edges[d]]; the last bin is unbounded.
+    (1..disc.factor_sizes()[0])
+        .filter(|&d| edges.get(d).is_some_and(|&hi| hi <= near))
+        .collect()
+}
+
 /// R(s) for every joint state: the goal reward where the car has arrived (d = 0), the
 /// crash penalty in crash-risk states (a pedestrian on the crosswalk while the car is
-/// moving in a crosswalk bin), and zero elsewhere.
+/// moving in a crosswalk bin), and zero elsewhere. The red-light rule is not a state
+/// preference but one over transitions ([`red_light_cost`]).
 pub fn state_rewards(map: &Map, disc: &Discretizer) -> Vec<f64> {
     let risky = crosswalk_bins(map, disc);
     (0..disc.n_states())
@@ -65,6 +81,31 @@ pub fn state_rewards(map: &Map, disc: &Discretizer) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// The red-light rule as the planner's preference over transitions (docs/ARCHITECTURE.md
+/// §4.3): a step from a state before the crosswalk's near edge on L = 0 (red or amber,
+/// not arrived) to a state in an [`entered_bins`] bin on L = 0 costs `-red_light / tau_c`
+/// nats of expected free energy, the scale of `C = log_softmax(R / tau_c)`. `None` on a
+/// map without the rule, or whose bins cannot tell the approach from the crosswalk
+/// (no [`entered_bins`]; the default bins).
+pub fn red_light_cost(map: &Map, disc: &Discretizer, tau_c: f64) -> Option<TransitionCost> {
+    if map.reward.red_light == 0.0 {
+        return None;
+    }
+    let entered = entered_bins(map, disc);
+    if entered.is_empty() {
+        return None;
+    }
+    let states: Vec<_> = (0..disc.n_states()).map(|s| disc.decode(s)).collect();
+    Some(TransitionCost {
+        from: states
+            .iter()
+            .map(|st| st.d > 0 && st.l == 0 && !entered.contains(&st.d))
+            .collect(),
+        to: states.iter().map(|st| st.l == 0 && entered.contains(&st.d)).collect(),
+        cost: -map.reward.red_light / tau_c,
+    })
 }
 
 #[cfg(test)]

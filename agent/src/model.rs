@@ -35,6 +35,9 @@ pub struct GenerativeModel {
     pub ln_b_t: Vec<DMatrix<f64>>,
     /// Log preferences over observations, `C = ln c` (a normalised log distribution).
     pub c: Vec<f64>,
+    /// A preference over transitions, beside `C` (docs/ARCHITECTURE.md §4.3): planning adds
+    /// its expected cost to every step's `G`.
+    pub transition_cost: Option<TransitionCost>,
     /// Initial state prior `D`.
     pub d: Vec<f64>,
     /// The same `B[u]` as per-factor steps (§II-A), when the model came from a factored
@@ -44,6 +47,20 @@ pub struct GenerativeModel {
     /// from a factored world model and every entry of `B` is at least the log floor, so
     /// that the factored sum is `ln B` up to rounding (see [`FactoredLogB`]).
     pub log_factored: Option<FactoredLogB>,
+}
+
+/// A cost in nats for moving from one set of states to another in one step (a
+/// preference over transitions that no state preference can express, such as entering
+/// the crosswalk on red: docs/ARCHITECTURE.md §4.3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransitionCost {
+    /// The states a costly step starts from, per state.
+    pub from: Vec<bool>,
+    /// The states a costly step ends in, per state.
+    pub to: Vec<bool>,
+    /// The cost, in nats of `G` (added to the expected free energy, so positive is avoided).
+    pub cost: f64,
 }
 
 impl GenerativeModel {
@@ -66,10 +83,41 @@ impl GenerativeModel {
             ln_b,
             ln_b_t,
             c,
+            transition_cost: None,
             d,
             factored: None,
             log_factored: None,
         }
+    }
+
+    /// The expected cost of one step `u` from belief `s` under [`Self::transition_cost`]
+    /// (0 without one): `cost · Σ_{s'} to[s'] (B[u] (from ⊙ s))[s']`. `masked` and
+    /// `next` are scratch of `n_states`.
+    pub fn transition_cost_of(
+        &self,
+        u: usize,
+        s: &[f64],
+        masked: &mut [f64],
+        next: &mut [f64],
+        scratch: &mut Vec<f64>,
+    ) -> f64 {
+        let Some(t) = &self.transition_cost else {
+            return 0.0;
+        };
+        for ((m, x), f) in masked.iter_mut().zip(s).zip(&t.from) {
+            *m = if *f { *x } else { 0.0 };
+        }
+        if masked.iter().all(|m| *m == 0.0) {
+            return 0.0;
+        }
+        self.transition_into(u, masked, next, scratch);
+        t.cost
+            * next
+                .iter()
+                .zip(&t.to)
+                .filter(|(_, to)| **to)
+                .map(|(p, _)| p)
+                .sum::<f64>()
     }
 
     /// `out = B[u] x` (§II): the factor-by-factor product when it is cheaper than the
@@ -109,6 +157,8 @@ struct WorldModelRepr {
     d_counts: Vec<f64>,
     #[serde(default)]
     terminal: Vec<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    transition_cost: Option<TransitionCost>,
 }
 
 /// A `DMatrix` stored as nalgebra writes it, `(data, nrows, ncols)` in column-major
@@ -220,6 +270,22 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
             format!("state {} is out of range (0..{n})", r.terminal[i]),
         ));
     }
+    if let Some(t) = &r.transition_cost {
+        for (name, len) in [("from", t.from.len()), ("to", t.to.len())] {
+            if len != n {
+                return Err(FieldError::new(
+                    format!("transition_cost.{name}"),
+                    format!("{len} entries, expected one per state ({n})"),
+                ));
+            }
+        }
+        if !t.cost.is_finite() {
+            return Err(FieldError::new(
+                "transition_cost.cost",
+                format!("{} is not finite", t.cost),
+            ));
+        }
+    }
     Ok(())
 }
 
@@ -256,6 +322,7 @@ impl From<WorldModel> for WorldModelRepr {
             c: w.gm.c,
             d_counts: w.d_counts,
             terminal: w.terminal,
+            transition_cost: w.gm.transition_cost,
         }
     }
 }
@@ -264,8 +331,10 @@ impl TryFrom<WorldModelRepr> for WorldModel {
     type Error = FieldError;
     fn try_from(r: WorldModelRepr) -> Result<Self, FieldError> {
         check_repr(&r)?;
+        let mut gm = GenerativeModel::new(DMatrix::zeros(0, 0), vec![], r.c, vec![]);
+        gm.transition_cost = r.transition_cost;
         let mut w = WorldModel {
-            gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], r.c, vec![]),
+            gm,
             gm_plan: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], vec![], vec![]),
             terminal: r.terminal,
             pooling: None,
@@ -474,6 +543,7 @@ impl WorldModel {
             }
         }
         let c = std::mem::take(&mut self.gm.c);
+        let rule = self.gm.transition_cost.take();
         let mut d = self.d_counts.clone();
         crate::maths::normalize_in_place(&mut d);
         let mut b_plan = b.clone();
@@ -484,6 +554,7 @@ impl WorldModel {
             }
         }
         self.gm_plan = GenerativeModel::new(a.clone(), b_plan, c.clone(), d.clone());
+        self.gm_plan.transition_cost.clone_from(&rule);
         self.gm_plan.factored = factored.as_ref().map(|ft| ft.with_terminal(&self.terminal));
         // Perception's messages through ln B factor by factor, when no entry of B is under
         // the log floor (then the per-factor sum is the floored ln B up to rounding).
@@ -493,6 +564,7 @@ impl WorldModel {
             None
         };
         self.gm = GenerativeModel::new(a, b, c, d);
+        self.gm.transition_cost = rule;
         self.gm.factored = factored;
         self.gm.log_factored = log_factored;
     }
@@ -684,6 +756,32 @@ impl WorldModel {
         let scaled: Vec<f64> = rewards.iter().map(|r| r / tau_c).collect();
         self.gm.c = log_softmax(&scaled);
         self.gm_plan.c = self.gm.c.clone();
+        Ok(())
+    }
+
+    /// Set (or, with `None`, clear) the preference over transitions planning adds to `G`
+    /// ([`TransitionCost`]; docs/ARCHITECTURE.md §4.3). Both masks need `n_states`
+    /// entries and the cost must be finite.
+    pub fn set_transition_cost(&mut self, cost: Option<TransitionCost>) -> Result<(), AgentError> {
+        if let Some(t) = &cost {
+            for (what, len) in [
+                ("transition cost from", t.from.len()),
+                ("transition cost to", t.to.len()),
+            ] {
+                if len != self.n_states() {
+                    return Err(AgentError::SizeMismatch {
+                        what: what.into(),
+                        expected: self.n_states(),
+                        found: len,
+                    });
+                }
+            }
+            if !t.cost.is_finite() {
+                return Err(ParamError::new("transition cost", t.cost, "finite").into());
+            }
+        }
+        self.gm.transition_cost.clone_from(&cost);
+        self.gm_plan.transition_cost = cost;
         Ok(())
     }
 

@@ -6,7 +6,9 @@
 //! factor for dense beliefs, §II-A); the brute-force oracle uses the dense `B`.
 //!
 //! All policies start from `q_t`: `s_1 = B[π_1] q_t`, `s_k = B[π_k] s_{k-1}`, `o_k = A s_k`,
-//! `G(π) = Σ_k [ o_k·(ln o_k - C) + s_k·H_A ]` (risk + ambiguity).
+//! `G(π) = Σ_k [ o_k·(ln o_k - C) + s_k·H_A ]` (risk + ambiguity), plus, where the model
+//! has a preference over transitions ([`crate::model::TransitionCost`], the red-light rule),
+//! each step's expected cost `cost · P(s_{k-1} ∈ from, s_k ∈ to)`.
 //!
 //! The tree takes two models: the first step from `q_t` goes through the *root* model's
 //! `B` and every later step through the planning model's. In the agent the planning
@@ -80,6 +82,14 @@ pub fn efe_brute_force(gm: &GenerativeModel, q_t: &[f64], policy: &[usize]) -> f
     let mut obuf = vec![0.0; gm.n_obs()];
     let mut g = 0.0;
     for u in policy {
+        if let Some(t) = &gm.transition_cost {
+            // The step's cost straight from its definition, state pair by state pair.
+            for (j, sj) in s.iter().enumerate().filter(|(j, _)| t.from[*j]) {
+                for i in (0..n).filter(|&i| t.to[i]) {
+                    g += t.cost * gm.b[*u][(i, j)] * sj;
+                }
+            }
+        }
         axpy_columns(gm.b[*u].as_slice(), n, &s, &mut next);
         std::mem::swap(&mut s, &mut next);
         let (r, a) = step_efe(gm, &s, &mut obuf);
@@ -134,6 +144,10 @@ pub struct EfeTree {
     bufs: Vec<Vec<f64>>,
     obuf: Vec<f64>,
     scratch: Vec<f64>,
+    /// The belief masked to a [`crate::model::TransitionCost`]'s `from` states, and its
+    /// prediction.
+    masked: Vec<f64>,
+    masked_next: Vec<f64>,
     /// `q_t` of the last evaluation (the root), for [`EfeTree::evaluate_reusing`].
     memo_root: Vec<f64>,
     /// Per internal node (depths 1..H-1, breadth-first): its predicted belief...
@@ -167,6 +181,8 @@ impl EfeTree {
             bufs: vec![vec![0.0; n_states]; horizon + 1],
             obuf: vec![0.0; n_obs],
             scratch: vec![0.0; n_states],
+            masked: vec![0.0; n_states],
+            masked_next: vec![0.0; n_states],
             memo_root: vec![0.0; n_states],
             memo_s: vec![0.0; internal * n_states],
             memo_g: vec![0.0; internal],
@@ -246,7 +262,16 @@ impl EfeTree {
             }
             self.matvecs += 1;
             let (r, a) = step_efe(gm, &self.bufs[depth + 1], &mut self.obuf);
-            let g = g_acc + r + a;
+            let mut g = g_acc + r + a;
+            if step_model.transition_cost.is_some() {
+                g += step_model.transition_cost_of(
+                    u,
+                    &self.bufs[depth],
+                    &mut self.masked,
+                    &mut self.masked_next,
+                    &mut self.scratch,
+                );
+            }
             let child = idx * self.n_actions + u;
             if depth + 1 == self.horizon {
                 self.g[child] = g;

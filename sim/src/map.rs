@@ -353,6 +353,10 @@ pub struct Expectation {
     /// Highest acceptable share of ticks that ran planning, in [0, 1].
     #[serde(default)]
     pub max_inference_rate: Option<f64>,
+    /// Highest acceptable rate of red-light violations (the car's front entering the
+    /// crosswalk on red) per episode, in [0, 1].
+    #[serde(default)]
+    pub max_red_light: Option<f64>,
     /// The evaluation protocol the bounds apply to, as written in the map (e.g.
     /// `"Continual"`); absent: every protocol the batch ran the method under.
     #[serde(
@@ -715,6 +719,7 @@ impl Map {
                 ("max_reward", x.max_reward),
                 ("max_collision", x.max_collision),
                 ("max_inference_rate", x.max_inference_rate),
+                ("max_red_light", x.max_red_light),
             ] {
                 if let Some(v) = val {
                     parts.push(format!("{label} {v}"));

@@ -565,6 +565,7 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
             ("max_success", x.max_success),
             ("max_collision", x.max_collision),
             ("max_inference_rate", x.max_inference_rate),
+            ("max_red_light", x.max_red_light),
         ] {
             if let Some(v) = val {
                 c.probability(&format!("{path}.{name}"), v, false);

@@ -67,9 +67,13 @@ pub struct BatchArgs {
     /// Training episodes when no --agent is given.
     #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
     pub train_episodes: u64,
-    /// Agent file from `unforeseen train` (default: train on the embedded intersection map).
+    /// Agent file from `unforeseen train` (default: train on --train-map).
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
+    /// Training map (file or embedded name) when no --agent is given: the agent (or, with
+    /// --train-seeds, each agent) is trained there.
+    #[arg(long, value_name = "MAP", default_value = DEFAULT_TRAIN_MAP, conflicts_with = "agent")]
+    pub train_map: String,
     /// Training seeds and the agent cache.
     #[command(flatten)]
     pub seeds: TrainSeedArgs,
@@ -114,7 +118,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             let bundle = pool.install(|| {
                 super::load_or_train(
                     args.agent.as_deref(),
-                    DEFAULT_TRAIN_MAP,
+                    &args.train_map,
                     args.train_episodes,
                     args.seed,
                     args.quiet,
@@ -123,7 +127,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
             let identity = match &args.agent {
                 Some(_) => agent_file_identity(&bundle),
                 None => {
-                    trained_agents_identity(&maps::load(DEFAULT_TRAIN_MAP)?, &[Some(args.seed)], args.train_episodes)?
+                    trained_agents_identity(&maps::load(&args.train_map)?, &[Some(args.seed)], args.train_episodes)?
                 }
             };
             let agent = Agent::from_bundle(bundle);
@@ -132,7 +136,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         }
         Some(seeds) => {
             let axis: Vec<Option<u64>> = seeds.0.iter().map(|&s| Some(s)).collect();
-            let identity = trained_agents_identity(&maps::load(DEFAULT_TRAIN_MAP)?, &axis, args.train_episodes)?;
+            let identity = trained_agents_identity(&maps::load(&args.train_map)?, &axis, args.train_episodes)?;
             (None, axis, identity)
         }
     };
@@ -155,7 +159,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         None => pool.install(|| {
             args.seeds.train(
                 &plan.train_seeds_to_run(),
-                DEFAULT_TRAIN_MAP,
+                &args.train_map,
                 args.train_episodes,
                 args.quiet,
             )

@@ -139,6 +139,7 @@ fn expectations_pass_and_fail_as_declared() {
         max_reward: None,
         max_collision: None,
         max_inference_rate: None,
+        max_red_light: None,
         protocol: None,
     };
     map.expect = vec![

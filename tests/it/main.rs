@@ -16,6 +16,7 @@ mod outputs;
 mod overrides;
 mod protocols;
 mod readme;
+mod red_light;
 mod reference;
 mod replay;
 mod robustness;

@@ -6,3 +6,4 @@ mod hand_worked;
 mod planning_root;
 mod properties;
 mod pymdp_crossval;
+mod transition_cost;
