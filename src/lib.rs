@@ -33,7 +33,7 @@
 //! * [`tick_replay`] records the scaled agent's reasoning ticks in episodes and replays
 //!   them (the benches' in-loop reasoning tick);
 //! * [`batch`] plans and runs scenario suites and sweeps headless, in parallel and in
-//!   shards;
+//!   shards, and [`merge`] joins shard files produced anywhere into one run's file;
 //! * [`error`] is the library's typed error, which every public function returns;
 //! * [`progress`] is how long runs report progress ([`progress::Progress`]); the library
 //!   itself prints nothing;
@@ -50,6 +50,7 @@ pub mod cli;
 pub mod error;
 pub mod experiments;
 pub mod maps;
+pub mod merge;
 pub mod methods;
 pub mod metrics;
 pub mod overrides;
