@@ -12,6 +12,8 @@
 //! * [`render`]: the top-down frame (tiny-skia) and the text line;
 //! * [`agent`]: training, agent files, every method's controller, evaluation;
 //! * [`results`]: `compare` and `batch` as the JSON data their files hold;
+//! * [`units`]: a batch run as units of work for a distributed driver (plan, train a
+//!   seed, run a block of units with the GIL released, join the results);
 //! * [`errors`]: Rust errors as Python exceptions (`ValueError` for what the user can fix).
 
 mod agent;
@@ -20,6 +22,7 @@ mod errors;
 mod maps;
 mod render;
 mod results;
+mod units;
 mod vector;
 
 use pyo3::prelude::*;
@@ -45,5 +48,6 @@ fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     vector::register(m)?;
     agent::register(m)?;
     results::register(m)?;
+    units::register(m)?;
     Ok(())
 }
