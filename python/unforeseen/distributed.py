@@ -90,6 +90,12 @@ def _ray() -> Any:
     return ray
 
 
+def _task_options(max_retries: int) -> dict[str, Any]:
+    """Ray options of every task: retried when its worker or node dies, never for an
+    exception it raises (an input error fails the same way on every attempt)."""
+    return {"max_retries": max_retries, "retry_exceptions": False}
+
+
 def _train_task(seed: int, episodes: int) -> bytes:
     """One agent, trained on the node that runs the task."""
     return _unforeseen.train_agent(seed, episodes)
@@ -248,7 +254,7 @@ def run_batch(
         _write_atomic(out, plan["head"])
         if not ray.is_initialized():
             ray.init(address=address, include_dashboard=False, log_to_driver=False)
-        options = {"max_retries": max_retries, "retry_exceptions": False}
+        options = _task_options(max_retries)
         # One agent per training seed the remaining units need, in the object store.
         if plan["agent"] is not None:
             agent_refs = {plan["todo_seeds"][0] if plan["todo_seeds"] else None: ray.put(plan["agent"].encode())}
