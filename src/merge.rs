@@ -72,7 +72,10 @@ pub fn units_of(identity: &RunIdentity) -> Result<Vec<(Unit, UnitKey)>, String> 
     let methods = identity
         .methods
         .iter()
-        .map(|m| m.parse::<Method>().map_err(|e| format!("its identity names method {m:?}: {e}")))
+        .map(|m| {
+            m.parse::<Method>()
+                .map_err(|e| format!("its identity names method {m:?}: {e}"))
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let params = identity
         .param_sets
@@ -140,7 +143,11 @@ fn missing_text(missing: &[usize], all: &[(Unit, UnitKey)]) -> String {
         "units {} are in no part: {}{}",
         positions.join(", "),
         named.join("; "),
-        if more > 0 { format!("; and {more} more") } else { String::new() }
+        if more > 0 {
+            format!("; and {more} more")
+        } else {
+            String::new()
+        }
     )
 }
 
@@ -202,7 +209,11 @@ pub fn merge(parts: &[PathBuf]) -> Result<Merged, Error> {
                     problem: format!(
                         "written by another run than {} ({}); merge only the parts of one run",
                         path.display(),
-                        first.differences(id).join("; ").replace("the file has", "this part has").replace("this run", "the other")
+                        first
+                            .differences(id)
+                            .join("; ")
+                            .replace("the file has", "this part has")
+                            .replace("this run", "the other")
                     ),
                 });
             }
@@ -247,7 +258,10 @@ pub fn merge(parts: &[PathBuf]) -> Result<Merged, Error> {
         let cut = if cut.is_empty() {
             String::new()
         } else {
-            format!(" ({} ended in a cut line: a shard killed while writing)", cut.join(", "))
+            format!(
+                " ({} ended in a cut line: a shard killed while writing)",
+                cut.join(", ")
+            )
         };
         return Err(Error::flag(
             flag,

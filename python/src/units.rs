@@ -19,8 +19,8 @@ use pyo3::types::PyBytes;
 use serde_json::{Value, json};
 use unforeseen::agents::Agent;
 use unforeseen::batch::{
-    BatchConfig, DEFAULT_METHODS, RunIdentity, Scenario, agent_file_identity, checked_sweep, load_scenarios,
-    run_unit, trained_agents_identity,
+    BatchConfig, DEFAULT_METHODS, RunIdentity, Scenario, agent_file_identity, checked_sweep, load_scenarios, run_unit,
+    trained_agents_identity,
 };
 use unforeseen::methods::Method;
 use unforeseen::progress::NoProgress;
@@ -71,7 +71,9 @@ fn check_out(out: &Path, force: bool, resume: bool) -> PyResult<()> {
     if force || resume {
         return Ok(());
     }
-    let head: Vec<u8> = std::fs::read(out).map(|b| b.into_iter().take(16).collect()).unwrap_or_default();
+    let head: Vec<u8> = std::fs::read(out)
+        .map(|b| b.into_iter().take(16).collect())
+        .unwrap_or_default();
     if !head.is_empty() && !head.starts_with(b"{\"run\":") {
         return Err(errors::value(format!(
             "--out {}: exists and is not a batch's results file (its first line is not {{\"run\": ...}}); give another --out, or add --force to replace it",
@@ -132,7 +134,11 @@ fn plan_batch(
         (None, Some(path)) => {
             let bundle = unforeseen::agent_file::load(path).map_err(errors::to_py)?;
             let a = Agent::from_bundle(bundle.clone());
-            (vec![a.train_seed], agent_file_identity(&bundle), Some(bundle.to_ron_string()))
+            (
+                vec![a.train_seed],
+                agent_file_identity(&bundle),
+                Some(bundle.to_ron_string()),
+            )
         }
         (None, None) => {
             let axis = vec![Some(seed)];

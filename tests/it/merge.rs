@@ -30,8 +30,21 @@ impl Setup {
     fn batch(&self, out: &str, episodes: &str, shard: Option<&str>) {
         let (map, agent, out) = (self.p("tiny.ron"), self.p("agent.ron"), self.p(out));
         let mut args = vec![
-            "batch", &map, "--agent", &agent, "--episodes", episodes, "--seed", "5", "--jobs", "2", "--quiet",
-            "--set", "horizon=1,2", "--out", &out,
+            "batch",
+            &map,
+            "--agent",
+            &agent,
+            "--episodes",
+            episodes,
+            "--seed",
+            "5",
+            "--jobs",
+            "2",
+            "--quiet",
+            "--set",
+            "horizon=1,2",
+            "--out",
+            &out,
         ];
         if let Some(s) = shard {
             args.extend(["--shard", s]);
@@ -39,7 +52,11 @@ impl Setup {
         let run = run_cli(&args);
         // The tiny agent fails some expectations of the intersection (exit 1): what is
         // compared here is the results, not the gate.
-        assert!(matches!(run.status.code(), Some(0 | 1)), "{}", crate::common::output_text(&run));
+        assert!(
+            matches!(run.status.code(), Some(0 | 1)),
+            "{}",
+            crate::common::output_text(&run)
+        );
     }
 
     fn merge(&self, parts: &[&str], out: &str) -> std::process::Output {
@@ -80,10 +97,18 @@ fn shards_merge_into_the_file_of_one_run_and_gaps_overlaps_and_other_runs_are_re
     }
     // In any order, the parts merge into the whole run's lines and summary.
     let merged = s.merge(&["part-3.jsonl", "part-1.jsonl", "part-2.jsonl"], "merged.jsonl");
-    assert!(matches!(merged.status.code(), Some(0 | 1)), "{}", crate::common::output_text(&merged));
+    assert!(
+        matches!(merged.status.code(), Some(0 | 1)),
+        "{}",
+        crate::common::output_text(&merged)
+    );
     assert!(crate::common::output_text(&merged).contains("merged 3 part(s)"));
     let whole = without_timing(&s.path("whole.jsonl"));
-    assert!(whole.len() >= 6, "the run should have several units, has {}", whole.len());
+    assert!(
+        whole.len() >= 6,
+        "the run should have several units, has {}",
+        whole.len()
+    );
     assert_eq!(without_timing(&s.path("merged.jsonl")), whole);
     assert_eq!(
         summary_without_timing(&s.path("merged.jsonl")),
@@ -97,7 +122,11 @@ fn shards_merge_into_the_file_of_one_run_and_gaps_overlaps_and_other_runs_are_re
     assert_eq!(merged.status.code(), whole_code);
 
     // A shard missing: refused, naming the units; no merged file written.
-    let units: Vec<usize> = read_lines(&s.path("part-2.jsonl")).unwrap().iter().map(|l| l.unit).collect();
+    let units: Vec<usize> = read_lines(&s.path("part-2.jsonl"))
+        .unwrap()
+        .iter()
+        .map(|l| l.unit)
+        .collect();
     assert!(!units.is_empty());
     let gap = s.merge(&["part-1.jsonl", "part-3.jsonl"], "gap.jsonl");
     let first = format!("unit {} (tiny", units[0]);
@@ -105,7 +134,10 @@ fn shards_merge_into_the_file_of_one_run_and_gaps_overlaps_and_other_runs_are_re
     assert!(!s.path("gap.jsonl").exists() && !summary_path(&s.path("gap.jsonl")).exists());
 
     // A shard given twice, or overlapping the whole: refused, naming both places.
-    let twice = s.merge(&["part-1.jsonl", "part-2.jsonl", "part-2.jsonl", "part-3.jsonl"], "twice.jsonl");
+    let twice = s.merge(
+        &["part-1.jsonl", "part-2.jsonl", "part-2.jsonl", "part-3.jsonl"],
+        "twice.jsonl",
+    );
     assert_exit(&twice, 2, &["in two places", "part-2.jsonl line", "overlap"]);
     let overlap = s.merge(&["whole.jsonl", "part-3.jsonl"], "overlap.jsonl");
     assert_exit(&overlap, 2, &["in two places", "whole.jsonl line", "part-3.jsonl line"]);
