@@ -34,7 +34,7 @@ START_TIMEOUT = 60
 RUN_TIMEOUT = 90
 # The sweep: two maps, two training seeds, one unit per task.
 SWEEP = ["batch", str(REPO / "maps" / "jaywalk.ron"), str(REPO / "maps" / "stop_midway.ron"),
-         "--train-seeds", "1..2", "--train-episodes", "200", "--episodes", "10", "--seed", "5"]
+         "--train-seeds", "1..2", "--train-episodes", "200", "--episodes", "6", "--seed", "5"]
 
 
 def test_train_seeds_parse_as_the_command_line_writes_them():
@@ -289,16 +289,52 @@ def _wait_for(what: str, found, proc: subprocess.Popen[str], timeout: float):
     pytest.fail(f"timed out waiting for {what}")
 
 
-def test_a_sweep_whose_worker_node_is_killed_equals_one_machine(cluster: Cluster, tmp_path: Path):
+@pytest.fixture(scope="module")
+def one_machine(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The sweep run by the command line on this machine."""
     cli = cli_binary()
     if cli is None:
         if os.environ.get("CI"):
             pytest.fail("CI must build the unforeseen binary before the Python tests (cargo test does)")
         pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
-    one = tmp_path / "one.jsonl"
+    one = tmp_path_factory.mktemp("one") / "one.jsonl"
     subprocess.run([str(cli), *SWEEP, "--no-cache", "--quiet", "--out", str(one)], check=False,
                    capture_output=True, timeout=RUN_TIMEOUT)
     assert one.is_file() and one.with_suffix(".summary.json").is_file()
+    return one
+
+
+def _lines_written(out: Path) -> int:
+    try:
+        return max(0, out.read_text().count("\n") - 1)
+    except FileNotFoundError:
+        return 0
+
+
+def test_a_killed_driver_resumes_with_the_same_command(cluster: Cluster, one_machine: Path, tmp_path: Path):
+    out = tmp_path / "resumed.jsonl"
+    args = ["-m", "unforeseen.distributed", *SWEEP, "--out", str(out), "--units-per-task", "1", "--address", ADDRESS]
+    driver = cluster.driver(args, cwd=tmp_path)
+    try:
+        _wait_for("the driver's first lines", lambda: _lines_written(out) >= 3, driver, RUN_TIMEOUT)
+        driver.kill()
+        driver.communicate(timeout=30)
+    finally:
+        if driver.poll() is None:
+            driver.kill()
+    kept = _lines_written(out)
+    total = len(one_machine.read_text().splitlines()) - 1
+    assert 3 <= kept < total, f"the driver should die mid-run: {kept} of {total} lines"
+    again = cluster.driver([*args, "--resume"], cwd=tmp_path)
+    _, err = again.communicate(timeout=RUN_TIMEOUT)
+    assert again.returncode == one_code(one_machine), err
+    assert _lines_without_timing(out) == _lines_without_timing(one_machine)
+    assert _summary_without_timing(out) == _summary_without_timing(one_machine)
+
+
+def test_a_sweep_whose_worker_node_is_killed_equals_one_machine(cluster: Cluster, one_machine: Path,
+                                                                 tmp_path: Path):
+    one = one_machine
     out = tmp_path / "cluster.jsonl"
     driver = cluster.driver(["-m", "unforeseen.distributed", *SWEEP, "--out", str(out), "--units-per-task", "1",
                              "--address", ADDRESS], cwd=tmp_path)
