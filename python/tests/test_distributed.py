@@ -45,6 +45,20 @@ def test_train_seeds_parse_as_the_command_line_writes_them():
             parse_train_seeds(bad)
 
 
+def test_bad_input_fails_before_any_task_with_its_reason(tmp_path: Path):
+    bad = tmp_path / "bad.ron"
+    bad.write_text("Map(name: \"bad\", lanes: 7)\n")
+    out = tmp_path / "r.jsonl"
+    run = subprocess.run([sys.executable, "-m", "unforeseen.distributed", "batch", str(bad), "--out", str(out),
+                          "--address", "127.0.0.1:9"], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2, run.stderr
+    assert "bad.ron" in run.stderr and "error:" in run.stderr and "Traceback" not in run.stderr
+    assert not out.exists()
+    shard = subprocess.run([sys.executable, "-m", "unforeseen.distributed", "batch", "--shard", "1/2"],
+                           capture_output=True, text=True, timeout=60)
+    assert shard.returncode == 2 and "unforeseen merge" in shard.stderr, shard.stderr
+
+
 def _unavailable(reason: str) -> None:
     if os.environ.get("UNFORESEEN_REQUIRE_RAY_CLUSTER") == "1":
         pytest.fail(f"the Ray cluster tests must run here: {reason}")

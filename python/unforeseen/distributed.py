@@ -225,7 +225,6 @@ def run_batch(
     (the expectations failed on the mean over training seeds; the command exits 1 on
     any, as ``batch`` does).
     """
-    ray = _ray()
     out = Path(out)
     if jobs < 1 or jobs > 256:
         raise ValueError(f"jobs {jobs}: expected a number of threads per task from 1 to 256")
@@ -249,6 +248,7 @@ def run_batch(
             force=force,
         )
     )
+    ray = _ray()
     lock = _lock(out)
     try:
         _write_atomic(out, plan["head"])
