@@ -370,7 +370,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    except RuntimeError as e:
+    except (RuntimeError, ConnectionError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
     print(
