@@ -693,7 +693,7 @@ impl RunIdentity {
     }
 
     /// The identity as the first line of a results file.
-    fn to_line(&self) -> String {
+    pub(crate) fn to_line(&self) -> String {
         let mut s = serde_json::json!({ "run": self }).to_string();
         s.push('\n');
         s
@@ -884,7 +884,7 @@ pub const MAX_FIGURE: f64 = 1e9;
 /// field of its own that is not this run's (seed, episodes, parameters,
 /// protocols covered), or a figure out of its range (rates in [0, 1]; others finite,
 /// non-negative where they count, at most [`MAX_FIGURE`] in magnitude).
-fn line_problem(l: &ResultLine, u: &Unit, identity: &RunIdentity) -> Option<String> {
+pub(crate) fn line_problem(l: &ResultLine, u: &Unit, identity: &RunIdentity) -> Option<String> {
     if l.seed != identity.seed {
         return Some(format!("has seed {}, the run's header {}", l.seed, identity.seed));
     }

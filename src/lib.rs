@@ -33,7 +33,7 @@
 //! * [`tick_replay`] records the scaled agent's reasoning ticks in episodes and replays
 //!   them (the benches' in-loop reasoning tick);
 //! * [`batch`] plans and runs scenario suites and sweeps headless, in parallel and in
-//!   shards;
+//!   shards, and [`merge`] joins shard files produced anywhere into one run's file;
 //! * [`search`] searches a space of map variations for the fair scenarios where a
 //!   method fails (Sobol stage, cross-entropy stage, minimisation);
 //! * [`error`] is the library's typed error, which every public function returns;
@@ -52,6 +52,7 @@ pub mod cli;
 pub mod error;
 pub mod experiments;
 pub mod maps;
+pub mod merge;
 pub mod methods;
 pub mod metrics;
 pub mod overrides;

@@ -13,6 +13,8 @@
 //! * [`agent`]: training, agent files, every method's controller, evaluation;
 //! * [`results`]: `compare` and `batch` as the JSON data their files hold;
 //! * [`wrapper`]: the scaled agent around any habit, and the batch summary of a results file;
+//! * [`units`]: a batch run as units of work for a distributed driver (plan, train a
+//!   seed, run a block of units with the GIL released, join the results);
 //! * [`errors`]: Rust errors as Python exceptions (`ValueError` for what the user can fix).
 
 mod agent;
@@ -21,6 +23,7 @@ mod errors;
 mod maps;
 mod render;
 mod results;
+mod units;
 mod vector;
 mod wrapper;
 
@@ -48,5 +51,6 @@ fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     agent::register(m)?;
     results::register(m)?;
     wrapper::register(m)?;
+    units::register(m)?;
     Ok(())
 }

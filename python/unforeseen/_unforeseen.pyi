@@ -201,3 +201,25 @@ def q_table_habit(agent: Agent, **params: Any) -> npt.NDArray[np.float64]:
     """``σ(Q[s, ·]/T)`` of ``agent``'s Q-table, ``(n_states, n_actions)``."""
 def summarize_json(path: str) -> str:
     """The batch summary over training seeds of a results file, as JSON text."""
+def plan_batch(
+    maps: Sequence[str],
+    out: str,
+    episodes: int = 100,
+    seed: int = 7,
+    methods: Sequence[str] | None = None,
+    protocol: str = "both",
+    sets: Sequence[str] = (),
+    train_seeds: Sequence[int] | None = None,
+    train_episodes: int = 6000,
+    agent: str | None = None,
+    resume: bool = False,
+    force: bool = False,
+) -> str:
+    """A batch run planned as `unforeseen batch` plans it (JSON text: spec, head, total,
+    kept, todo, todo_seeds, train_seeds_to_run, agent); runs and trains nothing."""
+def train_agent(seed: int, episodes: int) -> bytes:
+    """The agent of one training seed (agent-file text), trained with the GIL released."""
+def run_units(spec: str, agents: Sequence[tuple[int | None, bytes]], units: Sequence[int], threads: int = 1) -> list[str]:
+    """The result lines (JSON text) of units of a planned run, with the GIL released."""
+def finish_batch(out: str) -> str:
+    """Rewrites a driver's results file in canonical order with its summary (JSON text)."""

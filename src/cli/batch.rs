@@ -332,7 +332,7 @@ fn lock_results(out: &std::path::Path) -> anyhow::Result<std::fs::File> {
 }
 
 /// Prints one row per (scenario, method, parameters, protocol) over its training seeds.
-fn print_summary(rows: &[SummaryRow]) {
+pub(super) fn print_summary(rows: &[SummaryRow]) {
     let many = rows.iter().any(|r| r.train_seeds.len() > 1);
     let mut grid = vec![
         [
@@ -375,7 +375,7 @@ fn print_summary(rows: &[SummaryRow]) {
 }
 
 /// One message per expectation that fails on the mean, naming the worst seed.
-fn failures(rows: &[SummaryRow]) -> Vec<String> {
+pub(super) fn failures(rows: &[SummaryRow]) -> Vec<String> {
     let mut out = Vec::new();
     for r in rows {
         for c in r.checks.iter().filter(|c| !c.pass) {

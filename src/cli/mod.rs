@@ -62,6 +62,7 @@ pub mod eval;
 pub mod export_model;
 pub mod inspect;
 pub mod learn;
+pub mod merge;
 pub mod outputs;
 pub mod params;
 pub mod plot_sweep;
@@ -85,6 +86,7 @@ an --out that is not a results file unless --force; no output may be an input):
   trace         out/trace/: trace.csv, theta.svg, filmstrip.svg (and --html FILE: a replay page)
   learn         out/learn/: learn.csv, learn.json, learn.svg
   batch         results.jsonl and results.summary.json
+  merge         results.jsonl and results.summary.json
   plot-sweep    sweep.svg
   export-model  out/model.json
   search        out/search/: candidates.jsonl, summary.json, search.svg, failures/*.ron
@@ -118,6 +120,8 @@ pub enum Command {
     CheckMap(check_map::CheckMapArgs),
     /// Run scenario suites headless: every map x method x parameter set, in parallel, as JSON Lines, with expectations.
     Batch(batch::BatchArgs),
+    /// Merge the shard files of one batch run (from Slurm, Kubernetes, GNU parallel, Ray) into one results file and summary.
+    Merge(merge::MergeArgs),
     /// Plot a sweep's results (success and reward against reasoning compute) as SVG.
     PlotSweep(plot_sweep::PlotSweepArgs),
     /// Cross-check the agent's math on a single-factor model given as JSON (pymdp layout).
@@ -144,6 +148,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Inspect(args) => inspect::run(args),
         Command::ExportModel(args) => export_model::run(args),
         Command::Batch(args) => batch::run_cli(args),
+        Command::Merge(args) => merge::run(args),
         Command::PlotSweep(args) => plot_sweep::run(args),
         Command::Search(args) => search::run(args),
     }

@@ -12,6 +12,7 @@ mod end_to_end;
 mod figures;
 mod fuzz;
 mod golden;
+mod merge;
 mod outputs;
 mod overrides;
 mod protocols;

@@ -1,0 +1,389 @@
+"""Batch runs across machines on a Ray cluster, with the results one machine writes.
+
+:func:`run_batch` takes the arguments of ``unforeseen batch``, connects to a running
+cluster (``address="auto"``, or one given), and runs the batch as Ray tasks through the
+Rust binding (not the command line), a block of units per task with the GIL released::
+
+    from unforeseen.distributed import run_batch
+    report = run_batch(["maps/"], train_seeds=range(1, 5), episodes=20, out="sweep.jsonl")
+
+or, from a shell, ``python -m unforeseen.distributed batch maps/ --train-seeds 1..4
+--episodes 20 --out sweep.jsonl`` (the options of ``unforeseen batch``, plus
+``--address`` and ``--units-per-task``).
+
+How it runs
+-----------
+* The driver plans the run as ``batch`` does (its units, the run identity written as the
+  results file's first line, and with ``resume`` the lines an earlier run of it kept).
+* Each training seed the remaining units need is trained once, by one task on the
+  cluster; its agent (a few MB of agent-file text) goes to the object store, and every
+  unit task that needs it receives it from there.
+* Units run in blocks (``units_per_task``); each task rebuilds the run from the plan's
+  ``spec`` and refuses to run if what it rebuilt differs from the driver's run (a node
+  with other maps). Results do not depend on the number of workers or the order tasks
+  finish in: each unit's seeds derive from its identity, never from where it runs.
+* Lines are appended to the results file as tasks finish; at the end the file is
+  rewritten in canonical order with its summary, atomically, by ``unforeseen merge``'s
+  library code. The file then equals ``unforeseen batch``'s, timing fields aside.
+
+Faults
+------
+* A worker process or node that dies loses nothing: its tasks are retried
+  (``max_retries``), and an agent whose only copy was on a lost node is trained again
+  by Ray's lineage reconstruction.
+* A driver killed mid-run leaves the lines that had finished; the same call (command)
+  with ``resume=True`` (``--resume``) keeps them and runs only the rest, under the run
+  identity rules of ``batch``.
+* An error in the input (a bad map, a node whose maps differ) raises ``ValueError`` in
+  the task; such a task is not retried (``retry_exceptions=False``: it would fail the
+  same way everywhere) and the run fails once with that message.
+
+Network
+-------
+Usage statistics are switched off for the driver (``RAY_USAGE_STATS_ENABLED=0``); start
+the cluster's nodes with ``--disable-usage-stats`` too. The README shows a cluster kept
+on loopback inside a network namespace (the tests do the same).
+
+Where a search plugs in
+-----------------------
+The driver loop (:func:`_drive`) knows nothing of batches: it takes blocks of work,
+a function that submits a block as a task (given the object refs of the agents it
+needs), and a sink for each finished block's lines. A search (``unforeseen search``)
+adds its own planning binding (its candidate units and their identity) and a
+``run_search`` that calls :func:`_drive` with its blocks and the same train tasks; its
+results file is then finished the way :func:`run_batch` finishes a batch's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import fcntl
+import json
+import math
+import os
+import sys
+import time
+from collections.abc import Callable, Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from . import _unforeseen
+
+__all__ = ["DEFAULT_MAX_RETRIES", "main", "parse_train_seeds", "run_batch"]
+
+#: Retries of a task whose worker process or node died (system failures only).
+DEFAULT_MAX_RETRIES = 3
+
+#: Seconds between progress redraws; and the longest wait for any task before the
+#: driver checks again (it waits on task completion, never sleeps).
+_TICK = 1.0
+
+
+def _ray() -> Any:
+    os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+    try:
+        import ray
+    except ImportError as e:  # pragma: no cover - depends on the install
+        raise ImportError(
+            "unforeseen.distributed needs Ray: pip install './python[ray]' (or pip install 'unforeseen[ray]')"
+        ) from e
+    return ray
+
+
+def _task_options(max_retries: int) -> dict[str, Any]:
+    """Ray options of every task: retried when its worker or node dies, never for an
+    exception it raises (an input error fails the same way on every attempt)."""
+    return {"max_retries": max_retries, "retry_exceptions": False}
+
+
+def _train_task(seed: int, episodes: int) -> bytes:
+    """One agent, trained on the node that runs the task."""
+    return _unforeseen.train_agent(seed, episodes)
+
+
+def _units_task(spec: str, seeds: Sequence[int | None], *agents: bytes, units: list[int], threads: int) -> list[str]:
+    """A block of units: their result lines (JSON text)."""
+    return _unforeseen.run_units(spec, list(zip(seeds, agents, strict=True)), units, threads)
+
+
+class _Progress:
+    """Units done / total, rate and ETA on one stderr line, only when stderr is a terminal."""
+
+    def __init__(self, total: int, done: int, quiet: bool) -> None:
+        self.total, self.done, self.start_done = total, done, done
+        self.on = not quiet and sys.stderr.isatty()
+        self.started = time.monotonic()
+        self.drawn = 0.0
+
+    def advance(self, n: int) -> None:
+        self.done += n
+        now = time.monotonic()
+        if self.on and (now - self.drawn >= _TICK or self.done == self.total):
+            self.drawn = now
+            ran = self.done - self.start_done
+            rate = ran / max(now - self.started, 1e-9)
+            left = (self.total - self.done) / rate if rate > 0 else math.inf
+            eta = "?" if math.isinf(left) else f"{int(left) // 60}m{int(left) % 60:02d}s"
+            sys.stderr.write(f"\r{self.done}/{self.total} units, {rate:.2f} units/s, ETA {eta}   ")
+            sys.stderr.flush()
+
+    def finish(self) -> None:
+        if self.on:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def _app_error(ray: Any, err: BaseException) -> BaseException | None:
+    """The input error (ValueError) a task raised, if that is what `err` is."""
+    cause = getattr(err, "cause", None)
+    if isinstance(err, ray.exceptions.RayTaskError) and isinstance(cause, ValueError):
+        return cause
+    return None
+
+
+def _drive(
+    ray: Any,
+    blocks: list[list[int]],
+    submit: Callable[[list[int]], Any],
+    sink: Callable[[list[int], list[str]], None],
+) -> None:
+    """Submits every block as a task and hands each finished block's lines to `sink`, in
+    the order they finish. An input error of any task cancels the rest and raises it as
+    `ValueError`; a task lost after its retries raises `RuntimeError`."""
+    pending = {submit(b): b for b in blocks}
+    try:
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1, timeout=_TICK)
+            for ref in ready:
+                block = pending.pop(ref)
+                try:
+                    lines = ray.get(ref)
+                except ray.exceptions.RayError as e:
+                    cause = _app_error(ray, e)
+                    if cause is not None:
+                        raise ValueError(str(cause)) from None
+                    raise RuntimeError(
+                        f"units {block[0]}..{block[-1]}: the task failed after its retries ({type(e).__name__}): {e}"
+                    ) from None
+                sink(block, lines)
+    finally:
+        for ref in pending:
+            ray.cancel(ref, force=True)
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def _lock(out: Path) -> Any:
+    """The advisory lock ``batch`` takes on ``OUT.lock``: one run per results file."""
+    path = Path(str(out) + ".lock")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    f = open(path, "a")  # noqa: SIM115 - held for the run
+    try:
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        f.close()
+        raise ValueError(
+            f"--out {out}: another batch is writing this results file now (it holds {path}); "
+            "wait for it to finish, or give another --out"
+        ) from None
+    return f
+
+
+def run_batch(
+    maps: Iterable[str | os.PathLike[str]] = (),
+    *,
+    out: str | os.PathLike[str] = "results.jsonl",
+    episodes: int = 100,
+    seed: int = 7,
+    methods: Sequence[str] | None = None,
+    protocol: str = "both",
+    sets: Sequence[str] = (),
+    train_seeds: Iterable[int] | None = None,
+    train_episodes: int = 6000,
+    agent: str | os.PathLike[str] | None = None,
+    resume: bool = False,
+    force: bool = False,
+    jobs: int = 1,
+    units_per_task: int | None = None,
+    address: str | None = "auto",
+    max_retries: int = DEFAULT_MAX_RETRIES,
+    quiet: bool = False,
+) -> dict[str, Any]:
+    """``unforeseen batch`` on a Ray cluster (see the module's documentation).
+
+    The arguments are the command line's (``sets`` are ``--set`` texts such as
+    ``"horizon=1,2"``; ``jobs`` is the threads, and CPUs, of each task). Connects with
+    ``ray.init(address)`` unless Ray is connected already. Returns the finished file's
+    ``lines`` (dicts), ``summary`` (its path), ``checked``, ``failed`` and ``failures``
+    (the expectations failed on the mean over training seeds; the command exits 1 on
+    any, as ``batch`` does).
+    """
+    out = Path(out)
+    if jobs < 1 or jobs > 256:
+        raise ValueError(f"jobs {jobs}: expected a number of threads per task from 1 to 256")
+    if units_per_task is not None and units_per_task < 1:
+        raise ValueError(f"units_per_task {units_per_task}: expected at least 1")
+    if max_retries < 0:
+        raise ValueError(f"max_retries {max_retries}: expected 0 or more")
+    plan = json.loads(
+        _unforeseen.plan_batch(
+            [str(m) for m in maps],
+            str(out),
+            episodes=episodes,
+            seed=seed,
+            methods=list(methods) if methods else None,
+            protocol=protocol,
+            sets=list(sets),
+            train_seeds=None if train_seeds is None else list(train_seeds),
+            train_episodes=train_episodes,
+            agent=None if agent is None else str(agent),
+            resume=resume,
+            force=force,
+        )
+    )
+    ray = _ray()
+    lock = _lock(out)
+    try:
+        _write_atomic(out, plan["head"])
+        if not ray.is_initialized():
+            ray.init(address=address, include_dashboard=False, log_to_driver=False)
+        options = _task_options(max_retries)
+        # One agent per training seed the remaining units need, in the object store.
+        if plan["agent"] is not None:
+            agent_refs = {plan["todo_seeds"][0] if plan["todo_seeds"] else None: ray.put(plan["agent"].encode())}
+        else:
+            train = ray.remote(num_cpus=1, **options)(_train_task)
+            agent_refs = {s: train.remote(s, train_episodes) for s in plan["train_seeds_to_run"]}
+        todo: list[int] = plan["todo"]
+        seed_of = dict(zip(todo, plan["todo_seeds"], strict=True))
+        if units_per_task is None:
+            cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // jobs)
+            units_per_task = max(1, math.ceil(len(todo) / (4 * cpus)))
+        blocks = [todo[i : i + units_per_task] for i in range(0, len(todo), units_per_task)]
+        run = ray.remote(num_cpus=jobs, **options)(_units_task)
+
+        def submit(block: list[int]) -> Any:
+            seeds = sorted({seed_of[u] for u in block}, key=lambda s: (s is None, s or 0))
+            return run.remote(plan["spec"], seeds, *(agent_refs[s] for s in seeds), units=block, threads=jobs)
+
+        progress = _Progress(plan["total"], plan["kept"], quiet)
+        with open(out, "a", encoding="utf-8") as f:
+
+            def sink(_block: list[int], lines: list[str]) -> None:
+                f.write("".join(lines))
+                f.flush()
+                progress.advance(len(lines))
+
+            try:
+                _drive(ray, blocks, submit, sink)
+            finally:
+                progress.finish()
+        return json.loads(_unforeseen.finish_batch(str(out)))
+    finally:
+        lock.close()
+
+
+def parse_train_seeds(text: str) -> list[int]:
+    """``1..10``, ``1,3,5`` or ``1..3,7`` (ranges inclusive), as ``--train-seeds``."""
+    seeds: list[int] = []
+    for part in text.split(","):
+        part = part.strip()
+        try:
+            if ".." in part:
+                a, b = (int(x) for x in part.split("..", 1))
+                if a > b:
+                    raise ValueError
+                seeds.extend(range(a, b + 1))
+            else:
+                seeds.append(int(part))
+        except ValueError:
+            raise ValueError(f"--train-seeds {text!r}: expected seeds like 1..10, 1,3,5 or 1..3,7") from None
+    if any(s < 0 for s in seeds) or len(set(seeds)) != len(seeds):
+        raise ValueError(f"--train-seeds {text!r}: seeds are non-negative and listed once")
+    return seeds
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m unforeseen.distributed", description=__doc__.split("\n\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    b = sub.add_parser("batch", help="unforeseen batch on a Ray cluster (its options, plus --address)")
+    b.add_argument("maps", nargs="*", metavar="MAP|DIR")
+    b.add_argument("--episodes", type=int, default=100)
+    b.add_argument("--seed", type=int, default=7)
+    b.add_argument("--method", dest="methods", action="append", default=[])
+    b.add_argument("--protocol", choices=["zero-shot", "continual", "both"], default="both")
+    b.add_argument("--jobs", type=int, default=1, help="threads (and CPUs) of each task")
+    b.add_argument("--out", default="results.jsonl")
+    b.add_argument("--resume", action="store_true")
+    b.add_argument("--force", action="store_true")
+    b.add_argument("--shard", metavar="I/N", help="refused: the cluster splits the run itself")
+    b.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=V1,V2")
+    b.add_argument("--train-episodes", type=int, default=6000)
+    b.add_argument("--agent", metavar="FILE")
+    b.add_argument("--train-seeds", metavar="SEEDS")
+    b.add_argument("--cache", metavar="DIR", help="accepted; agents train on the cluster, once per seed per run")
+    b.add_argument("--no-cache", action="store_true", help="accepted (agents are not cached on the cluster)")
+    b.add_argument("--timeout-as", choices=["truncation"], default="truncation")
+    b.add_argument("--quiet", "-q", action="store_true")
+    b.add_argument("--address", default="auto", help="Ray cluster address (default: auto, the local cluster)")
+    b.add_argument("--units-per-task", type=int, help="units per task (default: about 4 tasks per CPU)")
+    b.add_argument("--max-retries", type=int, default=DEFAULT_MAX_RETRIES)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """The command: exit 0, 1 when an expectation fails on the mean, 2 for bad input."""
+    args = _parser().parse_args(argv)
+    try:
+        if args.shard:
+            raise ValueError(
+                f"--shard {args.shard}: the cluster splits the run itself; run it whole here, "
+                "or run `unforeseen batch --shard I/N` on separate machines and `unforeseen merge` the parts"
+            )
+        seeds = None if args.train_seeds is None else parse_train_seeds(args.train_seeds)
+        report = run_batch(
+            args.maps,
+            out=args.out,
+            episodes=args.episodes,
+            seed=args.seed,
+            methods=args.methods or None,
+            protocol=args.protocol,
+            sets=args.sets,
+            train_seeds=seeds,
+            train_episodes=args.train_episodes,
+            agent=args.agent,
+            resume=args.resume,
+            force=args.force,
+            jobs=args.jobs,
+            units_per_task=args.units_per_task,
+            address=args.address,
+            max_retries=args.max_retries,
+            quiet=args.quiet,
+        )
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    except (RuntimeError, ConnectionError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    print(
+        f"wrote {args.out} ({len(report['lines'])} lines) and {report['summary']}; "
+        f"{report['checked']} expectation(s) checked on the mean over training seeds, {report['failed']} failed"
+    )
+    for f in report["failures"]:
+        print(f"expectation failed: {f}", file=sys.stderr)
+    return 1 if report["failed"] else 0
+
+
+if __name__ == "__main__":
+    # Run the package's module (not this `__main__` copy), so tasks refer to its functions.
+    from unforeseen.distributed import main as _main
+
+    sys.exit(_main())
