@@ -336,6 +336,7 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
             max_reward: None,
             max_collision: None,
             max_inference_rate: None,
+            max_red_light: None,
             protocol: None,
         },
         unforeseen_sim::Expectation {
@@ -346,6 +347,7 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
             max_reward: None,
             max_collision: None,
             max_inference_rate: None,
+            max_red_light: None,
             protocol: None,
         },
     ];
