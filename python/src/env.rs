@@ -9,6 +9,7 @@
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::intern;
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
 use pyo3::types::PyString;
 use pyo3::types::{PyDict, PyTuple};
 use unforeseen_env::{Env, EnvConfig, Info, Observation, ObservationForm, kinematic};
@@ -83,10 +84,59 @@ fn light_str(py: Python<'_>, light: unforeseen_sim::LightPhase) -> &Bound<'_, Py
     }
 }
 
-/// The info dict (documented on `UnforeseenEnv`).
-fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    let state = |s: unforeseen_discretizer::State| (s.d as i64, s.v as i64, s.l as i64, s.p as i64);
+/// The info dict's keys in order, and the reward terms' keys.
+const INFO_KEYS: [&str; 11] = [
+    "step",
+    "collision",
+    "goal",
+    "timeout",
+    "red_light",
+    "state",
+    "observed",
+    "light",
+    "light_code",
+    "light_time_left",
+    "reward_terms",
+];
+const TERM_KEYS: [&str; 5] = ["progress", "time", "goal", "crash", "red_light"];
+
+/// A dict with `keys` (values `None`), made once: copying it and replacing the values
+/// skips the resizes of filling a new dict key by key (a step's info is built every tick).
+fn template<'py>(
+    py: Python<'py>,
+    cell: &'static PyOnceLock<Py<PyDict>>,
+    keys: &[&str],
+) -> PyResult<Bound<'py, PyDict>> {
+    let t = cell.get_or_try_init(py, || {
+        let d = PyDict::new(py);
+        for k in keys {
+            d.set_item(PyString::intern(py, k), py.None())?;
+        }
+        PyResult::Ok(d.unbind())
+    })?;
+    t.bind(py).copy()
+}
+
+/// Every joint state of `env` as a `(d, v, L, p)` tuple, by joint index (made once per
+/// env, so that a step's info shares them instead of building two tuples a tick).
+fn state_tuples(py: Python<'_>, env: &Env) -> PyResult<Vec<Py<PyTuple>>> {
+    let disc = env.discretizer();
+    (0..disc.n_states())
+        .map(|i| {
+            let s = disc.decode(i);
+            Ok((s.d as i64, s.v as i64, s.l as i64, s.p as i64)
+                .into_pyobject(py)?
+                .unbind())
+        })
+        .collect()
+}
+
+/// The info dict (documented on `UnforeseenEnv`); `states` from [`state_tuples`].
+fn info_dict<'py>(py: Python<'py>, env: &Env, states: &[Py<PyTuple>], info: &Info) -> PyResult<Bound<'py, PyDict>> {
+    static INFO: PyOnceLock<Py<PyDict>> = PyOnceLock::new();
+    static TERMS: PyOnceLock<Py<PyDict>> = PyOnceLock::new();
+    let state = |s| states[env.discretizer().encode(s)].bind(py);
+    let d = template(py, &INFO, &INFO_KEYS)?;
     d.set_item(intern!(py, "step"), info.step)?;
     d.set_item(intern!(py, "collision"), info.events.collision)?;
     d.set_item(intern!(py, "goal"), info.events.goal)?;
@@ -97,7 +147,7 @@ fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> 
     d.set_item(intern!(py, "light"), light_str(py, info.light))?;
     d.set_item(intern!(py, "light_code"), light_code(info.light))?;
     d.set_item(intern!(py, "light_time_left"), info.light_time_left)?;
-    let terms = PyDict::new(py);
+    let terms = template(py, &TERMS, &TERM_KEYS)?;
     terms.set_item(intern!(py, "progress"), info.reward.progress)?;
     terms.set_item(intern!(py, "time"), info.reward.time)?;
     terms.set_item(intern!(py, "goal"), info.reward.goal)?;
@@ -111,6 +161,7 @@ fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> 
 #[pyclass(name = "Env", module = "unforeseen._unforeseen")]
 pub struct PyEnv {
     env: Env,
+    states: Vec<Py<PyTuple>>,
     key: u64,
     episode: u64,
 }
@@ -121,6 +172,7 @@ impl PyEnv {
     #[new]
     #[pyo3(signature = (map, observation = "discrete", pedestrian_slots = 4, overrides = None))]
     fn new(
+        py: Python<'_>,
         map: &str,
         observation: &str,
         pedestrian_slots: usize,
@@ -128,8 +180,10 @@ impl PyEnv {
     ) -> PyResult<Self> {
         let form = observation_form(observation)?;
         let map = crate::maps::load(map, overrides)?;
+        let env = new_env(&map, form, pedestrian_slots)?;
         Ok(PyEnv {
-            env: new_env(&map, form, pedestrian_slots)?,
+            states: state_tuples(py, &env)?,
+            env,
             key: 0,
             episode: 0,
         })
@@ -189,7 +243,7 @@ impl PyEnv {
     /// Starts an episode with world seed `seed` exactly: `(observation, info)`.
     fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyTuple>> {
         let (obs, info) = self.env.reset(seed);
-        (observation(py, &obs), info_dict(py, &info)?).into_pyobject(py)
+        (observation(py, &obs), info_dict(py, &self.env, &self.states, &info)?).into_pyobject(py)
     }
 
     /// Keys the episode stream (see the module docs); the next `reset_next` is episode 0.
@@ -219,7 +273,7 @@ impl PyEnv {
             step.reward,
             step.terminated,
             step.truncated,
-            info_dict(py, &step.info)?,
+            info_dict(py, &self.env, &self.states, &step.info)?,
         )
             .into_pyobject(py)
     }

@@ -124,3 +124,18 @@ def test_render_modes():
     assert isinstance(line, str) and "C" in line and "light" in line
     with pytest.raises(ValueError, match="render_mode"):
         unforeseen.make_env("jaywalk", render_mode="human")
+
+
+def test_each_step_gets_its_own_info_dicts():
+    """Infos are built from shared templates and shared state tuples: a caller that
+    keeps or edits one step's info must not see it change, nor change the next one."""
+    env = unforeseen.make_env("jaywalk")
+    _, first = env.reset(seed=0)
+    kept = {**first, "reward_terms": dict(first["reward_terms"])}
+    first["collision"] = "edited"
+    first["reward_terms"]["goal"] = 1e9
+    _, _, _, _, second = env.step(1)
+    assert second["collision"] is False and second["reward_terms"]["goal"] != 1e9
+    assert second is not first and second["reward_terms"] is not first["reward_terms"]
+    assert kept["state"] == first["state"] and isinstance(second["state"], tuple)
+    assert list(second) == list(kept), "the keys keep their documented order"
