@@ -16,12 +16,13 @@
 use crate::controller::{Controller, Decision, Dist, Ending};
 use crate::error::AgentError;
 use crate::gate::StateGate;
+use crate::handback::HandBack;
 use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{
-    ActionSelection, CheckedScaledParams, GateBaseline, GateLearning, GateMode, ReasoningMode, RootStep, ScaledParams,
-    ScalingMode,
+    ActionSelection, CheckedScaledParams, GateBaseline, GateLearning, GateMode, HandBackRule, ReasoningMode, RootStep,
+    ScaledParams, ScalingMode,
 };
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s_into};
@@ -67,6 +68,12 @@ pub struct ScaledAgent {
     nu: Vec<f64>,
     /// The surprise gate on the state (`None` with [`GateMode::OneStep`]).
     gate: Option<StateGate>,
+    /// The crash-risk check of hand-backs that learning made ([`crate::handback`]).
+    handback: HandBack,
+    /// The habit's most likely action per state (refreshed when `ν` learns).
+    habit_modes: Vec<usize>,
+    /// Whether test-time learning has changed the agent (an episode was learned from).
+    learned: bool,
     rng: ChaCha8Rng,
     tree: EfeTree,
     vmp_ws: VmpWorkspace,
@@ -83,6 +90,8 @@ pub struct ScaledAgent {
     hist_pi: Vec<f64>,
     hist_surprise: Vec<f64>,
     hist_reasoned: Vec<bool>,
+    /// Whether each tick reasoned because the hand-back check refused the habit.
+    hist_refused: Vec<bool>,
     final_obs: Option<usize>,
     /// One-hot index of the last posterior, if it was one-hot.
     prev_one_hot: Option<usize>,
@@ -144,7 +153,8 @@ impl ScaledAgent {
             GateMode::OneStep => None,
         };
         let n_obs = model.generative().n_obs();
-        Ok(ScaledAgent {
+        let handback = HandBack::new(&model);
+        let mut agent = ScaledAgent {
             tree: EfeTree::new(n, n_obs, na, params.planning.horizon),
             window_q: vec![vec![0.0; n]; params.perception.vmp_window],
             window_obs: Vec::with_capacity(params.perception.vmp_window),
@@ -159,6 +169,7 @@ impl ScaledAgent {
             hist_pi: Vec::with_capacity(256 * na),
             hist_surprise: Vec::with_capacity(256),
             hist_reasoned: Vec::with_capacity(256),
+            hist_refused: Vec::with_capacity(256),
             final_obs: None,
             prev_one_hot: None,
             last: ReasoningTrace::default(),
@@ -168,7 +179,54 @@ impl ScaledAgent {
             n_actions: na,
             nu,
             gate,
-        })
+            handback,
+            habit_modes: Vec::new(),
+            learned: false,
+        };
+        agent.refresh_habit_modes();
+        Ok(agent)
+    }
+
+    /// The habit's most likely action in every state, the mode of [`ScaledAgent::pi_o`].
+    fn refresh_habit_modes(&mut self) {
+        self.habit_modes = (0..self.n_states).map(|s| argmax(&self.pi_o(s))).collect();
+    }
+
+    /// Whether the trained agent's trigger would reason under belief `q_t`
+    /// ([`StateGate::trained_surprise`]): a tick that now hands back although this holds is a
+    /// hand-back test-time learning made. With the one-step gate, which keeps no trained
+    /// table, every tick after the first learned episode counts as one.
+    fn trained_trigger_fires(&self) -> Option<f64> {
+        let th0 = match &self.gate {
+            Some(gate) => theta(gate.trained_surprise(&self.q_cur), self.params.gate.omega),
+            None if self.learned => 1.0,
+            None => 0.0,
+        };
+        (th0 > self.params.gate.epsilon).then_some(th0)
+    }
+
+    /// The hand-back check ([`crate::handback`]): on a tick that would hand control to the
+    /// habit (whose policy is in `self.pi`), `Some(θ_0)` (the trained trigger's `θ`) when the
+    /// hand-back is one that learning made and the world model predicts the habit enters a
+    /// crash-risk state within `handback_horizon` ticks with probability above `handback_risk`.
+    fn refuse_handback(&mut self) -> Option<f64> {
+        if self.params.gate.handback != HandBackRule::RiskChecked {
+            return None;
+        }
+        let th0 = self.trained_trigger_fires()?;
+        let root = match self.params.planning.root_step {
+            RootStep::Learned => self.model.generative(),
+            RootStep::Absorbing => self.model.planning_generative(),
+        };
+        let risk = self.handback.crash_risk(
+            root,
+            self.model.planning_generative(),
+            &self.q_cur,
+            argmax(&self.pi),
+            &self.habit_modes,
+            self.params.gate.handback_horizon,
+        );
+        (risk > self.params.gate.handback_risk).then_some(th0)
     }
 
     /// The world model.
@@ -200,6 +258,11 @@ impl ScaledAgent {
     /// Whether each tick of the current (or last) episode reasoned.
     pub fn reasoned_history(&self) -> &[bool] {
         &self.hist_reasoned
+    }
+    /// Whether each tick of the current (or last) episode reasoned because the hand-back
+    /// check refused to hand the state to the habit ([`crate::handback`]).
+    pub fn refused_history(&self) -> &[bool] {
+        &self.hist_refused
     }
     /// What the last reasoning tick computed.
     pub fn last_reasoning(&self) -> &ReasoningTrace {
@@ -330,6 +393,7 @@ impl Controller for ScaledAgent {
         self.hist_pi.clear();
         self.hist_surprise.clear();
         self.hist_reasoned.clear();
+        self.hist_refused.clear();
         self.final_obs = None;
         self.prev_one_hot = None;
         self.tree.invalidate();
@@ -370,14 +434,23 @@ impl Controller for ScaledAgent {
             }
         };
         let th = theta(trigger, self.params.gate.omega);
-        let reasoned = self.params.scaling.reasoning == ReasoningMode::Always || th > self.params.gate.epsilon;
+        let mut reasoned = self.params.scaling.reasoning == ReasoningMode::Always || th > self.params.gate.epsilon;
+        let mut refused = false;
         let mut scaling_iters = 0;
         if reasoned {
             scaling_iters = self.reason(obs, th);
-        } else if gm.a_identity {
-            learning::pi_o_state(&self.nu, self.n_actions, obs, &mut self.pi);
         } else {
-            learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
+            if gm.a_identity {
+                learning::pi_o_state(&self.nu, self.n_actions, obs, &mut self.pi);
+            } else {
+                learning::pi_o_belief(&self.nu, self.n_actions, &self.q_cur, &mut self.pi);
+            }
+            // The safe hand-back: reason instead where the habit is predicted to crash,
+            // scaling with the trained trigger's θ (the surprise learning removed).
+            if let Some(th0) = self.refuse_handback() {
+                (reasoned, refused) = (true, true);
+                scaling_iters = self.reason(obs, th0);
+            }
         }
         let pi = std::mem::take(&mut self.pi);
         let action = self.select(&pi);
@@ -389,6 +462,7 @@ impl Controller for ScaledAgent {
         self.hist_pi.extend_from_slice(&self.pi);
         self.hist_surprise.push(s);
         self.hist_reasoned.push(reasoned);
+        self.hist_refused.push(refused);
         Decision {
             action,
             reasoned,
@@ -477,6 +551,8 @@ impl Controller for ScaledAgent {
             gate.consolidate();
         }
         self.model.materialize();
+        self.refresh_habit_modes();
+        self.learned = true;
     }
 }
 
