@@ -63,6 +63,7 @@ pub mod rewards;
 pub mod runner;
 pub mod seeds;
 pub mod stats;
+pub mod stream;
 pub mod study;
 pub mod survivability;
 pub mod tick_replay;

@@ -6,22 +6,33 @@
 //! at the crosswalk on green is common; the trigger's baseline learns where reasoning
 //! endorsed the habit) in states where the habit was never taught what to do: the gate's
 //! table is kept per `(L, d)` and carries across speeds, the habit is kept per joint state.
-//! A hand-back that learning made possible is therefore checked first: the agent rolls its
-//! habit forward through the learned model for `H` ticks,
+//! A hand-back that learning made possible is therefore checked first: the agent rolls
+//! the car forward through the learned model for `H` ticks, holding one action `u`,
 //!
 //! ```text
-//! x_1 = B[a_o(q_t)] q_t                                (the root model: the learned B)
-//! x_{k+1}(s') = Σ_s B_plan[a_o(s)][s', s] x_k(s)         (the planning model: episode ends absorbing)
-//! risk = Σ_{s harmful} x_H(s)
+//! x_1 = B[u] q_t                 (the root model: the learned B)
+//! x_{k+1} = B_plan[u] x_k         (the planning model: episode ends absorbing)
+//! risk(u) = Σ_{s harmful} x_H(s)
 //! ```
 //!
-//! with `a_o(s)` the habit's most likely action in `s` (the mode of `π_o(·|s)`) and the
-//! harmful states the episode-ending states the preferences rank below every other state
-//! (the crash-risk states: a pedestrian on the crosswalk while the car moves in a crosswalk
-//! bin). Since harmful states absorb in the planning model, `risk` is the probability
-//! that the habit enters one within `H` ticks. If it exceeds `ρ` the agent reasons instead
-//! of handing back. The cost is `1 + n_actions (H - 1)` predictions on the ticks that are
-//! checked, a fraction of one reasoning tick's (VMP plus `U + U² + … + U^H` predictions).
+//! with the harmful states the episode-ending states the preferences rank below every
+//! other state (the crash-risk states: a pedestrian on the crosswalk while the car moves in
+//! a crosswalk bin). Since harmful states absorb, `risk(u)` is the probability of entering
+//! one within `H` ticks of holding `u`. If holding the habit's action `a_o` (the mode of
+//! `π_o(·|q_t)`) is riskier than holding the safest action by more than `ρ`,
+//! `risk(a_o) - min_u risk(u) > ρ`, the agent reasons instead of handing back.
+//!
+//! Two choices, both measured (EXPERIMENTS.md, "The safe hand-back"): the check is
+//! *relative*, because some risk can no longer be avoided (a car at speed close to a
+//! pedestrian), and where the habit already takes the safest action, handing the tick to
+//! the planner buys nothing: with an absolute bound the planner, indifferent between
+//! maintaining and braking at (d = 2, v = 2) with a runner ahead, maintained and crashed
+//! where the habit would have braked (late_fast). And the action is *held*, not followed
+//! by the habit: the habit's actions in the states after the first are what the check
+//! cannot trust (at (d = 2, v = 3) with a walker ahead, "brake, then the habit" sped up
+//! again and looked as risky as speeding up, so the check let a habit that sped up
+//! through (crowd_slow)). The cost is `U H` predictions on the ticks that are checked,
+//! fewer than one reasoning tick's (VMP plus `U + U² + … + U^H` predictions).
 //!
 //! Which hand-backs are checked: those the trained agent would not have made, i.e. ticks on
 //! which the trained gate's trigger ([`crate::gate::StateGate::trained_surprise`]) exceeds
@@ -29,7 +40,6 @@
 //! habit acts as training left it, as in the paper; so the zero-shot agent, which has
 //! learned nothing, decides exactly as before.
 
-use crate::maths::argmax;
 use crate::model::{GenerativeModel, WorldModel};
 
 /// The crash-risk check of the habit under the learned model (module docs).
@@ -74,16 +84,17 @@ impl HandBack {
         &self.harmful
     }
 
-    /// The probability that the habit enters a harmful state within `horizon` ticks of
-    /// belief `q` (module docs): its first action `first` goes through `root`, each later
-    /// one, `habit[s]` in state `s`, through `plan` (whose harmful states absorb).
+    /// The probability that the car enters a harmful state within `horizon` ticks of belief
+    /// `q`: its first action `first` goes through `root`, each later one, `then[s]` in state
+    /// `s`, through `plan` (whose harmful states absorb). The check (module docs) holds
+    /// one action: `then[s] = first` for every `s`.
     pub fn crash_risk(
         &mut self,
         root: &GenerativeModel,
         plan: &GenerativeModel,
         q: &[f64],
         first: usize,
-        habit: &[usize],
+        then: &[usize],
         horizon: usize,
     ) -> f64 {
         if self.harmful.is_empty() || horizon == 0 {
@@ -95,7 +106,7 @@ impl HandBack {
             for u in 0..plan.n_actions() {
                 let mut any = false;
                 for (s, m) in self.masked.iter_mut().enumerate() {
-                    *m = if habit[s] == u && self.x[s] != 0.0 {
+                    *m = if then[s] == u && self.x[s] != 0.0 {
                         any = true;
                         self.x[s]
                     } else {
@@ -111,11 +122,6 @@ impl HandBack {
         }
         self.harmful.iter().map(|&s| self.x[s]).sum()
     }
-}
-
-/// The habit's most likely action in every state: the mode of `π_o(·|s) ∝ ν[s, ·]` (§V-C).
-pub fn habit_modes(nu: &[f64], n_actions: usize) -> Vec<usize> {
-    nu.chunks(n_actions).map(argmax).collect()
 }
 
 #[cfg(test)]
@@ -197,10 +203,5 @@ mod tests {
         // Absorbing harm: the risk never falls as the horizon grows.
         let risks: Vec<f64> = (1..=4).map(|h| hb.crash_risk(root, plan, &q, 1, &habit, h)).collect();
         assert!(risks.windows(2).all(|r| r[1] >= r[0] - 1e-12), "{risks:?}");
-    }
-
-    #[test]
-    fn habit_modes_by_hand() {
-        assert_eq!(habit_modes(&[1.0, 3.0, 2.0, 5.0, 1.0, 1.0], 3), vec![1, 0]);
     }
 }

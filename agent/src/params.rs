@@ -196,7 +196,8 @@ pub enum GateBaseline {
 pub enum HandBackRule {
     /// A hand-back that test-time learning made (the trained agent's trigger would still
     /// fire) is made only if the habit, rolled forward `handback_horizon` ticks through the
-    /// learned model, enters a crash-risk state with probability at most `handback_risk`;
+    /// learned model, enters a crash-risk state at most `handback_risk` more likely than after
+    /// the safest first action;
     /// otherwise the agent reasons.
     #[default]
     RiskChecked,
@@ -235,7 +236,7 @@ pub enum RootStep {
 /// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
 /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `none` is the paper's trigger) ([`GateBaseline`]) |
 /// | `gate` | `handback` | `risk-checked` | `risk-checked`, `theta` | a hand-back that test-time learning made goes to the habit only if the world model does not predict it crashes (beyond the paper; `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
-/// | `gate` | `handback_risk` ρ | 0.05 | [0, 1) | the largest probability of entering a crash-risk state within `handback_horizon` ticks of following the habit at which control goes back to it |
+/// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
 /// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |
 /// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
 /// | `perception` | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
@@ -300,7 +301,8 @@ pub struct GateParams {
     pub gate_baseline: GateBaseline,
     /// When control goes back to the habit.
     pub handback: HandBackRule,
-    /// ρ: the largest predicted crash risk of the habit at which control goes back to it.
+    /// ρ: the largest excess of the habit's predicted crash risk over the safest first
+    /// action's at which control goes back to it.
     pub handback_risk: f64,
     /// Ticks of the hand-back check's rollout of the habit.
     pub handback_horizon: usize,
@@ -317,7 +319,7 @@ impl Default for GateParams {
             gate_learning: GateLearning::Endorsed,
             gate_baseline: GateBaseline::Endorsed,
             handback: HandBackRule::RiskChecked,
-            handback_risk: 0.05,
+            handback_risk: 0.08,
             handback_horizon: 3,
         }
     }

@@ -70,8 +70,6 @@ pub struct ScaledAgent {
     gate: Option<StateGate>,
     /// The crash-risk check of hand-backs that learning made ([`crate::handback`]).
     handback: HandBack,
-    /// The habit's most likely action per state (refreshed when `ν` learns).
-    habit_modes: Vec<usize>,
     /// Whether test-time learning has changed the agent (an episode was learned from).
     learned: bool,
     rng: ChaCha8Rng,
@@ -154,7 +152,7 @@ impl ScaledAgent {
         };
         let n_obs = model.generative().n_obs();
         let handback = HandBack::new(&model);
-        let mut agent = ScaledAgent {
+        Ok(ScaledAgent {
             tree: EfeTree::new(n, n_obs, na, params.planning.horizon),
             window_q: vec![vec![0.0; n]; params.perception.vmp_window],
             window_obs: Vec::with_capacity(params.perception.vmp_window),
@@ -180,16 +178,8 @@ impl ScaledAgent {
             nu,
             gate,
             handback,
-            habit_modes: Vec::new(),
             learned: false,
-        };
-        agent.refresh_habit_modes();
-        Ok(agent)
-    }
-
-    /// The habit's most likely action in every state, the mode of [`ScaledAgent::pi_o`].
-    fn refresh_habit_modes(&mut self) {
-        self.habit_modes = (0..self.n_states).map(|s| argmax(&self.pi_o(s))).collect();
+        })
     }
 
     /// Whether the trained agent's trigger would reason under belief `q_t`
@@ -207,8 +197,9 @@ impl ScaledAgent {
 
     /// The hand-back check ([`crate::handback`]): on a tick that would hand control to the
     /// habit (whose policy is in `self.pi`), `Some(θ_0)` (the trained trigger's `θ`) when the
-    /// hand-back is one that learning made and the world model predicts the habit enters a
-    /// crash-risk state within `handback_horizon` ticks with probability above `handback_risk`.
+    /// hand-back is one that learning made and the world model predicts that holding the
+    /// habit's action for `handback_horizon` ticks enters a crash-risk state more likely, by
+    /// more than `handback_risk`, than holding the safest action would.
     fn refuse_handback(&mut self) -> Option<f64> {
         if self.params.gate.handback != HandBackRule::RiskChecked {
             return None;
@@ -218,15 +209,18 @@ impl ScaledAgent {
             RootStep::Learned => self.model.generative(),
             RootStep::Absorbing => self.model.planning_generative(),
         };
-        let risk = self.handback.crash_risk(
-            root,
-            self.model.planning_generative(),
-            &self.q_cur,
-            argmax(&self.pi),
-            &self.habit_modes,
-            self.params.gate.handback_horizon,
-        );
-        (risk > self.params.gate.handback_risk).then_some(th0)
+        let plan = self.model.planning_generative();
+        let horizon = self.params.gate.handback_horizon;
+        let habit = argmax(&self.pi);
+        let n = self.n_states;
+        let mut held = vec![0; n];
+        let mut risk = |u: usize| {
+            held.fill(u);
+            self.handback.crash_risk(root, plan, &self.q_cur, u, &held, horizon)
+        };
+        let own = risk(habit);
+        let safest = (0..self.n_actions).map(&mut risk).fold(f64::INFINITY, f64::min);
+        (own - safest > self.params.gate.handback_risk).then_some(th0)
     }
 
     /// The world model.
@@ -551,7 +545,6 @@ impl Controller for ScaledAgent {
             gate.consolidate();
         }
         self.model.materialize();
-        self.refresh_habit_modes();
         self.learned = true;
     }
 }

@@ -19,5 +19,6 @@ mod readme;
 mod reference;
 mod replay;
 mod robustness;
+mod safety;
 mod svg_text;
 mod train_seeds;

@@ -1,0 +1,49 @@
+//! Issue 20: test-time learning must never make the agent less safe. With several
+//! jaywalkers per episode at random times (maps/crowd.ron), the hand-back rule
+//! `θ <= ε` alone let learning make a pedestrian at (green, d = 2) familiar from the
+//! ticks the car waited there, and then handed the approach at speed, where the habit
+//! still sped up, to the habit (agent/src/handback.rs). On the shared trained test
+//! agent, over continual episodes of that map: no episode the agent without learning
+//! survives is lost, and reasoning falls as it learns.
+
+use crate::common;
+use std::path::Path;
+use unforeseen::experiments::evaluate_under;
+use unforeseen::methods::Method;
+use unforeseen::progress::NoProgress;
+use unforeseen::protocol::Protocol;
+use unforeseen::runner::EpisodeResult;
+use unforeseen_agent::params::ScaledParams;
+
+const EPISODES: u64 = 40;
+
+fn run(method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<EpisodeResult> {
+    let map = unforeseen::maps::load_file(Path::new("maps/crowd.ron")).expect("maps/crowd.ron");
+    evaluate_under(protocol, &map, common::bundle(), params, method, EPISODES, 7, &NoProgress).unwrap()
+}
+
+/// Episodes the agent without learning survives and `learning` loses (both meet the same
+/// pedestrians: the world's seed depends on the map and the episode only).
+fn lost(without: &[EpisodeResult], learning: &[EpisodeResult]) -> Vec<usize> {
+    (0..without.len())
+        .filter(|&k| without[k].success && !learning[k].success)
+        .collect()
+}
+
+#[test]
+fn learning_loses_no_crowd_episode_that_the_agent_without_learning_survives() {
+    let params = ScaledParams::default();
+    let without = run(Method::ScaledNoLearning, Protocol::ZeroShot, &params);
+    let learning = run(Method::Scaled, Protocol::Continual, &params);
+    assert!(
+        without.iter().filter(|r| r.success).count() as u64 >= EPISODES / 2,
+        "the agent without learning should survive most of the crowd"
+    );
+    assert_eq!(lost(&without, &learning), Vec::<usize>::new());
+    let ticks = |rs: &[EpisodeResult]| rs.iter().map(|r| r.reasoning_ticks).sum::<u32>();
+    let (first, last) = (ticks(&learning[..10]), ticks(&learning[learning.len() - 10..]));
+    assert!(
+        2 * last <= first,
+        "reasoning ticks, first 10 episodes {first}, last 10 {last}: should at least halve"
+    );
+}
