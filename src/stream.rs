@@ -106,7 +106,9 @@ pub enum StreamError {
         message: String,
     },
     /// Not valid RON for a stream.
-    #[error("{file}:{line}:{column}: {message} (a stream is Stream(maps: [(map: \"FILE\", weight: W), ...], order: Weighted | Sequence))")]
+    #[error(
+        "{file}:{line}:{column}: {message} (a stream is Stream(maps: [(map: \"FILE\", weight: W), ...], order: Weighted | Sequence))"
+    )]
     Syntax {
         /// The stream file.
         file: String,
@@ -157,19 +159,24 @@ impl Stream {
         }
         let bytes = std::fs::read(path).map_err(|e| read(format!("cannot read: {e}")))?;
         let text = String::from_utf8(bytes).map_err(|_| read("not UTF-8 text".into()))?;
-        let parsed: StreamFile = ron::Options::default().from_str(&text).map_err(|e| StreamError::Syntax {
-            file: file.clone(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: e.code.to_string(),
-        })?;
+        let parsed: StreamFile = ron::Options::default()
+            .from_str(&text)
+            .map_err(|e| StreamError::Syntax {
+                file: file.clone(),
+                line: e.span.start.line,
+                column: e.span.start.col,
+                message: e.code.to_string(),
+            })?;
         let invalid = |field: String, message: &str| StreamError::Invalid {
             file: file.clone(),
             field,
             message: message.to_string(),
         };
         if parsed.maps.is_empty() {
-            return Err(invalid("maps".into(), "no maps: list at least one (map: \"FILE\", weight: W)"));
+            return Err(invalid(
+                "maps".into(),
+                "no maps: list at least one (map: \"FILE\", weight: W)",
+            ));
         }
         if parsed.maps.len() > MAX_MAPS {
             return Err(invalid("maps".into(), "more than 64 maps"));
@@ -200,7 +207,10 @@ impl Stream {
             if let Some(j) = maps.iter().position(|(m, _): &(Map, f64)| m.name == map.name) {
                 return Err(invalid(
                     format!("maps[{i}].map"),
-                    &format!("names map '{}' again (maps[{j}]): list each map once and give it the sum of the weights", map.name),
+                    &format!(
+                        "names map '{}' again (maps[{j}]): list each map once and give it the sum of the weights",
+                        map.name
+                    ),
                 ));
             }
             maps.push((map, e.weight));
@@ -378,22 +388,40 @@ mod tests {
         assert_eq!(sched, s.schedule(1000, 7));
         let jay = sched.iter().filter(|&&m| m == 1).count();
         assert!((50..150).contains(&jay), "{jay} of 1000 on the weight-1 map");
-        let syntax = write(dir.path(), "bad.ron", "Stream(\n  maps: [(map: \"jaywalk\", weight: )],\n)");
+        let syntax = write(
+            dir.path(),
+            "bad.ron",
+            "Stream(\n  maps: [(map: \"jaywalk\", weight: )],\n)",
+        );
         let e = Stream::load(&syntax).unwrap_err().to_string();
         assert!(e.starts_with(&format!("{}:2:", syntax.display())), "{e}");
         let weight = write(dir.path(), "z.ron", "Stream(maps: [(map: \"jaywalk\", weight: 0)])");
-        assert!(Stream::load(&weight).unwrap_err().to_string().contains("maps[0].weight"));
+        assert!(
+            Stream::load(&weight)
+                .unwrap_err()
+                .to_string()
+                .contains("maps[0].weight")
+        );
         let missing = write(dir.path(), "m.ron", "Stream(maps: [(map: \"nowhere.ron\")])");
         assert!(Stream::load(&missing).unwrap_err().to_string().contains("maps[0]"));
         let empty = write(dir.path(), "e.ron", "Stream(maps: [])");
         assert!(Stream::load(&empty).unwrap_err().to_string().contains("no maps"));
-        let twice = write(dir.path(), "t.ron", "Stream(maps: [(map: \"jaywalk\"), (map: \"jaywalk\")])");
+        let twice = write(
+            dir.path(),
+            "t.ron",
+            "Stream(maps: [(map: \"jaywalk\"), (map: \"jaywalk\")])",
+        );
         assert!(Stream::load(&twice).unwrap_err().to_string().contains("again"));
         let fraction = write(
             dir.path(),
             "f.ron",
             "Stream(maps: [(map: \"jaywalk\", weight: 1.5)], order: Sequence)",
         );
-        assert!(Stream::load(&fraction).unwrap_err().to_string().contains("whole number"));
+        assert!(
+            Stream::load(&fraction)
+                .unwrap_err()
+                .to_string()
+                .contains("whole number")
+        );
     }
 }

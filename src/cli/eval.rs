@@ -134,7 +134,8 @@ fn protocol_note(method: Method, protocol: Protocol, params: &unforeseen_agent::
 fn run_stream(args: &EvalArgs, file: &std::path::Path) -> anyhow::Result<()> {
     use crate::stream::{Stream, evaluate_stream, per_map};
     let stream = Stream::load(file)?;
-    args.agent.check_out_dir(&args.out, &["eval.json"], &[&file.display().to_string()])?;
+    args.agent
+        .check_out_dir(&args.out, &["eval.json"], &[&file.display().to_string()])?;
     let params = args.agent.params()?;
     let bundle = if args.method.is_scripted() {
         None

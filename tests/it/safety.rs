@@ -19,7 +19,17 @@ const EPISODES: u64 = 40;
 
 fn run(method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<EpisodeResult> {
     let map = unforeseen::maps::load_file(Path::new("maps/crowd.ron")).expect("maps/crowd.ron");
-    evaluate_under(protocol, &map, common::bundle(), params, method, EPISODES, 7, &NoProgress).unwrap()
+    evaluate_under(
+        protocol,
+        &map,
+        common::bundle(),
+        params,
+        method,
+        EPISODES,
+        7,
+        &NoProgress,
+    )
+    .unwrap()
 }
 
 /// Episodes the agent without learning survives and `learning` loses (both meet the same
