@@ -304,6 +304,8 @@ mod tests {
         bounded.consolidate();
         assert!((bounded.probability(1, &[1, 2]) - 0.5).abs() < 1e-12);
         assert!((bounded.surprise(&q) - 2f64.ln()).abs() < 1e-12);
+        // The trained table is what the gate was built with: learning leaves it, (1 + 1) / 7.
+        assert!((bounded.trained_surprise(&q) - (7.0f64 / 2.0).ln()).abs() < 1e-12);
     }
 
     #[test]

@@ -130,8 +130,8 @@ mod tests {
     use crate::params::ModelPriors;
     use crate::structure::Structure;
 
-    /// A two-factor toy: position x in {0, 1, 2} (2 = harmful, absorbing), action 0 stays,
-    /// action 1 moves one step forward, each with certainty after many observations.
+    /// The paper's state space with one crash-risk state (d = 1, v = 1, green, pedestrian)
+    /// and one arrival state as the terminal states, with the map's rewards as preferences.
     fn toy() -> WorldModel {
         let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
         let mut w = WorldModel::new(st.clone(), 3, &ModelPriors::default()).unwrap();
@@ -161,6 +161,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::needless_range_loop)] // the oracle spells the sums out index by index
     fn risk_by_brute_force_enumeration() {
         // The rollout equals the sum over every path of the habit through the dense B.
         let mut w = toy();

@@ -38,7 +38,7 @@ fn run(method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<Episode
     evaluate_under(
         protocol,
         &map,
-        common::bundle(),
+        full_agent(),
         params,
         method,
         EPISODES,
