@@ -27,7 +27,9 @@ fn full_agent() -> &'static AgentBundle {
     static BUNDLE: OnceLock<AgentBundle> = OnceLock::new();
     BUNDLE.get_or_init(|| {
         let map = unforeseen::maps::load("intersection").expect("embedded map");
-        train(&map, &TrainConfig::new(DEFAULT_TRAIN_EPISODES, 7)).expect("training").0
+        train(&map, &TrainConfig::new(DEFAULT_TRAIN_EPISODES, 7))
+            .expect("training")
+            .0
     })
 }
 
@@ -35,17 +37,7 @@ const EPISODES: u64 = 40;
 
 fn run(method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<EpisodeResult> {
     let map = unforeseen::maps::load_file(Path::new("maps/crowd.ron")).expect("maps/crowd.ron");
-    evaluate_under(
-        protocol,
-        &map,
-        full_agent(),
-        params,
-        method,
-        EPISODES,
-        7,
-        &NoProgress,
-    )
-    .unwrap()
+    evaluate_under(protocol, &map, full_agent(), params, method, EPISODES, 7, &NoProgress).unwrap()
 }
 
 /// Episodes the agent without learning survives and `learning` loses (both meet the same
