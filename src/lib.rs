@@ -67,6 +67,7 @@ pub mod runner;
 pub mod search;
 pub mod seeds;
 pub mod stats;
+pub mod stream;
 pub mod study;
 pub mod survivability;
 pub mod tick_replay;

@@ -50,6 +50,9 @@ pub struct StateGate {
     value_of: Vec<usize>,
     /// Per joint state: `P(x(s) | parents(s))`, refreshed after learning.
     prob: Vec<f64>,
+    /// Per joint state: `P(x(s) | parents(s))` as the table stood when the gate was built
+    /// (before any test-time learning): what the trained agent's trigger reads.
+    trained: Vec<f64>,
     /// Per joint state: how often reasoning has endorsed the habit there (at most `memory`).
     endorsed: Vec<f64>,
     /// Per joint state: the surprise expected there, `min(1, endorsed / memory) · H(row)`.
@@ -127,10 +130,12 @@ impl StateGate {
             row_of,
             value_of,
             prob: vec![0.0; n],
+            trained: Vec::new(),
             endorsed: vec![0.0; n],
             expected: vec![0.0; n],
         };
         gate.consolidate();
+        gate.trained.clone_from(&gate.prob);
         Ok(gate)
     }
 
@@ -161,6 +166,21 @@ impl StateGate {
     /// The gate's surprise in nats, `-ln Σ_s q(s) P(x(s) | parents(s))` (§VI, Fig. 9a).
     pub fn surprise(&self, q: &[f64]) -> f64 {
         -ln(self.evidence(q))
+    }
+
+    /// The surprise the trained agent's gate reads, `-ln Σ_s q(s) P_0(x(s) | parents(s))`
+    /// with `P_0` the table as it stood when the gate was built, before any test-time
+    /// learning. Where it exceeds the trigger but [`StateGate::surprise`] (or its excess)
+    /// no longer does, test-time learning has made the situation familiar: that is the
+    /// hand-back [`crate::handback`] checks.
+    pub fn trained_surprise(&self, q: &[f64]) -> f64 {
+        let evidence: f64 = q
+            .iter()
+            .zip(&self.trained)
+            .filter(|(w, _)| **w != 0.0)
+            .map(|(w, p)| w * p)
+            .sum();
+        -ln(evidence)
     }
 
     /// The surprise in excess of what is expected where the habit has proven itself:
@@ -284,6 +304,8 @@ mod tests {
         bounded.consolidate();
         assert!((bounded.probability(1, &[1, 2]) - 0.5).abs() < 1e-12);
         assert!((bounded.surprise(&q) - 2f64.ln()).abs() < 1e-12);
+        // The trained table is what the gate was built with: learning leaves it, (1 + 1) / 7.
+        assert!((bounded.trained_surprise(&q) - (7.0f64 / 2.0).ln()).abs() < 1e-12);
     }
 
     #[test]

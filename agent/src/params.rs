@@ -189,6 +189,22 @@ pub enum GateBaseline {
     None,
 }
 
+/// When control goes back to the habit on a tick whose `θ <= ε` ([`crate::handback`];
+/// docs/ARCHITECTURE.md §4.10). Beyond the paper, whose rule is `θ <= ε` alone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum HandBackRule {
+    /// A hand-back that test-time learning made (the trained agent's trigger would still
+    /// fire) is made only if the habit, rolled forward `handback_horizon` ticks through the
+    /// learned model, enters a crash-risk state at most `handback_risk` more likely than after
+    /// the safest first action;
+    /// otherwise the agent reasons.
+    #[default]
+    RiskChecked,
+    /// Ablation (the rule before the check): `θ <= ε` hands back, whatever the habit does.
+    Theta,
+}
+
 /// Which model the EFE tree's first step from `q_t` goes through
 /// ([`crate::planning::EfeTree::evaluate`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -219,6 +235,9 @@ pub enum RootStep {
 /// | `gate` | `gate_memory` | 20.0 | > 0 (`inf` allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
 /// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
 /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `none` is the paper's trigger) ([`GateBaseline`]) |
+/// | `gate` | `handback` | `risk-checked` | `risk-checked`, `theta` | a hand-back that test-time learning made goes to the habit only if the world model does not predict it crashes (beyond the paper; `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
+/// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
+/// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |
 /// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
 /// | `perception` | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
 /// | `perception` | `vmp_tol` | 1e-6 | finite and > 0 | VMP convergence threshold on max \|Δ q\| |
@@ -280,6 +299,13 @@ pub struct GateParams {
     pub gate_learning: GateLearning,
     /// What the trigger subtracts from the gate's surprise.
     pub gate_baseline: GateBaseline,
+    /// When control goes back to the habit.
+    pub handback: HandBackRule,
+    /// ρ: the largest excess of the habit's predicted crash risk over the safest first
+    /// action's at which control goes back to it.
+    pub handback_risk: f64,
+    /// Ticks of the hand-back check's rollout of the habit.
+    pub handback_horizon: usize,
 }
 
 impl Default for GateParams {
@@ -292,6 +318,9 @@ impl Default for GateParams {
             gate_memory: 20.0,
             gate_learning: GateLearning::Endorsed,
             gate_baseline: GateBaseline::Endorsed,
+            handback: HandBackRule::RiskChecked,
+            handback_risk: 0.08,
+            handback_horizon: 3,
         }
     }
 }
@@ -496,7 +525,7 @@ pub const MAX_HORIZON: usize = 8;
 
 impl ScaledParams {
     /// Every numeric parameter's key, value and range (the table above).
-    pub fn bounds(&self) -> [(&'static str, f64, Bound); 15] {
+    pub fn bounds(&self) -> [(&'static str, f64, Bound); 17] {
         let (g, pe, pl, s, l) = (
             &self.gate,
             &self.perception,
@@ -509,6 +538,15 @@ impl ScaledParams {
             ("omega", g.omega, Bound::Positive),
             ("epsilon", g.epsilon, Bound::BelowOne),
             ("gate_memory", g.gate_memory, Bound::PositiveOrInf),
+            ("handback_risk", g.handback_risk, Bound::BelowOne),
+            (
+                "handback_horizon",
+                g.handback_horizon as f64,
+                count(
+                    MAX_HORIZON,
+                    "in 1..=8 (the hand-back check rolls the habit forward on the ticks it checks)",
+                ),
+            ),
             (
                 "vmp_window",
                 pe.vmp_window as f64,

@@ -17,12 +17,13 @@ use crate::controller::{Controller, Decision, Dist, Ending};
 use crate::error::AgentError;
 use crate::gate::StateGate;
 use crate::habit::{Habit, PolicyHabit, TableHabit};
+use crate::handback::HandBack;
 use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{
-    ActionSelection, CheckedScaledParams, GateBaseline, GateLearning, GateMode, ReasoningMode, RootStep, ScaledParams,
-    ScalingMode,
+    ActionSelection, CheckedScaledParams, GateBaseline, GateLearning, GateMode, HandBackRule, ReasoningMode, RootStep,
+    ScaledParams, ScalingMode,
 };
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s_into};
@@ -69,6 +70,10 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     habit: H,
     /// The surprise gate on the state (`None` with [`GateMode::OneStep`]).
     gate: Option<StateGate>,
+    /// The crash-risk check of hand-backs that learning made ([`crate::handback`]).
+    handback: HandBack,
+    /// Whether test-time learning has changed the agent (an episode was learned from).
+    learned: bool,
     rng: ChaCha8Rng,
     tree: EfeTree,
     vmp_ws: VmpWorkspace,
@@ -85,6 +90,8 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     hist_pi: Vec<f64>,
     hist_surprise: Vec<f64>,
     hist_reasoned: Vec<bool>,
+    /// Whether each tick reasoned because the hand-back check refused the habit.
+    hist_refused: Vec<bool>,
     final_obs: Option<usize>,
     /// One-hot index of the last posterior, if it was one-hot.
     prev_one_hot: Option<usize>,
@@ -206,6 +213,7 @@ impl<H: Habit> ScaledAgent<H> {
             GateMode::OneStep => None,
         };
         let n_obs = model.generative().n_obs();
+        let handback = HandBack::new(&model);
         Ok(ScaledAgent {
             tree: EfeTree::new(n, n_obs, na, params.planning.horizon),
             window_q: vec![vec![0.0; n]; params.perception.vmp_window],
@@ -221,6 +229,7 @@ impl<H: Habit> ScaledAgent<H> {
             hist_pi: Vec::with_capacity(256 * na),
             hist_surprise: Vec::with_capacity(256),
             hist_reasoned: Vec::with_capacity(256),
+            hist_refused: Vec::with_capacity(256),
             final_obs: None,
             prev_one_hot: None,
             last: ReasoningTrace::default(),
@@ -230,7 +239,50 @@ impl<H: Habit> ScaledAgent<H> {
             n_actions: na,
             habit,
             gate,
+            handback,
+            learned: false,
         })
+    }
+
+    /// Whether the trained agent's trigger would reason under belief `q_t`
+    /// ([`StateGate::trained_surprise`]): a tick that now hands back although this holds is a
+    /// hand-back test-time learning made. With the one-step gate, which keeps no trained
+    /// table, every tick after the first learned episode counts as one.
+    fn trained_trigger_fires(&self) -> Option<f64> {
+        let th0 = match &self.gate {
+            Some(gate) => theta(gate.trained_surprise(&self.q_cur), self.params.gate.omega),
+            None if self.learned => 1.0,
+            None => 0.0,
+        };
+        (th0 > self.params.gate.epsilon).then_some(th0)
+    }
+
+    /// The hand-back check ([`crate::handback`]): on a tick that would hand control to the
+    /// habit (whose policy is in `self.pi`), `Some(θ_0)` (the trained trigger's `θ`) when the
+    /// hand-back is one that learning made and the world model predicts that holding the
+    /// habit's action for `handback_horizon` ticks enters a crash-risk state more likely, by
+    /// more than `handback_risk`, than holding the safest action would.
+    fn refuse_handback(&mut self) -> Option<f64> {
+        if self.params.gate.handback != HandBackRule::RiskChecked {
+            return None;
+        }
+        let th0 = self.trained_trigger_fires()?;
+        let root = match self.params.planning.root_step {
+            RootStep::Learned => self.model.generative(),
+            RootStep::Absorbing => self.model.planning_generative(),
+        };
+        let plan = self.model.planning_generative();
+        let horizon = self.params.gate.handback_horizon;
+        let habit = argmax(&self.pi);
+        let n = self.n_states;
+        let mut held = vec![0; n];
+        let mut risk = |u: usize| {
+            held.fill(u);
+            self.handback.crash_risk(root, plan, &self.q_cur, u, &held, horizon)
+        };
+        let own = risk(habit);
+        let safest = (0..self.n_actions).map(&mut risk).fold(f64::INFINITY, f64::min);
+        (own - safest > self.params.gate.handback_risk).then_some(th0)
     }
 
     /// The world model.
@@ -256,6 +308,11 @@ impl<H: Habit> ScaledAgent<H> {
     /// Whether each tick of the current (or last) episode reasoned.
     pub fn reasoned_history(&self) -> &[bool] {
         &self.hist_reasoned
+    }
+    /// Whether each tick of the current (or last) episode reasoned because the hand-back
+    /// check refused to hand the state to the habit ([`crate::handback`]).
+    pub fn refused_history(&self) -> &[bool] {
+        &self.hist_refused
     }
     /// What the last reasoning tick computed.
     pub fn last_reasoning(&self) -> &ReasoningTrace {
@@ -386,6 +443,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
         self.hist_pi.clear();
         self.hist_surprise.clear();
         self.hist_reasoned.clear();
+        self.hist_refused.clear();
         self.final_obs = None;
         self.prev_one_hot = None;
         self.tree.invalidate();
@@ -427,14 +485,23 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             }
         };
         let th = theta(trigger, self.params.gate.omega);
-        let reasoned = self.params.scaling.reasoning == ReasoningMode::Always || th > self.params.gate.epsilon;
+        let mut reasoned = self.params.scaling.reasoning == ReasoningMode::Always || th > self.params.gate.epsilon;
+        let mut refused = false;
         let mut scaling_iters = 0;
         if reasoned {
             scaling_iters = self.reason(obs, th);
-        } else if gm.a_identity {
-            self.habit.pi_o_state(t, obs, &mut self.pi);
         } else {
-            self.habit.pi_o_belief(t, &self.q_cur, &mut self.pi);
+            if gm.a_identity {
+                self.habit.pi_o_state(t, obs, &mut self.pi);
+            } else {
+                self.habit.pi_o_belief(t, &self.q_cur, &mut self.pi);
+            }
+            // The safe hand-back: reason instead where the habit is predicted to crash,
+            // scaling with the trained trigger's θ (the surprise learning removed).
+            if let Some(th0) = self.refuse_handback() {
+                (reasoned, refused) = (true, true);
+                scaling_iters = self.reason(obs, th0);
+            }
         }
         let pi = std::mem::take(&mut self.pi);
         let action = self.select(&pi);
@@ -446,6 +513,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
         self.hist_pi.extend_from_slice(&self.pi);
         self.hist_surprise.push(s);
         self.hist_reasoned.push(reasoned);
+        self.hist_refused.push(refused);
         Decision {
             action,
             reasoned,
@@ -534,6 +602,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             gate.consolidate();
         }
         self.model.materialize();
+        self.learned = true;
     }
 }
 

@@ -35,6 +35,11 @@ pub struct EvalArgs {
     /// with a warning).
     #[arg(long, value_name = "DIR", default_value = "out/eval")]
     pub out: PathBuf,
+    /// A deployment stream (a RON file listing maps with weights or a sequence; see
+    /// `src/stream.rs` and `maps/streams/`): run the episodes over its maps instead of
+    /// `--map`, and report per map within the stream.
+    #[arg(long, value_name = "FILE")]
+    pub stream: Option<PathBuf>,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -42,6 +47,9 @@ pub struct EvalArgs {
 
 /// Runs `eval`.
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
+    if let Some(file) = &args.stream {
+        return run_stream(&args, file);
+    }
     args.agent.check_out_dir(&args.out, &["eval.json"], &[&args.map])?;
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
@@ -120,4 +128,79 @@ fn protocol_note(method: Method, protocol: Protocol, params: &unforeseen_agent::
     } else {
         format!("{protocol}; {method} does not learn across episodes, so both protocols give these results")
     }
+}
+
+/// `eval --stream FILE`: the episodes over the stream's maps, one row per map.
+fn run_stream(args: &EvalArgs, file: &std::path::Path) -> anyhow::Result<()> {
+    use crate::stream::{Stream, evaluate_stream, per_map};
+    let stream = Stream::load(file)?;
+    args.agent
+        .check_out_dir(&args.out, &["eval.json"], &[&file.display().to_string()])?;
+    let params = args.agent.params()?;
+    let bundle = if args.method.is_scripted() {
+        None
+    } else {
+        Some(args.agent.bundle()?)
+    };
+    let bars = Bars::new(args.agent.quiet);
+    progress::phase(
+        args.agent.quiet,
+        format_args!(
+            "evaluating {} on stream '{}' ({} maps, {}, {} episodes)",
+            args.method,
+            stream.name,
+            stream.maps.len(),
+            args.protocol,
+            args.episodes
+        ),
+    );
+    bars.phase(&format!("{} {}", args.method, stream.name), args.episodes);
+    let episodes = evaluate_stream(
+        &stream,
+        bundle.as_ref(),
+        &params,
+        args.method,
+        args.protocol,
+        args.episodes,
+        args.agent.seed,
+        &bars,
+    )?;
+    bars.finish();
+    let rows = per_map(&stream, &episodes);
+    outln!(
+        "{} on stream '{}' ({}), per map:",
+        args.method,
+        stream.name,
+        protocol_note(args.method, args.protocol, &params)
+    );
+    for r in &rows {
+        let a = &r.aggregate;
+        outln!(
+            "  {:<20} {:>4} episodes: success {:.1}%, collisions {:.1}%, reward {:.2}, inference rate {:.1}%",
+            r.map,
+            a.episodes,
+            100.0 * a.success_rate,
+            100.0 * a.collision_rate,
+            a.mean_reward,
+            100.0 * a.inference_rate
+        );
+    }
+    let dir = &args.out;
+    warn_replacing(dir, &["eval.json"]);
+    write_json(
+        &dir.join("eval.json"),
+        &serde_json::json!({
+            "method": args.method,
+            "stream": stream.name,
+            "stream_file": file.display().to_string(),
+            "protocol": args.protocol,
+            "computed_under": args.protocol.effective(args.method, &params),
+            "seed": args.agent.seed,
+            "train_seed": bundle.as_ref().and_then(|b| b.meta.get("seed").cloned()),
+            "per_map": rows,
+            "episodes": episodes,
+        }),
+    )?;
+    outln!("wrote {}/eval.json", dir.display());
+    Ok(())
 }

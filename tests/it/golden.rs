@@ -79,8 +79,7 @@ fn agent_digest(bundle: &AgentBundle) -> String {
 
 /// Every method's episodes 0..3 on `map` zero-shot, and the scaled agent's episode 5 of a
 /// continual run (after learning from episodes 0..5).
-fn episodes_digest(bundle: &AgentBundle, map: &unforeseen_sim::Map) -> String {
-    let params = ScaledParams::default();
+fn episodes_digest(bundle: &AgentBundle, map: &unforeseen_sim::Map, params: &ScaledParams) -> String {
     let mut out = String::new();
     let methods = [
         Method::QLearning,
@@ -92,12 +91,12 @@ fn episodes_digest(bundle: &AgentBundle, map: &unforeseen_sim::Map) -> String {
     ];
     for method in methods {
         for ep in 0..3 {
-            let (result, ticks) = trace(bundle, &params, method, map, 7, Protocol::ZeroShot, ep).unwrap();
+            let (result, ticks) = trace(bundle, params, method, map, 7, Protocol::ZeroShot, ep).unwrap();
             let _ = writeln!(out, "{} {ep}", method.name());
             push_episode(&mut out, &result, &ticks);
         }
     }
-    let (result, ticks) = trace(bundle, &params, Method::Scaled, map, 7, Protocol::Continual, 5).unwrap();
+    let (result, ticks) = trace(bundle, params, Method::Scaled, map, 7, Protocol::Continual, 5).unwrap();
     out.push_str("scaled continual 5\n");
     push_episode(&mut out, &result, &ticks);
     content_hash(out.as_bytes())
@@ -114,14 +113,28 @@ fn noisy_jaywalk() -> unforeseen_sim::Map {
 }
 
 /// The agent's digest and its episodes' on the intersection, the jaywalk and the noisy
-/// jaywalk.
+/// jaywalk, with the scaled agent's default parameters.
 fn digests(bundle: &AgentBundle) -> [String; 4] {
+    digests_with(bundle, &ScaledParams::default())
+}
+
+/// [`digests`] with the scaled agent's parameters `params`.
+fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
     [
         agent_digest(bundle),
-        episodes_digest(bundle, &unforeseen::maps::load("intersection").unwrap()),
-        episodes_digest(bundle, &unforeseen::maps::load("jaywalk").unwrap()),
-        episodes_digest(bundle, &noisy_jaywalk()),
+        episodes_digest(bundle, &unforeseen::maps::load("intersection").unwrap(), params),
+        episodes_digest(bundle, &unforeseen::maps::load("jaywalk").unwrap(), params),
+        episodes_digest(bundle, &noisy_jaywalk(), params),
     ]
+}
+
+/// The hand-back rule before the safe hand-back (`handback = theta`, the ablation) decides
+/// exactly as the code before it did: the digests recorded on that code.
+#[test]
+fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
+    let mut params = ScaledParams::default();
+    params.set_str("handback", "theta").unwrap();
+    assert_eq!(digests_with(common::bundle(), &params), GOLDEN_THETA_HANDBACK);
 }
 
 /// Training with time-outs taken as terminal states reproduces the agent, and every
@@ -180,3 +193,12 @@ const GOLDEN_TIMEOUT_AS_TERMINATION: [&str; 4] = [
 
 /// Digests of [`trained_agent_and_decisions_are_unchanged`].
 const GOLDEN: [&str; 4] = GOLDEN_TIMEOUT_AS_TERMINATION;
+
+/// Digests of [`the_theta_handback_ablation_reproduces_the_decisions_of_before`]: those of
+/// the code before the safe hand-back (the default's, [`GOLDEN`], until then).
+const GOLDEN_THETA_HANDBACK: [&str; 4] = [
+    "10356990b4c98627",
+    "72e903b779f23fb4",
+    "fd86969ccbedd97b",
+    "35e3e279adc323a8",
+];

@@ -21,6 +21,7 @@ mod red_light;
 mod reference;
 mod replay;
 mod robustness;
+mod safety;
 mod search;
 mod svg_text;
 mod train_seeds;

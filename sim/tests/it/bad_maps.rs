@@ -378,7 +378,10 @@ fn the_shipped_maps_are_within_the_limits() {
                 continue;
             }
             if path.is_dir() {
-                dirs.push(path);
+                // maps/streams/ holds deployment streams (lists of maps, src/stream.rs), not maps.
+                if !path.ends_with("streams") {
+                    dirs.push(path);
+                }
             } else if path.extension().is_some_and(|x| x == "ron") {
                 Map::load(&path).unwrap_or_else(|e| panic!("{e}"));
                 loaded += 1;

@@ -1,0 +1,208 @@
+//! The safe hand-back (beyond the paper; docs/ARCHITECTURE.md §4.10): control goes back to
+//! the habit `π_o` only where the world model does not predict that the habit crashes.
+//!
+//! The paper hands control back to the habit whenever `θ_t <= ε` (§II, §IV). With test-time
+//! learning (§V), a situation can turn familiar (the gate's table learns that a pedestrian
+//! at the crosswalk on green is common; the trigger's baseline learns where reasoning
+//! endorsed the habit) in states where the habit was never taught what to do: the gate's
+//! table is kept per `(L, d)` and carries across speeds, the habit is kept per joint state.
+//! A hand-back that learning made possible is therefore checked first: the agent rolls
+//! the car forward through the learned model for `H` ticks, holding one action `u`,
+//!
+//! ```text
+//! x_1 = B[u] q_t                 (the root model: the learned B)
+//! x_{k+1} = B_plan[u] x_k         (the planning model: episode ends absorbing)
+//! risk(u) = Σ_{s harmful} x_H(s)
+//! ```
+//!
+//! with the harmful states the episode-ending states the preferences rank below every
+//! other state (the crash-risk states: a pedestrian on the crosswalk while the car moves in
+//! a crosswalk bin). Since harmful states absorb, `risk(u)` is the probability of entering
+//! one within `H` ticks of holding `u`. If holding the habit's action `a_o` (the mode of
+//! `π_o(·|q_t)`) is riskier than holding the safest action by more than `ρ`,
+//! `risk(a_o) - min_u risk(u) > ρ`, the agent reasons instead of handing back.
+//!
+//! Two choices, both measured (EXPERIMENTS.md, "The safe hand-back"): the check is
+//! *relative*, because some risk can no longer be avoided (a car at speed close to a
+//! pedestrian), and where the habit already takes the safest action, handing the tick to
+//! the planner buys nothing: with an absolute bound the planner, indifferent between
+//! maintaining and braking at (d = 2, v = 2) with a runner ahead, maintained and crashed
+//! where the habit would have braked (late_fast). And the action is *held*, not followed
+//! by the habit: the habit's actions in the states after the first are what the check
+//! cannot trust (at (d = 2, v = 3) with a walker ahead, "brake, then the habit" sped up
+//! again and looked as risky as speeding up, so the check let a habit that sped up
+//! through (crowd_slow)). The cost is `U H` predictions on the ticks that are checked,
+//! fewer than one reasoning tick's (VMP plus `U + U² + … + U^H` predictions).
+//!
+//! Which hand-backs are checked: those the trained agent would not have made, i.e. ticks on
+//! which the trained gate's trigger ([`crate::gate::StateGate::trained_surprise`]) exceeds
+//! `ε` while the learned one no longer does. Where the trained agent also hands back, the
+//! habit acts as training left it, as in the paper; so the zero-shot agent, which has
+//! learned nothing, decides exactly as before.
+
+use crate::model::{GenerativeModel, WorldModel};
+
+/// The crash-risk check of the habit under the learned model (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HandBack {
+    /// The harmful states (episode-ending states the preferences rank lowest).
+    harmful: Vec<usize>,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    masked: Vec<f64>,
+    part: Vec<f64>,
+    scratch: Vec<f64>,
+}
+
+impl HandBack {
+    /// The check for `model`: its harmful states are the terminal states
+    /// ([`WorldModel::terminal_states`]) whose expected preference `Σ_o A[o, s] C[o]` is below
+    /// that of every state that does not end the episode. A model without terminal states
+    /// has none, and its habit is never found at risk.
+    pub fn new(model: &WorldModel) -> HandBack {
+        let gm = model.generative();
+        let n = gm.n_states();
+        let preference = |s: usize| -> f64 { (0..gm.n_obs()).map(|o| gm.a[(o, s)] * gm.c[o]).sum() };
+        let terminal = model.terminal_states();
+        let floor = (0..n)
+            .filter(|s| !terminal.contains(s))
+            .map(preference)
+            .fold(f64::INFINITY, f64::min);
+        let harmful = terminal.iter().copied().filter(|&s| preference(s) < floor).collect();
+        HandBack {
+            harmful,
+            x: vec![0.0; n],
+            y: vec![0.0; n],
+            masked: vec![0.0; n],
+            part: vec![0.0; n],
+            scratch: Vec::new(),
+        }
+    }
+
+    /// The harmful states, in increasing order of index.
+    pub fn harmful(&self) -> &[usize] {
+        &self.harmful
+    }
+
+    /// The probability that the car enters a harmful state within `horizon` ticks of belief
+    /// `q`: its first action `first` goes through `root`, each later one, `then[s]` in state
+    /// `s`, through `plan` (whose harmful states absorb). The check (module docs) holds
+    /// one action: `then[s] = first` for every `s`.
+    pub fn crash_risk(
+        &mut self,
+        root: &GenerativeModel,
+        plan: &GenerativeModel,
+        q: &[f64],
+        first: usize,
+        then: &[usize],
+        horizon: usize,
+    ) -> f64 {
+        if self.harmful.is_empty() || horizon == 0 {
+            return 0.0;
+        }
+        root.transition_into(first, q, &mut self.x, &mut self.scratch);
+        for _ in 1..horizon {
+            self.y.fill(0.0);
+            for u in 0..plan.n_actions() {
+                let mut any = false;
+                for (s, m) in self.masked.iter_mut().enumerate() {
+                    *m = if then[s] == u && self.x[s] != 0.0 {
+                        any = true;
+                        self.x[s]
+                    } else {
+                        0.0
+                    };
+                }
+                if any {
+                    plan.transition_into(u, &self.masked, &mut self.part, &mut self.scratch);
+                    self.y.iter_mut().zip(&self.part).for_each(|(y, p)| *y += p);
+                }
+            }
+            std::mem::swap(&mut self.x, &mut self.y);
+        }
+        self.harmful.iter().map(|&s| self.x[s]).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::ModelPriors;
+    use crate::structure::Structure;
+
+    /// The paper's state space with one crash-risk state (d = 1, v = 1, green, pedestrian)
+    /// and one arrival state as the terminal states, with the map's rewards as preferences.
+    fn toy() -> WorldModel {
+        let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
+        let mut w = WorldModel::new(st.clone(), 3, &ModelPriors::default()).unwrap();
+        // States (d, v, L, p): the harmful one is (1, 1, 1, 1); a terminal goal (0, 0, 1, 0).
+        let harm = st.encode(&[1, 1, 1, 1]);
+        let goal = st.encode(&[0, 0, 1, 0]);
+        w.set_terminal_states(&[harm, goal]).unwrap();
+        let mut rewards = vec![0.0; 64];
+        rewards[harm] = -25.0;
+        rewards[goal] = 50.0;
+        w.set_preferences(&rewards, 1.0).unwrap();
+        w
+    }
+
+    #[test]
+    fn harmful_states_are_the_terminal_states_ranked_lowest() {
+        let w = toy();
+        let st = w.structure().clone();
+        assert_eq!(HandBack::new(&w).harmful(), &[st.encode(&[1, 1, 1, 1])]);
+        // No terminal states: nothing is harmful and the risk is 0.
+        let plain = WorldModel::new(st, 3, &ModelPriors::default()).unwrap();
+        let mut hb = HandBack::new(&plain);
+        assert!(hb.harmful().is_empty());
+        let q = vec![1.0 / 64.0; 64];
+        let gm = plain.generative();
+        assert_eq!(hb.crash_risk(gm, gm, &q, 0, &[0; 64], 3), 0.0);
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)] // the oracle spells the sums out index by index
+    fn risk_by_brute_force_enumeration() {
+        // The rollout equals the sum over every path of the habit through the dense B.
+        let mut w = toy();
+        let st = w.structure().clone();
+        // Some data so that B is not uniform: speeding up at d = 2 often reaches d = 1.
+        for k in 0..30 {
+            let (s, u) = (st.encode(&[2, k % 4, 1, k % 2]), k % 3);
+            let s2 = st.encode(&[1 + usize::from(k % 3 == 0), (k + 1) % 4, 1, (k / 2) % 2]);
+            w.observe_transition(s, u, s2);
+        }
+        w.materialize();
+        let mut hb = HandBack::new(&w);
+        let habit: Vec<usize> = (0..64).map(|s| (s * 7) % 3).collect();
+        let mut q = vec![0.0; 64];
+        q[st.encode(&[2, 3, 1, 1])] = 0.7;
+        q[st.encode(&[2, 2, 1, 1])] = 0.3;
+        let (root, plan) = (w.generative(), w.planning_generative());
+        for horizon in 1..=3 {
+            let fast = hb.crash_risk(root, plan, &q, 1, &habit, horizon);
+            // Brute force: distribution over paths.
+            let mut x = vec![0.0; 64];
+            for s in 0..64 {
+                for s2 in 0..64 {
+                    x[s2] += root.b[1][(s2, s)] * q[s];
+                }
+            }
+            for _ in 1..horizon {
+                let mut y = vec![0.0; 64];
+                for s in 0..64 {
+                    for s2 in 0..64 {
+                        y[s2] += plan.b[habit[s]][(s2, s)] * x[s];
+                    }
+                }
+                x = y;
+            }
+            let slow: f64 = hb.harmful().iter().map(|&s| x[s]).sum();
+            assert!((fast - slow).abs() < 1e-12, "H = {horizon}: {fast} vs {slow}");
+            assert!((0.0..=1.0 + 1e-12).contains(&fast));
+        }
+        // Absorbing harm: the risk never falls as the horizon grows.
+        let risks: Vec<f64> = (1..=4).map(|h| hb.crash_risk(root, plan, &q, 1, &habit, h)).collect();
+        assert!(risks.windows(2).all(|r| r[1] >= r[0] - 1e-12), "{risks:?}");
+    }
+}

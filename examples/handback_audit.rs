@@ -1,0 +1,77 @@
+//! Audits the scaled agent over a long continual run on one map (issue 20, EXPERIMENTS.md
+//! "The safe hand-back"): reasoning ticks with and without a pedestrian on the crosswalk,
+//! ticks the hand-back check refused, reasoning per block of 50 episodes, and what drifts:
+//! the gate's table `P(p = 1 | L, d)` and the habit's total counts `Σ ν`, every 50 episodes.
+//!
+//! ```sh
+//! cargo build --release --example handback_audit
+//! target/release/examples/handback_audit AGENT.ron MAP [EPISODES] [key=value ...]
+//! ```
+//!
+//! Prints one JSON object. Episodes are seeded as `eval --seed 7` seeds them.
+
+use std::path::Path;
+
+use unforeseen::experiments::eval_seeds;
+use unforeseen::methods::{Method, scaled_agent};
+use unforeseen::runner::run_episode;
+use unforeseen_agent::params::ScaledParams;
+use unforeseen_env::{Env, EnvConfig};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() < 3 {
+        return Err("usage: handback_audit AGENT.ron MAP [EPISODES] [key=value ...]".into());
+    }
+    let bundle = unforeseen::agent_file::load(Path::new(&args[1]))?;
+    let map = unforeseen::maps::load(&args[2])?;
+    let episodes: u64 = args.get(3).map_or(Ok(200), |s| s.parse())?;
+    let mut params = ScaledParams::default();
+    for kv in args.iter().skip(4) {
+        let (k, v) = kv.split_once('=').ok_or("expected key=value")?;
+        params.set_str(k, v)?;
+    }
+    let mut agent = scaled_agent(&bundle, params)?;
+    let mut env = Env::new(&map, EnvConfig::default())?;
+    let (mut ticks, mut reasoning, mut reasoning_no_pedestrian, mut refused, mut successes) =
+        (0u64, 0u64, 0u64, 0u64, 0u64);
+    let mut per_episode = Vec::new();
+    let mut drift = Vec::new();
+    let snapshot = |agent: &unforeseen_agent::scaled::ScaledAgent, episode: u64| {
+        let table: Vec<Vec<f64>> = agent
+            .gate()
+            .map(|g| {
+                (0..2)
+                    .map(|l| (0..4).map(|d| g.probability(1, &[l, d])).collect())
+                    .collect()
+            })
+            .unwrap_or_default();
+        serde_json::json!({"episode": episode, "p_pedestrian_by_L_d": table, "nu_total": agent.nu().iter().sum::<f64>()})
+    };
+    for ep in 0..episodes {
+        if ep % 50 == 0 {
+            drift.push(snapshot(&agent, ep));
+        }
+        let (result, trace) = run_episode(&mut env, &mut agent, eval_seeds(7, &map, Method::Scaled, ep), true)?;
+        ticks += u64::from(result.ticks);
+        reasoning += u64::from(result.reasoning_ticks);
+        reasoning_no_pedestrian += trace.iter().filter(|t| t.reasoned && t.state.p == 0).count() as u64;
+        refused += agent.refused_history().iter().filter(|r| **r).count() as u64;
+        successes += u64::from(result.success);
+        per_episode.push(result.reasoning_ticks);
+    }
+    drift.push(snapshot(&agent, episodes));
+    let blocks: Vec<f64> = per_episode
+        .chunks(50)
+        .map(|c| f64::from(c.iter().sum::<u32>()) / c.len() as f64)
+        .collect();
+    println!(
+        "{}",
+        serde_json::json!({
+            "map": map.name, "episodes": episodes, "successes": successes, "ticks": ticks,
+            "reasoning_ticks": reasoning, "reasoning_ticks_without_pedestrian": reasoning_no_pedestrian,
+            "refused_handbacks": refused, "reasoning_per_episode_by_50": blocks, "drift": drift,
+        })
+    );
+    Ok(())
+}
