@@ -253,37 +253,48 @@ impl PyController {
 
     /// An observation as the joint index: an int, or `(d, v, L, p)`.
     fn index(&self, obs: &Bound<'_, PyAny>) -> PyResult<usize> {
-        let n: usize = self.sizes.iter().product();
-        if let Ok(i) = obs.extract::<i64>() {
-            return usize::try_from(i).ok().filter(|i| *i < n).ok_or_else(|| {
-                errors::value(format!(
-                    "observation {i}: expected a joint index in 0..{n} or (d, v, L, p)"
-                ))
-            });
-        }
-        let factors: Vec<i64> = obs
-            .try_iter()
-            .and_then(|it| it.map(|x| x?.extract::<i64>()).collect::<PyResult<Vec<_>>>())
-            .map_err(|_| errors::value(format!("observation {obs}: expected a joint index or (d, v, L, p)")))?;
-        if factors.len() != self.sizes.len() {
-            return Err(errors::value(format!(
-                "observation {obs}: expected {} factors (d, v, L, p)",
-                self.sizes.len()
-            )));
-        }
-        let mut index = 0;
-        for (&f, &size) in factors.iter().zip(&self.sizes) {
-            let f = usize::try_from(f)
-                .ok()
-                .filter(|f| *f < size)
-                .ok_or_else(|| errors::value(format!("observation {obs}: factor sizes are {:?}", self.sizes)))?;
-            index = index * size + f;
-        }
-        Ok(index)
+        joint_index(&self.sizes, obs)
     }
 }
 
-fn decision_dict<'py>(py: Python<'py>, d: &Decision) -> PyResult<Bound<'py, PyDict>> {
+/// An observation as the joint index of a model with factor `sizes`: an int in
+/// `0..product(sizes)`, or one integer per factor (`(d, v, L, p)`, e.g. `info["observed"]`).
+pub fn joint_index(sizes: &[usize], obs: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let n: usize = sizes.iter().product();
+    if let Ok(i) = obs.extract::<i64>() {
+        return usize::try_from(i).ok().filter(|i| *i < n).ok_or_else(|| {
+            errors::value(format!(
+                "observation {i}: expected a joint index in 0..{n} or (d, v, L, p)"
+            ))
+        });
+    }
+    let factors: Vec<i64> = obs
+        .try_iter()
+        .and_then(|it| it.map(|x| x?.extract::<i64>()).collect::<PyResult<Vec<_>>>())
+        .map_err(|_| {
+            errors::value(format!(
+                "observation {obs}: expected a joint index or (d, v, L, p), e.g. info['observed']"
+            ))
+        })?;
+    if factors.len() != sizes.len() {
+        return Err(errors::value(format!(
+            "observation {obs}: expected {} factors (d, v, L, p)",
+            sizes.len()
+        )));
+    }
+    let mut index = 0;
+    for (&f, &size) in factors.iter().zip(sizes) {
+        let f = usize::try_from(f)
+            .ok()
+            .filter(|f| *f < size)
+            .ok_or_else(|| errors::value(format!("observation {obs}: factor sizes are {sizes:?}")))?;
+        index = index * size + f;
+    }
+    Ok(index)
+}
+
+/// A decision record as the dict `act` returns.
+pub fn decision_dict<'py>(py: Python<'py>, d: &Decision) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("action", d.action)?;
     out.set_item("reasoned", d.reasoned)?;

@@ -12,11 +12,11 @@ use std::sync::Mutex;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use unforeseen_agent::controller::{Controller, Decision, Ending};
+use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_agent::habit::{PolicyHabit, TableHabit};
 use unforeseen_agent::scaled::ScaledAgent;
 
-use crate::agent::{PyAgent, scaled_params};
+use crate::agent::{PyAgent, decision_dict, scaled_params};
 use crate::errors;
 
 /// The agent, with either kind of habit.
@@ -55,46 +55,8 @@ impl PyScaledHabitAgent {
 
     /// `(d, v, L, p)` (or a joint index) as the joint index.
     fn index(&self, obs: &Bound<'_, PyAny>) -> PyResult<usize> {
-        let n: usize = self.sizes.iter().product();
-        if let Ok(i) = obs.extract::<i64>() {
-            return usize::try_from(i).ok().filter(|i| *i < n).ok_or_else(|| {
-                errors::value(format!(
-                    "observed {i}: expected a joint index in 0..{n} or (d, v, L, p)"
-                ))
-            });
-        }
-        let factors: Vec<i64> = obs
-            .try_iter()
-            .and_then(|it| it.map(|x| x?.extract::<i64>()).collect::<PyResult<Vec<_>>>())
-            .map_err(|_| errors::value(format!("observed {obs}: expected (d, v, L, p), e.g. info['observed']")))?;
-        if factors.len() != self.sizes.len() {
-            return Err(errors::value(format!(
-                "observed {obs}: expected {} factors (d, v, L, p)",
-                self.sizes.len()
-            )));
-        }
-        let mut index = 0;
-        for (&f, &size) in factors.iter().zip(&self.sizes) {
-            let f = usize::try_from(f)
-                .ok()
-                .filter(|f| *f < size)
-                .ok_or_else(|| errors::value(format!("observed {obs}: factor sizes are {:?}", self.sizes)))?;
-            index = index * size + f;
-        }
-        Ok(index)
+        crate::agent::joint_index(&self.sizes, obs)
     }
-}
-
-fn decision_dict<'py>(py: Python<'py>, d: &Decision) -> PyResult<Bound<'py, PyDict>> {
-    let out = PyDict::new(py);
-    out.set_item("action", d.action)?;
-    out.set_item("reasoned", d.reasoned)?;
-    out.set_item("surprise", d.surprise)?;
-    out.set_item("theta", d.theta)?;
-    out.set_item("policy", d.policy.to_vec())?;
-    out.set_item("psi", d.psi.as_deref().map(<[f64]>::to_vec))?;
-    out.set_item("scaling_iters", d.scaling_iters)?;
-    Ok(out)
 }
 
 #[pymethods]
