@@ -199,7 +199,7 @@ impl Evaluator for PyEvaluator {
         Python::attach(|py| {
             self.evaluate
                 .call1(py, (texts,))
-                .and_then(|r| r.extract::<Vec<Vec<String>>>(py).map_err(PyErr::from))
+                .and_then(|r| r.extract::<Vec<Vec<String>>>(py))
         })
         .map_err(|e| {
             let problem = format!("evaluating candidates failed: {e}");
