@@ -23,6 +23,7 @@ mod errors;
 mod maps;
 mod render;
 mod results;
+mod search_units;
 mod units;
 mod vector;
 mod wrapper;
@@ -52,5 +53,6 @@ fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     results::register(m)?;
     wrapper::register(m)?;
     units::register(m)?;
+    search_units::register(m)?;
     Ok(())
 }

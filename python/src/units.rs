@@ -42,7 +42,7 @@ fn protocols_of(choice: &str) -> PyResult<Vec<Protocol>> {
     }
 }
 
-fn check_episodes(what: &str, n: u64) -> PyResult<()> {
+pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
     if (1..=unforeseen::cli::MAX_EPISODES).contains(&n) {
         Ok(())
     } else {
@@ -213,7 +213,7 @@ static PARSED: Mutex<Option<HashMap<String, Agent>>> = Mutex::new(None);
 /// Most agents [`PARSED`] keeps (a few MB each).
 const MAX_PARSED: usize = 16;
 
-fn parse_agent(text: &[u8]) -> PyResult<Agent> {
+pub(crate) fn parse_agent(text: &[u8]) -> PyResult<Agent> {
     let key = unforeseen::seeds::content_hash(text);
     let mut parsed = PARSED.lock().unwrap_or_else(|e| e.into_inner());
     let map = parsed.get_or_insert_with(HashMap::new);

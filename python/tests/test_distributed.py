@@ -273,6 +273,51 @@ def test_an_input_error_fails_once_and_a_dead_worker_is_retried(cluster: Cluster
     assert result["retried"] == "done"
 
 
+# A small failure search: q-learning over the shipped jaywalk space, two training seeds.
+SEARCH = ["--space", str(REPO / "maps" / "spaces" / "jaywalk.ron"), "--method", "q-learning",
+          "--train-seeds", "1..2", "--train-episodes", "200", "--budget", "6", "--episodes", "3", "--seed", "5",
+          "--rounds", "2", "--max-failures", "2"]
+
+
+def _search_outputs(out: Path) -> dict[str, object]:
+    """A search folder's outputs, timing fields, the folder's name and the failure maps'
+    `Found by` comment (the command that ran it) aside."""
+    lines = [json.loads(line) for line in (out / "candidates.jsonl").read_text().splitlines()]
+    for line in lines[1:]:
+        line.pop("timing_us_per_tick")
+    summary = (out / "summary.json").read_text().replace(str(out), "DIR")
+    failures = {f.name: [line for line in f.read_text().replace(str(out), "DIR").splitlines()
+                         if "Found by:" not in line]
+                for f in sorted((out / "failures").iterdir())}
+    return {"candidates": lines, "summary": json.loads(summary), "failures": failures,
+            "figure": (out / "search.svg").read_text()}
+
+
+def test_a_search_on_the_cluster_equals_one_machine(cluster: Cluster, tmp_path: Path):
+    cli = cli_binary()
+    if cli is None:
+        if os.environ.get("CI"):
+            pytest.fail("CI must build the unforeseen binary before the Python tests (cargo test does)")
+        pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
+    one, two = tmp_path / "one", tmp_path / "cluster"
+    done = subprocess.run([str(cli), "search", *SEARCH, "--no-cache", "--quiet", "--jobs", "1", "--out", str(one)],
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    driver = cluster.driver(["-m", "unforeseen.distributed", "search", *SEARCH, "--out", str(two),
+                             "--candidates-per-task", "1", "--address", ADDRESS], cwd=tmp_path)
+    _, err = driver.communicate(timeout=RUN_TIMEOUT)
+    assert driver.returncode == 0, err
+    a, b = _search_outputs(one), _search_outputs(two)
+    # Every stage ran: Sobol and adaptive candidates, minimisation tries of a failure.
+    counts = a["summary"]["counts"]
+    assert counts["sobol"] == 3 and counts["adaptive"] == 3 and counts["minimise"] > 0, counts
+    assert a["failures"], "the search should write a minimised failure"
+    for part in ("candidates", "summary", "failures", "figure"):
+        assert a[part] == b[part], part
+    found = [line for f in (two / "failures").iterdir() for line in f.read_text().splitlines() if "Found by:" in line]
+    assert found and all("python -m unforeseen.distributed search" in line for line in found)
+
+
 def _lines_without_timing(path: Path) -> list[dict]:
     lines = [json.loads(line) for line in path.read_text().splitlines()]
     for line in lines[1:]:

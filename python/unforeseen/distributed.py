@@ -69,7 +69,7 @@ from typing import Any
 
 from . import _unforeseen
 
-__all__ = ["DEFAULT_MAX_RETRIES", "main", "parse_train_seeds", "run_batch"]
+__all__ = ["DEFAULT_MAX_RETRIES", "main", "parse_train_seeds", "run_batch", "run_search"]
 
 #: Retries of a task whose worker process or node died (system failures only).
 DEFAULT_MAX_RETRIES = 3
@@ -104,6 +104,15 @@ def _train_task(seed: int, episodes: int) -> bytes:
 def _units_task(spec: str, seeds: Sequence[int | None], *agents: bytes, units: list[int], threads: int) -> list[str]:
     """A block of units: their result lines (JSON text)."""
     return _unforeseen.run_units(spec, list(zip(seeds, agents, strict=True)), units, threads)
+
+
+def _search_task(
+    spec: str, seeds: Sequence[int | None], *agents: bytes, candidates: list[str], from_file: bool, threads: int
+) -> list[list[str]]:
+    """A block of search candidates: each one's lines of ``candidates.jsonl``."""
+    return _unforeseen.evaluate_search_candidates(
+        spec, list(zip(seeds, agents, strict=True)), candidates, from_file, threads
+    )
 
 
 class _Progress:
@@ -290,6 +299,116 @@ def run_batch(
         lock.close()
 
 
+def run_search(
+    *,
+    space: str | os.PathLike[str],
+    map: str | os.PathLike[str] = "jaywalk",
+    method: str = "scaled",
+    protocol: str = "zero-shot",
+    budget: int = 100,
+    episodes: int = 20,
+    seed: int = 7,
+    sobol_share: float = 0.5,
+    rounds: int = 5,
+    max_failures: int = 5,
+    out: str | os.PathLike[str] = "out/search",
+    train_seeds: Iterable[int] | None = None,
+    train_episodes: int = 6000,
+    agent: str | os.PathLike[str] | None = None,
+    resume: bool = False,
+    jobs: int = 1,
+    candidates_per_task: int | None = None,
+    address: str | None = "auto",
+    max_retries: int = DEFAULT_MAX_RETRIES,
+    command: str | None = None,
+) -> dict[str, Any]:
+    """``unforeseen search`` on a Ray cluster: the same arguments, the same folder of
+    outputs (``candidates.jsonl``, ``summary.json``, ``failures/*.ron``, ``search.svg``),
+    timing fields aside, whatever the number of workers.
+
+    The stages run in order on the driver, in the library (``unforeseen::search``); each
+    stage's candidates (the Sobol stage's, each adaptive round's) run as tasks of
+    ``candidates_per_task`` candidates (default: about 4 tasks per CPU), and each
+    minimisation try as a task of its own, the best failures minimised at once. Agents
+    train once per training seed on the cluster and reach the tasks through the object
+    store. ``command`` is written in the failure maps' comments (``Found by: ...``).
+    Returns ``summary.json``'s contents.
+    """
+    if jobs < 1 or jobs > 256:
+        raise ValueError(f"jobs {jobs}: expected a number of threads per task from 1 to 256")
+    if candidates_per_task is not None and candidates_per_task < 1:
+        raise ValueError(f"candidates_per_task {candidates_per_task}: expected at least 1")
+    if max_retries < 0:
+        raise ValueError(f"max_retries {max_retries}: expected 0 or more")
+    seeds = None if train_seeds is None else list(train_seeds)
+    if seeds is not None and agent is not None:
+        raise ValueError("--train-seeds and --agent: give one (train agents per seed, or search with one agent file)")
+    spec = json.dumps(
+        {
+            "map": str(map),
+            "space": str(space),
+            "method": method,
+            "protocol": protocol,
+            "budget": budget,
+            "episodes": episodes,
+            "seed": seed,
+            "sobol_share": sobol_share,
+            "rounds": rounds,
+            "max_failures": max_failures,
+            "train_seeds": seeds,
+            "train_episodes": train_episodes,
+        }
+    )
+    # The arguments, maps and space checked before any task runs.
+    scripted = _unforeseen.check_search(spec)
+    ray = _ray()
+    if not ray.is_initialized():
+        ray.init(address=address, include_dashboard=False, log_to_driver=False)
+    options = _task_options(max_retries)
+    from_file = agent is not None and not scripted
+    if scripted:
+        pairs: list[tuple[int | None, Any]] = []
+    elif from_file:
+        pairs = [(None, ray.put(_unforeseen.search_agent_text(str(agent))))]
+    else:
+        train = ray.remote(num_cpus=1, **options)(_train_task)
+        pairs = [(s, train.remote(s, train_episodes)) for s in (seeds if seeds is not None else [seed])]
+    agent_seeds = [s for s, _ in pairs]
+    refs = [r for _, r in pairs]
+    texts = ray.get(refs) if refs else []
+    task = ray.remote(num_cpus=jobs, **options)(_search_task)
+    cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // jobs)
+
+    def evaluate(candidates: list[str]) -> list[list[str]]:
+        per = candidates_per_task or max(1, math.ceil(len(candidates) / (4 * cpus)))
+        blocks = [list(range(i, min(i + per, len(candidates)))) for i in range(0, len(candidates), per)]
+        lines: list[list[str] | None] = [None] * len(candidates)
+
+        def submit(block: list[int]) -> Any:
+            return task.remote(
+                spec, agent_seeds, *refs, candidates=[candidates[i] for i in block], from_file=from_file, threads=jobs
+            )
+
+        def sink(block: list[int], got: list[list[str]]) -> None:
+            for i, g in zip(block, got, strict=True):
+                lines[i] = g
+
+        _drive(ray, blocks, submit, sink)
+        return [g for g in lines if g is not None]
+
+    summary = _unforeseen.drive_search(
+        spec,
+        list(zip(agent_seeds, texts, strict=True)),
+        evaluate,
+        str(out),
+        resume=resume,
+        from_file=from_file,
+        jobs=max(1, max_failures),
+        command=command if command is not None else f"unforeseen.distributed.run_search(space={str(space)!r}, ...)",
+    )
+    return json.loads(summary)
+
+
 def parse_train_seeds(text: str) -> list[int]:
     """``1..10``, ``1,3,5`` or ``1..3,7`` (ranges inclusive), as ``--train-seeds``."""
     seeds: list[int] = []
@@ -335,12 +454,83 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--address", default="auto", help="Ray cluster address (default: auto, the local cluster)")
     b.add_argument("--units-per-task", type=int, help="units per task (default: about 4 tasks per CPU)")
     b.add_argument("--max-retries", type=int, default=DEFAULT_MAX_RETRIES)
+    s = sub.add_parser("search", help="unforeseen search on a Ray cluster (its options, plus --address)")
+    s.add_argument("--map", default="jaywalk")
+    s.add_argument("--space", required=True)
+    s.add_argument("--method", default="scaled")
+    s.add_argument("--protocol", choices=["zero-shot", "continual"], default="zero-shot")
+    s.add_argument("--budget", type=int, default=100)
+    s.add_argument("--episodes", type=int, default=20)
+    s.add_argument("--seed", type=int, default=7)
+    s.add_argument("--sobol-share", type=float, default=0.5)
+    s.add_argument("--rounds", type=int, default=5)
+    s.add_argument("--max-failures", type=int, default=5)
+    s.add_argument("--jobs", type=int, default=1, help="threads (and CPUs) of each task")
+    s.add_argument("--shard", metavar="I/N", help="refused: the cluster splits the run itself")
+    s.add_argument("--resume", action="store_true")
+    s.add_argument("--out", default="out/search")
+    s.add_argument("--train-episodes", type=int, default=6000)
+    s.add_argument("--agent", metavar="FILE")
+    s.add_argument("--train-seeds", metavar="SEEDS")
+    s.add_argument("--cache", metavar="DIR", help="accepted; agents train on the cluster, once per seed per run")
+    s.add_argument("--no-cache", action="store_true", help="accepted (agents are not cached on the cluster)")
+    s.add_argument("--quiet", "-q", action="store_true")
+    s.add_argument("--address", default="auto", help="Ray cluster address (default: auto, the local cluster)")
+    s.add_argument("--candidates-per-task", type=int, help="candidates per task (default: about 4 tasks per CPU)")
+    s.add_argument("--max-retries", type=int, default=DEFAULT_MAX_RETRIES)
     return p
+
+
+def _main_search(args: argparse.Namespace, argv: Sequence[str]) -> int:
+    try:
+        if args.shard:
+            raise ValueError(
+                f"--shard {args.shard}: the cluster splits the run itself; run it whole here, "
+                "or run `unforeseen search --shard I/N` on separate machines and finish with --resume"
+            )
+        summary = run_search(
+            space=args.space,
+            map=args.map,
+            method=args.method,
+            protocol=args.protocol,
+            budget=args.budget,
+            episodes=args.episodes,
+            seed=args.seed,
+            sobol_share=args.sobol_share,
+            rounds=args.rounds,
+            max_failures=args.max_failures,
+            out=args.out,
+            train_seeds=None if args.train_seeds is None else parse_train_seeds(args.train_seeds),
+            train_episodes=args.train_episodes,
+            agent=args.agent,
+            resume=args.resume,
+            jobs=args.jobs,
+            candidates_per_task=args.candidates_per_task,
+            address=args.address,
+            max_retries=args.max_retries,
+            command=" ".join(["python -m unforeseen.distributed", *argv]),
+        )
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    except (RuntimeError, ConnectionError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    c = summary["counts"]
+    print(
+        f"candidates: {c['sobol']} Sobol, {c['adaptive']} adaptive, {c['minimise']} minimisation tries; "
+        f"{len(summary['failures'])} failure(s) written; wrote {args.out}/"
+        "{candidates.jsonl, summary.json, search.svg, failures/}"
+    )
+    return 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """The command: exit 0, 1 when an expectation fails on the mean, 2 for bad input."""
+    argv = list(sys.argv[1:] if argv is None else argv)
     args = _parser().parse_args(argv)
+    if args.command == "search":
+        return _main_search(args, argv)
     try:
         if args.shard:
             raise ValueError(

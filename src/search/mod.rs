@@ -399,6 +399,57 @@ struct RawLine {
     parsed: CandidateLine,
 }
 
+/// Evaluates candidates somewhere else than in this process (e.g. as tasks of a
+/// cluster): what [`run_with`] calls in place of [`evaluate`]. Each candidate's lines
+/// must be what [`evaluate`] gives for it (JSON text, one line each, ending in `\n`), in
+/// the same order as the candidates given; [`CandidateWire`] is what to send of a
+/// candidate, and [`evaluate_wire`] what to run with it where the lines are made.
+pub trait Evaluator: Sync {
+    /// The lines of each candidate of `candidates` (valid maps not kept by `--resume`).
+    fn evaluate(&self, candidates: &[CandidateWire]) -> Result<Vec<Vec<String>>, Error>;
+}
+
+/// What an [`Evaluator`] needs of a candidate to rebuild it: its map derives from the
+/// space and its values.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CandidateWire {
+    /// Its number.
+    pub index: usize,
+    /// The stage that made it.
+    pub stage: Stage,
+    /// Its parameter values, in the space's order.
+    pub values: Vec<Value>,
+}
+
+impl CandidateWire {
+    fn of(c: &Candidate) -> Self {
+        CandidateWire {
+            index: c.index,
+            stage: c.stage,
+            values: c.values.clone(),
+        }
+    }
+}
+
+/// The lines of a candidate sent as a [`CandidateWire`]: what [`evaluate`] writes for
+/// it, as JSON text (one line each, with its `\n`); an error when its map is not valid.
+pub fn evaluate_wire(cfg: &SearchConfig<'_>, wire: &CandidateWire) -> Result<Vec<String>, Error> {
+    let c = Candidate::new(cfg.space, wire.index, wire.stage, Vec::new(), Some(wire.values.clone()));
+    let map = c.map.as_ref().map_err(|r| Error::Results {
+        path: cfg.space.source.clone().into(),
+        problem: format!("candidate {}: not a valid map ({r:?})", wire.index),
+    })?;
+    let named = c.named_values(cfg.space);
+    evaluate(cfg, &c, map, named)?
+        .iter()
+        .map(|l| {
+            let mut raw = serde_json::to_string(l)?;
+            raw.push('\n');
+            Ok(raw)
+        })
+        .collect()
+}
+
 /// The shared state of a running search: the file being appended and the lines kept.
 struct Runner<'a, 'b> {
     cfg: &'a SearchConfig<'b>,
@@ -407,6 +458,10 @@ struct Runner<'a, 'b> {
     kept: BTreeMap<usize, Vec<RawLine>>,
     written: Mutex<BTreeMap<usize, Vec<RawLine>>>,
     progress: &'a dyn Progress,
+    /// Where candidates are evaluated when not here.
+    remote: Option<&'a dyn Evaluator>,
+    /// Lines the remote evaluator made for a stage, taken by [`Runner::one`].
+    prefetched: Mutex<BTreeMap<usize, Vec<RawLine>>>,
 }
 
 impl Runner<'_, '_> {
@@ -417,6 +472,14 @@ impl Runner<'_, '_> {
             .filter(|c| c.map.is_ok() && !self.kept.contains_key(&c.index))
             .count();
         self.progress.phase(name, todo as u64);
+        if self.remote.is_some() {
+            let todo: Vec<Candidate> = candidates
+                .iter()
+                .filter(|c| c.map.is_ok() && !self.kept.contains_key(&c.index))
+                .cloned()
+                .collect();
+            self.fetch(&todo)?;
+        }
         let done = candidates
             .into_par_iter()
             .map(|c| self.one(c, true))
@@ -455,6 +518,33 @@ impl Runner<'_, '_> {
             let lines = kept.iter().map(|l| l.parsed.clone()).collect();
             return Ok(Evaluated { candidate, lines });
         }
+        let remote = if self.remote.is_some() {
+            let got = self.prefetched.lock().expect("lines lock").remove(&candidate.index);
+            match got {
+                Some(raws) => Some(raws),
+                None => {
+                    self.fetch(std::slice::from_ref(&candidate))?;
+                    self.prefetched.lock().expect("lines lock").remove(&candidate.index)
+                }
+            }
+        } else {
+            None
+        };
+        if let Some(raws) = remote {
+            if let Some(bad) = raws
+                .iter()
+                .find(|l| l.parsed.values != named || l.parsed.stage != candidate.stage)
+            {
+                return Err(Error::Results {
+                    path: self.out.to_path_buf(),
+                    problem: format!(
+                        "candidate {}: the evaluator returned lines of other values or another stage ({:?} vs {:?})",
+                        candidate.index, bad.parsed.values, named
+                    ),
+                });
+            }
+            return self.write(candidate, raws, advance);
+        }
         let lines = evaluate(self.cfg, &candidate, map, named)?;
         let raws: Vec<RawLine> = lines
             .iter()
@@ -464,6 +554,12 @@ impl Runner<'_, '_> {
                 Ok(RawLine { raw, parsed: l.clone() })
             })
             .collect::<Result<_, Error>>()?;
+        self.write(candidate, raws, advance)
+    }
+
+    /// Appends a candidate's fresh lines to the file and keeps them.
+    fn write(&self, candidate: Candidate, raws: Vec<RawLine>, advance: bool) -> Result<Evaluated, Error> {
+        let lines = raws.iter().map(|r| r.parsed.clone()).collect();
         let text: String = raws.iter().map(|r| r.raw.as_str()).collect();
         {
             let mut f = self.sink.lock().expect("file lock");
@@ -476,6 +572,59 @@ impl Runner<'_, '_> {
             self.progress.advance(1);
         }
         Ok(Evaluated { candidate, lines })
+    }
+
+    /// Has the remote evaluator make the lines of `candidates`, parsed, for [`Runner::one`].
+    fn fetch(&self, candidates: &[Candidate]) -> Result<(), Error> {
+        let Some(remote) = self.remote else { return Ok(()) };
+        if candidates.is_empty() {
+            return Ok(());
+        }
+        let wires: Vec<CandidateWire> = candidates.iter().map(CandidateWire::of).collect();
+        let got = remote.evaluate(&wires)?;
+        let bad = |problem: String| Error::Results {
+            path: self.out.to_path_buf(),
+            problem,
+        };
+        if got.len() != candidates.len() {
+            return Err(bad(format!(
+                "the evaluator returned {} candidates' lines for {}",
+                got.len(),
+                candidates.len()
+            )));
+        }
+        let need = lines_per_candidate(self.cfg);
+        let mut parsed = Vec::with_capacity(got.len());
+        for (c, lines) in candidates.iter().zip(got) {
+            if lines.len() != need {
+                return Err(bad(format!(
+                    "candidate {}: the evaluator returned {} lines, expected {need}",
+                    c.index,
+                    lines.len()
+                )));
+            }
+            let raws = lines
+                .into_iter()
+                .map(|raw| {
+                    let parsed: CandidateLine = serde_json::from_str(raw.trim_end()).map_err(|e| {
+                        bad(format!(
+                            "candidate {}: the evaluator returned a bad line ({e})",
+                            c.index
+                        ))
+                    })?;
+                    if parsed.candidate != c.index || !raw.ends_with('\n') {
+                        return Err(bad(format!(
+                            "candidate {}: the evaluator returned another candidate's line",
+                            c.index
+                        )));
+                    }
+                    Ok(RawLine { raw, parsed })
+                })
+                .collect::<Result<Vec<_>, Error>>()?;
+            parsed.push((c.index, raws));
+        }
+        self.prefetched.lock().expect("lines lock").extend(parsed);
+        Ok(())
     }
 }
 
@@ -693,6 +842,20 @@ pub struct Outcome {
 /// `search.svg`); with `resume`, completes the search a file there holds. Progress: one
 /// phase per stage (`search sobol`, `search adaptive N`, `search minimise`).
 pub fn run(cfg: &SearchConfig<'_>, out: &Path, resume: bool, progress: &dyn Progress) -> Result<Summary, Error> {
+    run_with(cfg, out, resume, progress, None)
+}
+
+/// [`run`], with the candidates evaluated by `remote` when given (each stage's
+/// candidates in one call, each minimisation try in its own; the stage logic, the files
+/// and their order stay here, so the outputs equal [`run`]'s). Minimisation's failures
+/// run on `cfg.jobs` threads, each waiting on its own calls.
+pub fn run_with(
+    cfg: &SearchConfig<'_>,
+    out: &Path,
+    resume: bool,
+    progress: &dyn Progress,
+    remote: Option<&dyn Evaluator>,
+) -> Result<Summary, Error> {
     cfg.check()?;
     std::fs::create_dir_all(out).map_err(|e| Error::io("create folder", out, e))?;
     let file = out.join(output::CANDIDATES);
@@ -716,6 +879,8 @@ pub fn run(cfg: &SearchConfig<'_>, out: &Path, resume: bool, progress: &dyn Prog
         kept,
         written: Mutex::new(BTreeMap::new()),
         progress,
+        remote,
+        prefetched: Mutex::new(BTreeMap::new()),
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(cfg.jobs.max(1)).build()?;
     let outcome = pool.install(|| search(&runner))?;
