@@ -44,14 +44,15 @@ Usage statistics are switched off for the driver (``RAY_USAGE_STATS_ENABLED=0``)
 the cluster's nodes with ``--disable-usage-stats`` too. The README shows a cluster kept
 on loopback inside a network namespace (the tests do the same).
 
-Where a search plugs in
------------------------
-The driver loop (:func:`_drive`) knows nothing of batches: it takes blocks of work,
-a function that submits a block as a task (given the object refs of the agents it
-needs), and a sink for each finished block's lines. A search (``unforeseen search``)
-adds its own planning binding (its candidate units and their identity) and a
-``run_search`` that calls :func:`_drive` with its blocks and the same train tasks; its
-results file is then finished the way :func:`run_batch` finishes a batch's.
+How a search runs
+-----------------
+:func:`run_search` keeps the search's stages in Rust (``unforeseen::search::run_with``,
+through the binding's ``drive_search``): the Sobol stage, each cross-entropy round and
+each minimisation try hand their candidates to an evaluator, which here splits them into
+blocks and runs them as Ray tasks through :func:`_drive` (the same retry and input-error
+rules as :func:`run_batch`; each training seed trained once and shared). The outputs are
+those of ``unforeseen search`` with the same arguments, timing aside. The search driver
+shows no progress bar and takes no output lock.
 """
 
 from __future__ import annotations
