@@ -6,7 +6,8 @@ an agent file, a parameter, an action), with the message the command line prints
 ``RuntimeError`` otherwise.
 """
 
-from typing import Any, Sequence, final
+import os
+from typing import Any, Callable, Sequence, final
 
 import numpy as np
 import numpy.typing as npt
@@ -223,3 +224,27 @@ def run_units(spec: str, agents: Sequence[tuple[int | None, bytes]], units: Sequ
     """The result lines (JSON text) of units of a planned run, with the GIL released."""
 def finish_batch(out: str) -> str:
     """Rewrites a driver's results file in canonical order with its summary (JSON text)."""
+def check_search(spec: str) -> bool:
+    """Checks a search's spec (JSON text: arguments, base map, space file) before any task;
+    whether its method is scripted (needs no agents)."""
+def search_agent_text(path: str | os.PathLike[str]) -> bytes:
+    """An agent file's text, as the search tasks take it."""
+def evaluate_search_candidates(
+    spec: str,
+    agents: Sequence[tuple[int | None, bytes]],
+    candidates: Sequence[str],
+    from_file: bool = False,
+    threads: int = 1,
+) -> list[list[str]]:
+    """The candidate lines (JSON text) of a block of candidates, with the GIL released."""
+def drive_search(
+    spec: str,
+    agents: Sequence[tuple[int | None, bytes]],
+    evaluate: Callable[[list[str]], list[list[str]]],
+    out: str | os.PathLike[str],
+    resume: bool = False,
+    from_file: bool = False,
+    jobs: int = 1,
+    command: str = "",
+) -> str:
+    """Runs a search's stages in Rust with ``evaluate`` for its candidates; the summary (JSON text)."""
