@@ -1,7 +1,8 @@
 //! Audits the scaled agent over a long continual run on one map (issue 20, EXPERIMENTS.md
 //! "The safe hand-back"): reasoning ticks with and without a pedestrian on the crosswalk,
-//! ticks the hand-back check refused, reasoning per block of 50 episodes, and what drifts:
-//! the gate's table `P(p = 1 | L, d)` and the habit's total counts `Σ ν`, every 50 episodes.
+//! ticks the hand-back check refused, learned triggers it declined, reasoning per block of 50 episodes, and what drifts:
+//! the gate's table `P(p = 1 | L, d)`, the habit's total counts `Σ ν` and its largest
+//! state's `Σ_u ν[s, u]`, every 50 episodes.
 //!
 //! ```sh
 //! cargo build --release --example handback_audit
@@ -35,6 +36,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut env = Env::new(&map, EnvConfig::default())?;
     let (mut ticks, mut reasoning, mut reasoning_no_pedestrian, mut refused, mut successes) =
         (0u64, 0u64, 0u64, 0u64, 0u64);
+    let mut declined = 0u64;
+    let mut empty_reasoning = Vec::new();
     let mut per_episode = Vec::new();
     let mut drift = Vec::new();
     let snapshot = |agent: &unforeseen_agent::scaled::ScaledAgent, episode: u64| {
@@ -46,7 +49,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .collect()
             })
             .unwrap_or_default();
-        serde_json::json!({"episode": episode, "p_pedestrian_by_L_d": table, "nu_total": agent.nu().iter().sum::<f64>()})
+        serde_json::json!({"episode": episode, "p_pedestrian_by_L_d": table, "nu_total": agent.nu().iter().sum::<f64>(),
+            "nu_largest_state": agent.nu().chunks(3).map(|r| r.iter().sum::<f64>()).fold(0.0, f64::max)})
     };
     for ep in 0..episodes {
         if ep % 50 == 0 {
@@ -55,8 +59,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (result, trace) = run_episode(&mut env, &mut agent, eval_seeds(7, &map, Method::Scaled, ep), true)?;
         ticks += u64::from(result.ticks);
         reasoning += u64::from(result.reasoning_ticks);
-        reasoning_no_pedestrian += trace.iter().filter(|t| t.reasoned && t.state.p == 0).count() as u64;
+        for t in trace.iter().filter(|t| t.reasoned && t.state.p == 0) {
+            reasoning_no_pedestrian += 1;
+            let refused = agent.refused_history()[t.step as usize];
+            empty_reasoning.push(serde_json::json!({
+                "episode": ep, "step": t.step, "state": [t.state.d, t.state.v, t.state.l, t.state.p],
+                "theta": t.theta, "policy": t.policy, "refused_handback": refused,
+            }));
+        }
         refused += agent.refused_history().iter().filter(|r| **r).count() as u64;
+        declined += agent.declined_history().iter().filter(|r| **r).count() as u64;
         successes += u64::from(result.success);
         per_episode.push(result.reasoning_ticks);
     }
@@ -70,7 +82,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         serde_json::json!({
             "map": map.name, "episodes": episodes, "successes": successes, "ticks": ticks,
             "reasoning_ticks": reasoning, "reasoning_ticks_without_pedestrian": reasoning_no_pedestrian,
-            "refused_handbacks": refused, "reasoning_per_episode_by_50": blocks, "drift": drift,
+            "reasoning_without_pedestrian": empty_reasoning, "refused_handbacks": refused, "declined_triggers": declined, "reasoning_per_episode_by_50": blocks, "drift": drift,
         })
     );
     Ok(())

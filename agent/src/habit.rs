@@ -50,6 +50,25 @@ pub trait Habit: std::fmt::Debug + Clone + Send {
     fn pi_o_belief(&self, t: usize, q: &[f64], out: &mut [f64]);
     /// Consolidate what reasoning chose (§V-C): `ν[s,u] += lr q[s] π[u]`.
     fn learn(&mut self, q: &[f64], pi: &[f64], lr: f64);
+    /// The habit's bounded memory (beyond the paper, like the gate's rows): in every state
+    /// whose counts of reasoning (the counts [`Habit::learn`] added, beyond the prior)
+    /// exceed `memory`, rescales them to `memory`: what reasoning chose there keeps its
+    /// proportions, and how stiff the habit grows over a long deployment is bounded.
+    /// `inf` keeps everything.
+    fn bound_memory(&mut self, memory: f64);
+}
+
+/// Rescales each row of `counts` (`n_actions` wide) whose sum exceeds `memory` to `memory`.
+fn rescale_rows(counts: &mut [f64], n_actions: usize, memory: f64) {
+    if memory.is_finite() {
+        for row in counts.chunks_mut(n_actions.max(1)) {
+            let total: f64 = row.iter().sum();
+            if total > memory {
+                let k = memory / total;
+                row.iter_mut().for_each(|c| *c *= k);
+            }
+        }
+    }
 }
 
 /// A habit as a table of Dirichlet counts `ν[s,u]`, laid out `[s * n_actions + u]`
@@ -57,6 +76,10 @@ pub trait Habit: std::fmt::Debug + Clone + Send {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TableHabit {
     n_actions: usize,
+    /// The prior counts the table was built with.
+    prior: Vec<f64>,
+    /// The counts reasoning added, `ν - prior`.
+    learned: Vec<f64>,
     nu: Vec<f64>,
 }
 
@@ -64,10 +87,7 @@ impl TableHabit {
     /// `ν = ν0 σ(Q[s,·]/T)` from a Q-table laid out `[s * n_actions + u]`
     /// (docs/ARCHITECTURE.md §4.8).
     pub fn from_q(q_table: &[f64], n_actions: usize, nu0: f64, temperature: f64) -> TableHabit {
-        TableHabit {
-            n_actions,
-            nu: learning::nu_from_q(q_table, n_actions, nu0, temperature),
-        }
+        TableHabit::with_prior(n_actions, learning::nu_from_q(q_table, n_actions, nu0, temperature))
     }
 
     /// `ν = ν0 π` from per-state probabilities `probs[s * n_actions + u]`. Each row must be
@@ -84,10 +104,19 @@ impl TableHabit {
         for (s, row) in probs.chunks(n_actions).enumerate() {
             check_probs(row).map_err(|why| AgentError::InvalidHabit(format!("state {s}: {why}")))?;
         }
-        Ok(TableHabit {
+        Ok(TableHabit::with_prior(
             n_actions,
-            nu: probs.iter().map(|p| p * nu0).collect(),
-        })
+            probs.iter().map(|p| p * nu0).collect(),
+        ))
+    }
+
+    fn with_prior(n_actions: usize, prior: Vec<f64>) -> TableHabit {
+        TableHabit {
+            n_actions,
+            learned: vec![0.0; prior.len()],
+            nu: prior.clone(),
+            prior,
+        }
     }
 
     /// The counts `ν`, `[s * n_actions + u]`.
@@ -111,6 +140,15 @@ impl Habit for TableHabit {
     }
     fn learn(&mut self, q: &[f64], pi: &[f64], lr: f64) {
         learning::update_nu(&mut self.nu, self.n_actions, q, pi, lr);
+        learning::update_nu(&mut self.learned, self.n_actions, q, pi, lr);
+    }
+    fn bound_memory(&mut self, memory: f64) {
+        if memory.is_finite() {
+            rescale_rows(&mut self.learned, self.n_actions, memory);
+            for ((n, p), c) in self.nu.iter_mut().zip(&self.prior).zip(&self.learned) {
+                *n = p + c;
+            }
+        }
     }
 }
 
@@ -219,6 +257,9 @@ impl Habit for PolicyHabit {
     fn learn(&mut self, q: &[f64], pi: &[f64], lr: f64) {
         learning::update_nu(&mut self.corrections, self.n_actions, q, pi, lr);
     }
+    fn bound_memory(&mut self, memory: f64) {
+        rescale_rows(&mut self.corrections, self.n_actions, memory);
+    }
 }
 
 fn check_nu0(nu0: f64) -> Result<(), AgentError> {
@@ -283,6 +324,53 @@ mod tests {
         // A belief mixes the states' habits.
         h.pi_o_belief(0, &[0.5, 0.5], &mut out);
         assert!((out[2] - 0.5 * (0.1 + 21.0 / 30.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bounded_memory_by_hand() {
+        // Prior ν0 = 10 over (0.2, 0.7, 0.1) in both states.
+        let probs = [0.2, 0.7, 0.1, 0.2, 0.7, 0.1];
+        let mut table = TableHabit::from_probs(&probs, 3, 10.0).unwrap();
+        let mut policy = PolicyHabit::new(2, 3, 10.0).unwrap();
+        policy.push(&[0.2, 0.7, 0.1]).unwrap();
+        // 30 ticks of reasoning in state 1: 20 chose "slow down", 10 "maintain".
+        for k in 0..30 {
+            let pi = if k < 20 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] };
+            table.learn(&[0.0, 1.0], &pi, 1.0);
+            policy.learn(&[0.0, 1.0], &pi, 1.0);
+        }
+        let mut unbounded = table.clone();
+        unbounded.bound_memory(f64::INFINITY);
+        assert_eq!(unbounded, table, "inf keeps everything");
+        // Memory 15: the 30 counts become 10 and 5, the prior stays: (2 + 5, 7, 1 + 10) / 25.
+        table.bound_memory(15.0);
+        policy.bound_memory(15.0);
+        let mut out = [0.0; 3];
+        for h in [&table as &dyn HabitView, &policy] {
+            h.state(1, &mut out);
+            for (o, want) in out.iter().zip([7.0 / 25.0, 7.0 / 25.0, 11.0 / 25.0]) {
+                assert!((o - want).abs() < 1e-12, "{out:?}");
+            }
+            // State 0 was never reasoned in: the prior.
+            h.state(0, &mut out);
+            assert!((out[1] - 0.7).abs() < 1e-12);
+        }
+        assert!((table.nu()[3..].iter().sum::<f64>() - 25.0).abs() < 1e-12);
+        assert!((policy.corrections()[3..].iter().sum::<f64>() - 15.0).abs() < 1e-12);
+        // Below the memory nothing changes.
+        let before = table.clone();
+        table.bound_memory(15.0);
+        assert_eq!(before, table);
+    }
+
+    /// `π_o(·|s)` at tick 0, for either habit.
+    trait HabitView {
+        fn state(&self, s: usize, out: &mut [f64]);
+    }
+    impl<H: Habit> HabitView for H {
+        fn state(&self, s: usize, out: &mut [f64]) {
+            self.pi_o_state(0, s, out);
+        }
     }
 
     #[test]

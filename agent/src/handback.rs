@@ -34,9 +34,16 @@
 //! through (crowd_slow)). The cost is `U H` predictions on the ticks that are checked,
 //! fewer than one reasoning tick's (VMP plus `U + U² + … + U^H` predictions).
 //!
-//! Which hand-backs are checked: those the trained agent would not have made, i.e. ticks on
-//! which the trained gate's trigger ([`crate::gate::StateGate::trained_surprise`]) exceeds
-//! `ε` while the learned one no longer does. Where the trained agent also hands back, the
+//! Which ticks are checked: those where test-time learning changed the trigger's verdict.
+//! A hand-back the trained agent would not have made (the trained gate's trigger,
+//! [`crate::gate::StateGate::trained_surprise`], exceeds `ε` while the learned one no
+//! longer does) goes to the habit only if the check passes. And a reasoning tick the
+//! trained agent would not have taken (the learned trigger exceeds `ε`, the trained one
+//! does not: learning that pedestrians are common makes an empty road read as surprising)
+//! is taken only if the check finds the habit at risk; where the habit is safe it acts, as
+//! the trained agent's would. Measured on the crowd maps, such reasoning did harm: the
+//! planner slowed a car on an empty road and brought it to the crosswalk in front of the
+//! next walker (EXPERIMENTS.md, "The safe hand-back"). Where learning changed nothing, the
 //! habit acts as training left it, as in the paper; so the zero-shot agent, which has
 //! learned nothing, decides exactly as before.
 

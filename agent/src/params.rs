@@ -194,14 +194,19 @@ pub enum GateBaseline {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum HandBackRule {
-    /// A hand-back that test-time learning made (the trained agent's trigger would still
+    /// Where test-time learning changed the trigger's verdict, the crash-risk check decides
+    /// who drives. A hand-back that learning made (the trained agent's trigger would still
     /// fire) is made only if the habit, rolled forward `handback_horizon` ticks through the
-    /// learned model, enters a crash-risk state at most `handback_risk` more likely than after
-    /// the safest first action;
-    /// otherwise the agent reasons.
+    /// learned model, enters a crash-risk state at most `handback_risk` more likely than
+    /// the safest action; otherwise the agent reasons. A reasoning tick that learning made
+    /// (the trained trigger would hand back, the learned one fires) is taken only if that
+    /// check finds the habit at risk; otherwise the habit acts, as the trained agent's would.
     #[default]
     RiskChecked,
-    /// Ablation (the rule before the check): `θ <= ε` hands back, whatever the habit does.
+    /// Ablation: only hand-backs that learning made are checked; every tick the learned
+    /// trigger fires on reasons.
+    HandBackChecked,
+    /// Ablation (the paper's rule): `θ <= ε` hands back, whatever the habit does.
     Theta,
 }
 
@@ -235,7 +240,7 @@ pub enum RootStep {
 /// | `gate` | `gate_memory` | 20.0 | > 0 (`inf` allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
 /// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
 /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `none` is the paper's trigger) ([`GateBaseline`]) |
-/// | `gate` | `handback` | `risk-checked` | `risk-checked`, `theta` | a hand-back that test-time learning made goes to the habit only if the world model does not predict it crashes (beyond the paper; `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
+/// | `gate` | `handback` | `risk-checked` | `risk-checked`, `hand-back-checked`, `theta` | where test-time learning changed the trigger's verdict, the world model's crash-risk check of the habit decides whether the habit or reasoning acts (beyond the paper; `hand-back-checked` checks only the hand-backs learning made, `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
 /// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
 /// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |
 /// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
@@ -256,6 +261,7 @@ pub enum RootStep {
 /// | `learning` | `learning_rate` | 1.0 | finite and >= 0 | multiplies the expected counts added in §V |
 /// | `learning` | `nu0` ν0 | 10.0 | finite and > 0 | prior strength of ν = ν0 σ(Q/T) (docs/ARCHITECTURE.md §4.8) |
 /// | `learning` | `nu_temperature` T | 1.0 | finite and > 0 | temperature of ν's softmax over Q |
+/// | `learning` | `habit_memory` | `inf` | > 0 (`inf` allowed) | counts of reasoning a state of the habit keeps beyond its prior: each state's counts are rescaled to at most this many at the end of an episode (beyond the paper; [`crate::habit::Habit::bound_memory`]) |
 ///
 /// Where each range is enforced: numbers and enum values when set by name and by
 /// [`ScaledParams::check`]; the spelling of `gate_factor` and `persistence_ignores` (names
@@ -421,6 +427,10 @@ pub struct LearningParams {
     pub nu0: f64,
     /// T, temperature of the Q softmax that initialises ν.
     pub nu_temperature: f64,
+    /// Counts of reasoning each state of the habit keeps beyond its prior (bounded memory;
+    /// `inf`, written as the string `"inf"`, is unbounded).
+    #[serde(with = "f64_or_inf")]
+    pub habit_memory: f64,
 }
 
 impl Default for LearningParams {
@@ -430,11 +440,12 @@ impl Default for LearningParams {
             learning_rate: 1.0,
             nu0: 10.0,
             nu_temperature: 1.0,
+            habit_memory: f64::INFINITY,
         }
     }
 }
 
-/// `gate_memory`: a number, or `"inf"` (JSON has no infinity).
+/// `gate_memory` and `habit_memory`: a number, or `"inf"` (JSON has no infinity).
 mod f64_or_inf {
     use serde::{Deserialize, Deserializer, Serializer, de::Error};
 
@@ -525,7 +536,7 @@ pub const MAX_HORIZON: usize = 8;
 
 impl ScaledParams {
     /// Every numeric parameter's key, value and range (the table above).
-    pub fn bounds(&self) -> [(&'static str, f64, Bound); 17] {
+    pub fn bounds(&self) -> [(&'static str, f64, Bound); 18] {
         let (g, pe, pl, s, l) = (
             &self.gate,
             &self.perception,
@@ -584,6 +595,7 @@ impl ScaledParams {
             ("learning_rate", l.learning_rate, Bound::NonNegative),
             ("nu0", l.nu0, Bound::Positive),
             ("nu_temperature", l.nu_temperature, Bound::Positive),
+            ("habit_memory", l.habit_memory, Bound::PositiveOrInf),
         ]
     }
 

@@ -92,6 +92,9 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     hist_reasoned: Vec<bool>,
     /// Whether each tick reasoned because the hand-back check refused the habit.
     hist_refused: Vec<bool>,
+    /// Whether each tick's trigger fired only because of test-time learning and the habit
+    /// acted, the check finding it safe.
+    hist_declined: Vec<bool>,
     final_obs: Option<usize>,
     /// One-hot index of the last posterior, if it was one-hot.
     prev_one_hot: Option<usize>,
@@ -230,6 +233,7 @@ impl<H: Habit> ScaledAgent<H> {
             hist_surprise: Vec::with_capacity(256),
             hist_reasoned: Vec::with_capacity(256),
             hist_refused: Vec::with_capacity(256),
+            hist_declined: Vec::with_capacity(256),
             final_obs: None,
             prev_one_hot: None,
             last: ReasoningTrace::default(),
@@ -257,16 +261,11 @@ impl<H: Habit> ScaledAgent<H> {
         (th0 > self.params.gate.epsilon).then_some(th0)
     }
 
-    /// The hand-back check ([`crate::handback`]): on a tick that would hand control to the
-    /// habit (whose policy is in `self.pi`), `Some(θ_0)` (the trained trigger's `θ`) when the
-    /// hand-back is one that learning made and the world model predicts that holding the
-    /// habit's action for `handback_horizon` ticks enters a crash-risk state more likely, by
-    /// more than `handback_risk`, than holding the safest action would.
-    fn refuse_handback(&mut self) -> Option<f64> {
-        if self.params.gate.handback != HandBackRule::RiskChecked {
-            return None;
-        }
-        let th0 = self.trained_trigger_fires()?;
+    /// The crash-risk check of the habit ([`crate::handback`]), with the habit's policy in
+    /// `self.pi`: whether holding the habit's action for `handback_horizon` ticks is
+    /// predicted, under the learned model, to enter a crash-risk state more likely, by more
+    /// than `handback_risk`, than holding the safest action would.
+    fn habit_at_risk(&mut self) -> bool {
         let root = match self.params.planning.root_step {
             RootStep::Learned => self.model.generative(),
             RootStep::Absorbing => self.model.planning_generative(),
@@ -282,7 +281,44 @@ impl<H: Habit> ScaledAgent<H> {
         };
         let own = risk(habit);
         let safest = (0..self.n_actions).map(&mut risk).fold(f64::INFINITY, f64::min);
-        (own - safest > self.params.gate.handback_risk).then_some(th0)
+        own - safest > self.params.gate.handback_risk
+    }
+
+    /// The hand-back check: on a tick that would hand control to the habit (whose policy is
+    /// in `self.pi`), `Some(θ_0)` (the trained trigger's `θ`) when the hand-back is one that
+    /// learning made and the habit is at risk ([`ScaledAgent::habit_at_risk`]).
+    fn refuse_handback(&mut self) -> Option<f64> {
+        if self.params.gate.handback == HandBackRule::Theta {
+            return None;
+        }
+        let th0 = self.trained_trigger_fires()?;
+        self.habit_at_risk().then_some(th0)
+    }
+
+    /// The check of a reasoning tick that learning made: on a tick whose learned trigger
+    /// fires, `true` when the trained agent's trigger would have handed back and the habit
+    /// is not at risk, so the habit acts (with [`HandBackRule::RiskChecked`]). Leaves the
+    /// habit's policy in `self.pi` when it returns `true`.
+    fn decline_trigger(&mut self, obs: usize) -> bool {
+        if self.params.gate.handback != HandBackRule::RiskChecked
+            || !self.learned
+            || self.gate.is_none()
+            || self.trained_trigger_fires().is_some()
+        {
+            return false;
+        }
+        self.habit_policy(obs);
+        !self.habit_at_risk()
+    }
+
+    /// The habit's policy `π_o` for this tick into `self.pi`.
+    fn habit_policy(&mut self, obs: usize) {
+        let t = self.hist_obs.len();
+        if self.model.generative().a_identity {
+            self.habit.pi_o_state(t, obs, &mut self.pi);
+        } else {
+            self.habit.pi_o_belief(t, &self.q_cur, &mut self.pi);
+        }
     }
 
     /// The world model.
@@ -313,6 +349,12 @@ impl<H: Habit> ScaledAgent<H> {
     /// check refused to hand the state to the habit ([`crate::handback`]).
     pub fn refused_history(&self) -> &[bool] {
         &self.hist_refused
+    }
+    /// Whether each tick of the current (or last) episode went to the habit although the
+    /// learned trigger fired, because only test-time learning made it fire and the check
+    /// found the habit safe ([`HandBackRule::RiskChecked`]).
+    pub fn declined_history(&self) -> &[bool] {
+        &self.hist_declined
     }
     /// What the last reasoning tick computed.
     pub fn last_reasoning(&self) -> &ReasoningTrace {
@@ -444,6 +486,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
         self.hist_surprise.clear();
         self.hist_reasoned.clear();
         self.hist_refused.clear();
+        self.hist_declined.clear();
         self.final_obs = None;
         self.prev_one_hot = None;
         self.tree.invalidate();
@@ -485,16 +528,18 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             }
         };
         let th = theta(trigger, self.params.gate.omega);
-        let mut reasoned = self.params.scaling.reasoning == ReasoningMode::Always || th > self.params.gate.epsilon;
+        let always = self.params.scaling.reasoning == ReasoningMode::Always;
+        let mut reasoned = always || th > self.params.gate.epsilon;
+        // A reasoning tick that only learning made, where the habit is safe: the habit acts.
+        let declined = reasoned && !always && self.decline_trigger(obs);
+        reasoned &= !declined;
         let mut refused = false;
         let mut scaling_iters = 0;
         if reasoned {
             scaling_iters = self.reason(obs, th);
         } else {
-            if gm.a_identity {
-                self.habit.pi_o_state(t, obs, &mut self.pi);
-            } else {
-                self.habit.pi_o_belief(t, &self.q_cur, &mut self.pi);
+            if !declined {
+                self.habit_policy(obs);
             }
             // The safe hand-back: reason instead where the habit is predicted to crash,
             // scaling with the trained trigger's θ (the surprise learning removed).
@@ -514,6 +559,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
         self.hist_surprise.push(s);
         self.hist_reasoned.push(reasoned);
         self.hist_refused.push(refused);
+        self.hist_declined.push(declined);
         Decision {
             action,
             reasoned,
@@ -564,6 +610,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
                 learning::update_cpts(&mut self.model, qp, self.hist_act[k - 1], q, lr);
             }
         }
+        self.habit.bound_memory(self.params.learning.habit_memory);
         if let Some(gate) = &mut self.gate {
             // Each tick is attributed to its most likely state and that state's cell.
             let mut weight = vec![1.0; gate.n_cells()];

@@ -1,26 +1,30 @@
 //! Issue 20: test-time learning must never make the agent less safe. With several
-//! jaywalkers per episode at random times (maps/crowd.ron), the hand-back rule
-//! `θ <= ε` alone let learning make a pedestrian at (green, d = 2) familiar from the
-//! ticks the car waited there, and then handed the approach at speed, where the habit
-//! still sped up, to the habit (agent/src/handback.rs). On an agent trained as the CLI
-//! trains it (6000 episodes, seed 7), over continual episodes of that map: no episode the
-//! agent without learning survives is lost, and reasoning falls as it learns.
+//! jaywalkers per episode at random times (maps/crowd.ron), the hand-back rule `θ <= ε`
+//! alone let learning make a pedestrian at (green, d = 2) familiar from the ticks the car
+//! waited there, and then handed the approach at speed, where the habit still sped up, to
+//! the habit; and reasoning that only learning triggered, where the habit was safe, put
+//! the car at the crosswalk later, in front of the next walker (agent/src/handback.rs).
 //!
-//! Ignored by default: the full training takes minutes in a debug build. Run it with
-//! `cargo test --release --test it safety -- --ignored`. On the shared small test agent
-//! (600 training episodes) the claim does not hold (11 of 40 crowd episodes lost that the
-//! agent without learning survives; EXPERIMENTS.md, "The safe hand-back").
+//! On agents trained by the library's training (the shared test agent, 600 episodes of the
+//! embedded intersection; and, ignored in debug builds, the agent `unforeseen train --seed
+//! 7` writes), over continual episodes of that map: no episode the agent without learning
+//! survives is lost, and reasoning falls as it learns. Under the `hand-back-checked`
+//! ablation the shared test agent loses 11 of these 40 episodes (EXPERIMENTS.md, "The safe
+//! hand-back").
 
 use std::path::Path;
 use std::sync::OnceLock;
-use unforeseen::experiments::evaluate_under;
-use unforeseen::methods::Method;
+use unforeseen::experiments::{eval_seeds, evaluate_under};
+use unforeseen::methods::{Method, scaled_agent};
 use unforeseen::progress::NoProgress;
 use unforeseen::protocol::Protocol;
-use unforeseen::runner::EpisodeResult;
+use unforeseen::runner::{EpisodeResult, run_episode};
 use unforeseen::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
+use unforeseen_env::{Env, EnvConfig};
+
+use crate::common;
 
 /// The agent `unforeseen train --seed 7` writes.
 fn full_agent() -> &'static AgentBundle {
@@ -35,9 +39,12 @@ fn full_agent() -> &'static AgentBundle {
 
 const EPISODES: u64 = 40;
 
-fn run(method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<EpisodeResult> {
-    let map = unforeseen::maps::load_file(Path::new("maps/crowd.ron")).expect("maps/crowd.ron");
-    evaluate_under(protocol, &map, full_agent(), params, method, EPISODES, 7, &NoProgress).unwrap()
+fn crowd() -> unforeseen_sim::Map {
+    unforeseen::maps::load_file(Path::new("maps/crowd.ron")).expect("maps/crowd.ron")
+}
+
+fn run(bundle: &AgentBundle, method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<EpisodeResult> {
+    evaluate_under(protocol, &crowd(), bundle, params, method, EPISODES, 7, &NoProgress).unwrap()
 }
 
 /// Episodes the agent without learning survives and `learning` loses (both meet the same
@@ -48,12 +55,10 @@ fn lost(without: &[EpisodeResult], learning: &[EpisodeResult]) -> Vec<usize> {
         .collect()
 }
 
-#[test]
-#[ignore = "trains a full agent (6000 episodes); run with --release -- --ignored"]
-fn learning_loses_no_crowd_episode_that_the_agent_without_learning_survives() {
+fn check_learning_loses_nothing(bundle: &AgentBundle) {
     let params = ScaledParams::default();
-    let without = run(Method::ScaledNoLearning, Protocol::ZeroShot, &params);
-    let learning = run(Method::Scaled, Protocol::Continual, &params);
+    let without = run(bundle, Method::ScaledNoLearning, Protocol::ZeroShot, &params);
+    let learning = run(bundle, Method::Scaled, Protocol::Continual, &params);
     assert!(
         without.iter().filter(|r| r.success).count() as u64 >= EPISODES / 2,
         "the agent without learning should survive most of the crowd"
@@ -65,4 +70,58 @@ fn learning_loses_no_crowd_episode_that_the_agent_without_learning_survives() {
         2 * last <= first,
         "reasoning ticks, first 10 episodes {first}, last 10 {last}: should at least halve"
     );
+}
+
+#[test]
+fn learning_loses_no_crowd_episode_that_the_test_agent_without_learning_survives() {
+    check_learning_loses_nothing(common::bundle());
+}
+
+#[test]
+#[ignore = "trains a full agent (6000 episodes); run with --release -- --ignored"]
+fn learning_loses_no_crowd_episode_that_the_full_agent_without_learning_survives() {
+    check_learning_loses_nothing(full_agent());
+}
+
+/// Per episode of a continual run on the crowd: (reasoned, declined, θ) per tick.
+fn continual_ticks(handback: &str) -> Vec<Vec<(bool, bool, f64)>> {
+    let mut params = ScaledParams::default();
+    params.set_str("handback", handback).unwrap();
+    let map = crowd();
+    let mut agent = scaled_agent(common::bundle(), params).unwrap();
+    let mut env = Env::new(&map, EnvConfig::default()).unwrap();
+    (0..15)
+        .map(|ep| {
+            let (_, trace) = run_episode(&mut env, &mut agent, eval_seeds(7, &map, Method::Scaled, ep), true).unwrap();
+            let declined = agent.declined_history();
+            trace
+                .iter()
+                .map(|t| (t.reasoned, declined[t.step as usize], t.theta.unwrap()))
+                .collect()
+        })
+        .collect()
+}
+
+/// A tick the learned trigger fires on only because of test-time learning goes to the
+/// habit where the check finds the habit safe: such ticks exist once the agent has learned
+/// (never in the first episode), each has `θ > ε` and did not reason; the ablation
+/// `hand-back-checked` declines none.
+#[test]
+fn triggers_only_learning_made_go_to_a_safe_habit() {
+    let epsilon = ScaledParams::default().gate.epsilon;
+    let episodes = continual_ticks("risk-checked");
+    assert!(
+        episodes[0].iter().all(|(_, declined, _)| !declined),
+        "nothing learned yet"
+    );
+    let declined: Vec<_> = episodes.iter().flatten().filter(|(_, d, _)| *d).collect();
+    assert!(
+        !declined.is_empty(),
+        "the crowd makes the gate fire where the trained one would not"
+    );
+    for (reasoned, _, theta) in declined {
+        assert!(!reasoned && *theta > epsilon, "theta {theta}, reasoned {reasoned}");
+    }
+    let ablation = continual_ticks("hand-back-checked");
+    assert!(ablation.iter().flatten().all(|(_, d, _)| !d));
 }
