@@ -8,6 +8,13 @@
 //! protocol asked. Over training seeds, [`summarize`] gives each figure's mean, 95%
 //! interval, range and worst seed, and checks the maps' expectations on the mean.
 //!
+//! A scenario is a map or a deployment stream ([`ScenarioKind`], [`load_stream_scenario`]):
+//! a stream's unit runs its episodes over the stream's maps ([`evaluate_stream`]) and its
+//! line is a line like a map's (the figures over the whole stream) with the figures per
+//! map within the stream added ([`ResultLine::per_map`]); the summary follows the stream's
+//! row with one row per map, and [`stream_learning`] compares each map's figures under
+//! the two protocols.
+//!
 //! A results file starts with the [`RunIdentity`] of the run that wrote it (program
 //! version, agents, map contents, methods, parameter sets, protocols, training seeds,
 //! episodes, seed). `--resume` refuses a file of another run, saying what differs, and

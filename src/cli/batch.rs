@@ -1,5 +1,6 @@
-//! `unforeseen batch`: run scenario suites headless, with expectations, sweeps, shards,
-//! both protocols and training-seed studies.
+//! `unforeseen batch`: run scenario suites (maps, or one deployment stream with
+//! `--stream`) headless, with expectations, sweeps, shards, both protocols and
+//! training-seed studies.
 
 use clap::Args;
 use std::path::PathBuf;
