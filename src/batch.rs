@@ -8,6 +8,13 @@
 //! protocol asked. Over training seeds, [`summarize`] gives each figure's mean, 95%
 //! interval, range and worst seed, and checks the maps' expectations on the mean.
 //!
+//! A scenario is a map or a deployment stream ([`ScenarioKind`], [`load_stream_scenario`]):
+//! a stream's unit runs its episodes over the stream's maps ([`evaluate_stream`]) and its
+//! line is a line like a map's (the figures over the whole stream) with the figures per
+//! map within the stream added ([`ResultLine::per_map`]); the summary follows the stream's
+//! row with one row per map, and [`stream_learning`] compares each map's figures under
+//! the two protocols.
+//!
 //! A results file starts with the [`RunIdentity`] of the run that wrote it (program
 //! version, agents, map contents, methods, parameter sets, protocols, training seeds,
 //! episodes, seed). `--resume` refuses a file of another run, saying what differs, and
@@ -37,15 +44,80 @@ use crate::methods::Method;
 use crate::metrics::Aggregate;
 use crate::progress::{NoProgress, Progress};
 use crate::protocol::{Protocol, covered};
+use crate::runner::EpisodeResult;
 use crate::stats::Stat;
+use crate::stream::{Stream, evaluate_stream, per_map};
 
-/// A scenario of the suite: a map and where it came from.
+/// A scenario of the suite: a map or a deployment stream, and where it came from.
 #[derive(Debug, Clone)]
 pub struct Scenario {
-    /// The map.
-    pub map: Map,
+    /// What its units run on.
+    pub kind: ScenarioKind,
     /// File it was read from, or `embedded:NAME`.
     pub source: String,
+}
+
+/// What a scenario's units run on.
+#[derive(Debug, Clone)]
+pub enum ScenarioKind {
+    /// One map: every episode on it (boxed: a map is several times a stream's size).
+    Map(Box<Map>),
+    /// A deployment stream ([`crate::stream`]): each episode on the map the stream's order
+    /// gives it; the unit's line adds the figures per map within the stream
+    /// ([`ResultLine::per_map`]).
+    Stream(Stream),
+}
+
+impl Scenario {
+    /// A scenario of one map, read from `source`.
+    pub fn of_map(map: Map, source: impl Into<String>) -> Scenario {
+        Scenario {
+            kind: ScenarioKind::Map(Box::new(map)),
+            source: source.into(),
+        }
+    }
+
+    /// A scenario of a deployment stream, read from the stream file `source`.
+    pub fn of_stream(stream: Stream, source: impl Into<String>) -> Scenario {
+        Scenario {
+            kind: ScenarioKind::Stream(stream),
+            source: source.into(),
+        }
+    }
+
+    /// The scenario's name (the map's, or the stream's), which its result lines carry.
+    pub fn name(&self) -> &str {
+        match &self.kind {
+            ScenarioKind::Map(map) => &map.name,
+            ScenarioKind::Stream(stream) => &stream.name,
+        }
+    }
+
+    /// The map of a map scenario (None for a stream).
+    pub fn map(&self) -> Option<&Map> {
+        match &self.kind {
+            ScenarioKind::Map(map) => Some(map.as_ref()),
+            ScenarioKind::Stream(_) => None,
+        }
+    }
+
+    /// The map of a map scenario, to change (None for a stream).
+    pub fn map_mut(&mut self) -> Option<&mut Map> {
+        match &mut self.kind {
+            ScenarioKind::Map(map) => Some(map.as_mut()),
+            ScenarioKind::Stream(_) => None,
+        }
+    }
+
+    /// A hash of everything of the scenario that determines results: the map's full
+    /// contents (bases merged), or the stream's name, maps, weights and order.
+    fn content_hash(&self) -> String {
+        let text = match &self.kind {
+            ScenarioKind::Map(map) => serde_json::to_string(map),
+            ScenarioKind::Stream(s) => serde_json::to_string(&("stream", &s.name, &s.maps, s.order)),
+        };
+        crate::seeds::content_hash(text.unwrap_or_default().as_bytes())
+    }
 }
 
 /// One named set of parameter overrides of a sweep (`[]` = the defaults).
@@ -190,7 +262,7 @@ impl Unit {
     /// The unit's identity, as its result line's [`ResultLine::key`] gives it.
     pub fn key(&self, scenarios: &[Scenario]) -> UnitKey {
         (
-            scenarios[self.scenario].map.name.clone(),
+            scenarios[self.scenario].name().to_string(),
             self.method.name().to_string(),
             self.params.label(),
             self.protocol,
@@ -341,6 +413,63 @@ pub struct ResultLine {
     pub checks: Vec<Check>,
     /// Wall-clock µs per decision tick (the only field that varies between identical runs).
     pub timing_us_per_tick: f64,
+    /// For a stream scenario, the figures of each map within the stream that episodes ran
+    /// on, in the stream's order (the line's own figures are over the whole stream); left
+    /// out for a map scenario.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub per_map: Vec<MapFigures>,
+}
+
+/// The figures of one map within a stream unit: its episodes of the stream only.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapFigures {
+    /// The map's name.
+    pub map: String,
+    /// Episodes of the stream that ran on it (the same for every training seed and
+    /// protocol: the stream's order derives from the evaluation seed).
+    pub episodes: u64,
+    /// Mean return.
+    pub mean_reward: f64,
+    /// Success rate.
+    pub success_rate: f64,
+    /// Collision rate.
+    pub collision_rate: f64,
+    /// Time-out rate.
+    pub timeout_rate: f64,
+    /// Red-light violations per episode.
+    pub red_light_rate: f64,
+    /// Share of ticks that reasoned.
+    pub inference_rate: f64,
+    /// Reasoning compute in EFE mat-vecs per tick (as [`ResultLine::efe_matvecs_per_tick`]).
+    pub efe_matvecs_per_tick: f64,
+    /// Mean decision ticks per episode.
+    pub mean_ticks: f64,
+    /// Wall-clock µs per decision tick.
+    pub timing_us_per_tick: f64,
+}
+
+impl ResultLine {
+    /// The line of map `map` within this stream unit's line: its figures, episodes and
+    /// scenario (the map's name); no checks. None if no episode of the unit ran on it.
+    pub fn within_stream(&self, map: &str) -> Option<ResultLine> {
+        let f = self.per_map.iter().find(|f| f.map == map)?;
+        Some(ResultLine {
+            scenario: f.map.clone(),
+            episodes: f.episodes,
+            mean_reward: f.mean_reward,
+            success_rate: f.success_rate,
+            collision_rate: f.collision_rate,
+            timeout_rate: f.timeout_rate,
+            red_light_rate: f.red_light_rate,
+            inference_rate: f.inference_rate,
+            efe_matvecs_per_tick: f.efe_matvecs_per_tick,
+            mean_ticks: f.mean_ticks,
+            timing_us_per_tick: f.timing_us_per_tick,
+            checks: Vec::new(),
+            per_map: Vec::new(),
+            ..self.clone()
+        })
+    }
 }
 
 /// The identity of a unit, for `--resume`: (scenario, method, parameter set, protocol,
@@ -541,11 +670,12 @@ pub fn agent_file_identity(bundle: &AgentBundle) -> String {
 }
 
 /// Runs one unit: `episodes` episodes of its method on its scenario with its agent,
-/// under its protocol ([`evaluate_under`]: zero-shot episodes in parallel, each from a
-/// fresh controller; continual ones in order on one controller).
+/// under its protocol. A map: [`evaluate_under`] (zero-shot episodes in parallel, each
+/// from a fresh controller; continual ones in order on one controller). A stream:
+/// [`evaluate_stream`] (the same, over the stream's maps), and the line adds the figures
+/// per map within the stream ([`per_map`]).
 pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error> {
     let scenario = &cfg.scenarios[unit.scenario];
-    let map = &scenario.map;
     let agent = cfg
         .agents
         .iter()
@@ -554,23 +684,73 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error>
             train_seed: unit.train_seed,
         })?;
     let params = unit.params.scaled_params()?;
-    let results = evaluate_under(
-        unit.protocol,
-        map,
-        &agent.bundle,
-        &params,
-        unit.method,
-        cfg.episodes,
-        cfg.seed,
-        &NoProgress,
-    )?;
-    let agg = Aggregate::of(&results);
     let actions = Action::ALL.len();
     let tree: usize = (1..=params.planning.horizon).map(|k| actions.pow(k as u32)).sum();
-    let plans_by_efe = unit.method.is_scaled();
+    // Reasoning compute: the inference rate times the prefix tree, for the planner by EFE.
+    let efe = |agg: &Aggregate| {
+        if unit.method.is_scaled() {
+            agg.inference_rate * tree as f64
+        } else {
+            0.0
+        }
+    };
+    let (agg, per_map_figures) = match &scenario.kind {
+        ScenarioKind::Map(map) => {
+            let results = evaluate_under(
+                unit.protocol,
+                map,
+                &agent.bundle,
+                &params,
+                unit.method,
+                cfg.episodes,
+                cfg.seed,
+                &NoProgress,
+            )?;
+            (Aggregate::of(&results), Vec::new())
+        }
+        ScenarioKind::Stream(stream) => {
+            let episodes = evaluate_stream(
+                stream,
+                Some(&agent.bundle),
+                &params,
+                unit.method,
+                unit.protocol,
+                cfg.episodes,
+                cfg.seed,
+                &NoProgress,
+            )?;
+            let results: Vec<EpisodeResult> = episodes.iter().map(|e| e.result.clone()).collect();
+            let figures = per_map(stream, &episodes)
+                .into_iter()
+                .map(|row| {
+                    let a = &row.aggregate;
+                    MapFigures {
+                        efe_matvecs_per_tick: efe(a),
+                        map: row.map,
+                        episodes: a.episodes as u64,
+                        mean_reward: a.mean_reward,
+                        success_rate: a.success_rate,
+                        collision_rate: a.collision_rate,
+                        timeout_rate: a.timeout_rate,
+                        red_light_rate: a.red_light_rate,
+                        inference_rate: a.inference_rate,
+                        mean_ticks: a.mean_ticks,
+                        timing_us_per_tick: a.us_per_tick,
+                    }
+                })
+                .collect();
+            (Aggregate::of(&results), figures)
+        }
+    };
+    // A map's expectations describe the methods at their default parameters on that map
+    // alone: the other points of a sweep, and streams, are reported, not gated.
+    let checks = match scenario.map() {
+        Some(map) if unit.params.0.is_empty() => check_expectations(map, unit.method, &unit.covers, &agg),
+        _ => Vec::new(),
+    };
     Ok(ResultLine {
         unit: unit.index,
-        scenario: map.name.clone(),
+        scenario: scenario.name().to_string(),
         source: scenario.source.clone(),
         method: unit.method.name().into(),
         param_set: unit.params.label(),
@@ -587,20 +767,11 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error>
         timeout_rate: agg.timeout_rate,
         red_light_rate: agg.red_light_rate,
         inference_rate: agg.inference_rate,
-        efe_matvecs_per_tick: if plans_by_efe {
-            agg.inference_rate * tree as f64
-        } else {
-            0.0
-        },
+        efe_matvecs_per_tick: efe(&agg),
         mean_ticks: agg.mean_ticks,
-        // A map's expectations describe the methods at their default parameters: the
-        // other points of a sweep are reported, not gated.
-        checks: if unit.params.0.is_empty() {
-            check_expectations(map, unit.method, &unit.covers, &agg)
-        } else {
-            Vec::new()
-        },
+        checks,
         timing_us_per_tick: agg.us_per_tick,
+        per_map: per_map_figures,
     })
 }
 
@@ -616,7 +787,8 @@ pub struct RunIdentity {
     pub program: String,
     /// The agents: an agent file's content hash, or how they were trained.
     pub agents: String,
-    /// The scenarios in order: name and a hash of the map's full contents (bases merged).
+    /// The scenarios in order: name and a hash of the map's full contents (bases merged),
+    /// or of a stream's name, maps, weights and order.
     pub maps: Vec<(String, String)>,
     /// Methods in order.
     pub methods: Vec<String>,
@@ -654,10 +826,7 @@ impl RunIdentity {
             agents: agents.to_string(),
             maps: scenarios
                 .iter()
-                .map(|s| {
-                    let text = serde_json::to_string(&s.map).unwrap_or_default();
-                    (s.map.name.clone(), crate::seeds::content_hash(text.as_bytes()))
-                })
+                .map(|s| (s.name().to_string(), s.content_hash()))
                 .collect(),
             methods: methods.iter().map(|m| m.name().to_string()).collect(),
             param_sets: params.iter().map(ParamSet::label).collect(),
@@ -883,7 +1052,8 @@ pub const MAX_FIGURE: f64 = 1e9;
 /// What is wrong with result line `l` as the line of unit `u` of the run `identity`: a
 /// field of its own that is not this run's (seed, episodes, parameters,
 /// protocols covered), or a figure out of its range (rates in [0, 1]; others finite,
-/// non-negative where they count, at most [`MAX_FIGURE`] in magnitude).
+/// non-negative where they count, at most [`MAX_FIGURE`] in magnitude), its own or of a
+/// map within a stream (whose episodes must add up to the line's).
 pub(crate) fn line_problem(l: &ResultLine, u: &Unit, identity: &RunIdentity) -> Option<String> {
     if l.seed != identity.seed {
         return Some(format!("has seed {}, the run's header {}", l.seed, identity.seed));
@@ -903,31 +1073,53 @@ pub(crate) fn line_problem(l: &ResultLine, u: &Unit, identity: &RunIdentity) -> 
     if l.covers != u.covers {
         return Some(format!("covers {:?}, the unit covers {:?}", l.covers, u.covers));
     }
-    let rates = [
-        ("success_rate", l.success_rate),
-        ("collision_rate", l.collision_rate),
-        ("timeout_rate", l.timeout_rate),
-        ("inference_rate", l.inference_rate),
-    ];
-    for (name, x) in rates {
+    let own = figure_problem(
+        "",
+        [l.success_rate, l.collision_rate, l.timeout_rate, l.inference_rate],
+        [l.efe_matvecs_per_tick, l.mean_ticks, l.timing_us_per_tick],
+        l.mean_reward,
+    );
+    if own.is_some() {
+        return own;
+    }
+    if !l.per_map.is_empty() {
+        let total: u64 = l.per_map.iter().map(|f| f.episodes).sum();
+        if total != l.episodes {
+            return Some(format!(
+                "has per_map episodes adding up to {total}, the line's {}",
+                l.episodes
+            ));
+        }
+    }
+    l.per_map.iter().find_map(|f| {
+        figure_problem(
+            &format!("per_map {}: ", f.map),
+            [f.success_rate, f.collision_rate, f.timeout_rate, f.inference_rate],
+            [f.efe_matvecs_per_tick, f.mean_ticks, f.timing_us_per_tick],
+            f.mean_reward,
+        )
+    })
+}
+
+/// What is wrong with a line's (or one of its maps', `prefix`) figures: the rates
+/// (success, collision, time-out, inference) outside [0, 1], the counts (EFE mat-vecs,
+/// ticks, µs per tick) outside [0, [`MAX_FIGURE`]], or a return not finite within it.
+fn figure_problem(prefix: &str, rates: [f64; 4], counts: [f64; 3], reward: f64) -> Option<String> {
+    let rate_names = ["success_rate", "collision_rate", "timeout_rate", "inference_rate"];
+    for (name, x) in rate_names.into_iter().zip(rates) {
         if !(0.0..=1.0).contains(&x) {
-            return Some(format!("has {name} {x}, outside [0, 1]"));
+            return Some(format!("has {prefix}{name} {x}, outside [0, 1]"));
         }
     }
-    let counts = [
-        ("efe_matvecs_per_tick", l.efe_matvecs_per_tick),
-        ("mean_ticks", l.mean_ticks),
-        ("timing_us_per_tick", l.timing_us_per_tick),
-    ];
-    for (name, x) in counts {
+    let count_names = ["efe_matvecs_per_tick", "mean_ticks", "timing_us_per_tick"];
+    for (name, x) in count_names.into_iter().zip(counts) {
         if !(0.0..=MAX_FIGURE).contains(&x) {
-            return Some(format!("has {name} {x}, outside [0, {MAX_FIGURE:e}]"));
+            return Some(format!("has {prefix}{name} {x}, outside [0, {MAX_FIGURE:e}]"));
         }
     }
-    if !(l.mean_reward.is_finite() && l.mean_reward.abs() <= MAX_FIGURE) {
+    if !(reward.is_finite() && reward.abs() <= MAX_FIGURE) {
         return Some(format!(
-            "has mean_reward {}, not a finite return within ±{MAX_FIGURE:e}",
-            l.mean_reward
+            "has {prefix}mean_reward {reward}, not a finite return within ±{MAX_FIGURE:e}"
         ));
     }
     None
@@ -1029,11 +1221,16 @@ pub struct WorstLine {
     pub mean_reward: f64,
 }
 
-/// One (scenario, method, parameter set, protocol) summarized over its training seeds.
+/// One (scenario, method, parameter set, protocol) summarized over its training seeds, or
+/// one map within a stream scenario's (scenario, method, parameter set, protocol).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SummaryRow {
-    /// Scenario (map) name.
+    /// Scenario name: a map's, a stream's, or for a row within a stream its map's.
     pub scenario: String,
+    /// For a row of one map within a stream, the stream's name (the row summarizes that
+    /// map's episodes of the stream's units); left out otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stream: Option<String>,
     /// Map file or `embedded:NAME`.
     pub source: String,
     /// Method name.
@@ -1075,7 +1272,9 @@ pub struct SummaryRow {
 }
 
 /// Groups result lines by (scenario, method, parameter set, protocol), in order of first
-/// appearance, and summarizes each group over its training seeds.
+/// appearance, and summarizes each group over its training seeds; a stream scenario's row
+/// is followed by one row per map within the stream ([`ResultLine::within_stream`]), in
+/// the stream's order.
 pub fn summarize(lines: &[ResultLine]) -> Vec<SummaryRow> {
     let mut groups: Vec<Vec<&ResultLine>> = Vec::new();
     for l in lines {
@@ -1088,7 +1287,74 @@ pub fn summarize(lines: &[ResultLine]) -> Vec<SummaryRow> {
             None => groups.push(vec![l]),
         }
     }
-    groups.iter().map(|g| summary_row(g)).collect()
+    let mut rows = Vec::new();
+    for g in &groups {
+        rows.push(summary_row(g));
+        for f in &g[0].per_map {
+            let within: Vec<ResultLine> = g.iter().filter_map(|l| l.within_stream(&f.map)).collect();
+            let mut row = summary_row(&within.iter().collect::<Vec<_>>());
+            row.stream = Some(g[0].scenario.clone());
+            rows.push(row);
+        }
+    }
+    rows
+}
+
+/// What learning across episodes does to one map within a stream, for one method and
+/// parameter set: the map's figures under the continual protocol against zero-shot, on
+/// the same episodes of the stream, as means over training seeds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StreamLearning {
+    /// The stream's name.
+    pub stream: String,
+    /// The map within it.
+    pub map: String,
+    /// Method name.
+    pub method: String,
+    /// Parameter set label.
+    pub param_set: String,
+    /// Episodes of the stream on the map, per agent.
+    pub episodes: u64,
+    /// Mean success rate, zero-shot.
+    pub zero_shot_success: f64,
+    /// Mean success rate, continual.
+    pub continual_success: f64,
+    /// Mean return, zero-shot.
+    pub zero_shot_reward: f64,
+    /// Mean return, continual.
+    pub continual_reward: f64,
+    /// Whether learning made the map worse: a lower mean success rate continual than
+    /// zero-shot.
+    pub worse: bool,
+}
+
+/// For every map within a stream and every method that learns across episodes (a row
+/// per protocol), what learning does to it ([`StreamLearning`]), in the rows' order.
+/// Empty unless the rows hold a stream run under both protocols.
+pub fn stream_learning(rows: &[SummaryRow]) -> Vec<StreamLearning> {
+    let only = |r: &SummaryRow, p: Protocol| r.stream.is_some() && r.covers == [p];
+    rows.iter()
+        .filter(|z| only(z, Protocol::ZeroShot))
+        .filter_map(|z| {
+            let c = rows.iter().find(|c| {
+                only(c, Protocol::Continual)
+                    && (&c.stream, &c.scenario, &c.method, &c.param_set)
+                        == (&z.stream, &z.scenario, &z.method, &z.param_set)
+            })?;
+            Some(StreamLearning {
+                stream: z.stream.clone().unwrap_or_default(),
+                map: z.scenario.clone(),
+                method: z.method.clone(),
+                param_set: z.param_set.clone(),
+                episodes: z.episodes,
+                zero_shot_success: z.success_rate.mean,
+                continual_success: c.success_rate.mean,
+                zero_shot_reward: z.mean_reward.mean,
+                continual_reward: c.mean_reward.mean,
+                worse: c.success_rate.mean < z.success_rate.mean - 1e-12,
+            })
+        })
+        .collect()
 }
 
 /// Summarizes one group of lines (all of one configuration, one per seed).
@@ -1106,6 +1372,7 @@ fn summary_row(group: &[&ResultLine]) -> SummaryRow {
         .expect("groups are not empty");
     SummaryRow {
         scenario: first.scenario.clone(),
+        stream: None,
         source: first.source.clone(),
         method: first.method.clone(),
         param_set: first.param_set.clone(),
@@ -1177,9 +1444,9 @@ pub fn summary_path(out: &Path) -> PathBuf {
 pub fn load_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
     let scenarios = read_scenarios(paths)?;
     for (i, s) in scenarios.iter().enumerate() {
-        if let Some(first) = scenarios[..i].iter().find(|f| f.map.name == s.map.name) {
+        if let Some(first) = scenarios[..i].iter().find(|f| f.name() == s.name()) {
             return Err(Error::DuplicateScenario {
-                name: s.map.name.clone(),
+                name: s.name().to_string(),
                 first: first.source.clone(),
                 second: s.source.clone(),
             });
@@ -1194,10 +1461,10 @@ fn read_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
         return unforeseen_sim::embedded::names()
             .iter()
             .map(|n| {
-                Ok(Scenario {
-                    map: unforeseen_sim::embedded::load(n)?,
-                    source: format!("embedded:{n}"),
-                })
+                Ok(Scenario::of_map(
+                    unforeseen_sim::embedded::load(n)?,
+                    format!("embedded:{n}"),
+                ))
             })
             .collect();
     }
@@ -1217,23 +1484,20 @@ fn read_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
                 ));
             }
             for f in found {
-                scenarios.push(Scenario {
-                    map: crate::maps::load_file(&f)?,
-                    source: f.display().to_string(),
-                });
+                scenarios.push(Scenario::of_map(crate::maps::load_file(&f)?, f.display().to_string()));
             }
         } else if p.exists() {
-            scenarios.push(Scenario {
-                map: crate::maps::load_file(p)?,
-                source: p.display().to_string(),
-            });
+            scenarios.push(Scenario::of_map(crate::maps::load_file(p)?, p.display().to_string()));
         } else {
             let map = crate::maps::load(&p.to_string_lossy())?;
-            scenarios.push(Scenario {
-                source: format!("embedded:{}", map.name),
-                map,
-            });
+            let source = format!("embedded:{}", map.name);
+            scenarios.push(Scenario::of_map(map, source));
         }
     }
     Ok(scenarios)
+}
+
+/// The one scenario of a batch over the deployment stream in `file` ([`Stream::load`]).
+pub fn load_stream_scenario(file: &Path) -> Result<Scenario, Error> {
+    Ok(Scenario::of_stream(Stream::load(file)?, file.display().to_string()))
 }

@@ -92,6 +92,9 @@ pub enum Error {
     /// A map file that does not validate (every diagnostic).
     #[error(transparent)]
     MapFile(#[from] unforeseen_sim::MapError),
+    /// A deployment stream file that cannot be used (its place and what to change).
+    #[error(transparent)]
+    Stream(#[from] StreamError),
     /// A file or folder could not be read, written, created or listed.
     #[error("cannot {action} {}", path.display())]
     Io {
@@ -156,7 +159,8 @@ impl Error {
             | Error::ModelFile { .. }
             | Error::MapsFailed { .. }
             | Error::Map(_)
-            | Error::MapFile(_) => true,
+            | Error::MapFile(_)
+            | Error::Stream(_) => true,
             Error::Io { .. }
             | Error::Env(_)
             | Error::Episode(_)
@@ -217,4 +221,52 @@ pub enum MapLookupError {
     /// The file or embedded map did not validate (its diagnostics, printed once).
     #[error(transparent)]
     Invalid(#[from] unforeseen_sim::MapError),
+}
+
+/// A stream file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamError {
+    /// Unreadable, too large or not UTF-8.
+    #[error("{file}: {message}")]
+    Read {
+        /// The stream file.
+        file: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// Not valid RON for a stream.
+    #[error(
+        "{file}:{line}:{column}: {message} (a stream is Stream(maps: [(map: \"FILE\", weight: W), ...], order: Weighted | Sequence))"
+    )]
+    Syntax {
+        /// The stream file.
+        file: String,
+        /// Line, from 1.
+        line: usize,
+        /// Column, from 1.
+        column: usize,
+        /// What the parser said.
+        message: String,
+    },
+    /// A field with a value that cannot be used.
+    #[error("{file}: {field}: {message}")]
+    Invalid {
+        /// The stream file.
+        file: String,
+        /// The field, e.g. `maps[1].weight`.
+        field: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+    /// A map of the stream could not be loaded.
+    #[error("{file}: maps[{index}] (a map file relative to the stream file's folder, or an embedded map's name)")]
+    Map {
+        /// The stream file.
+        file: String,
+        /// The entry.
+        index: usize,
+        /// Why the map could not be loaded.
+        #[source]
+        source: MapLookupError,
+    },
 }

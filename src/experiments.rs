@@ -222,6 +222,9 @@ pub fn trace(
 pub struct LearnPoint {
     /// Episode index (0 = first encounter).
     pub episode: u64,
+    /// The map the episode ran on (one map for a map's curve; the stream's draw for a
+    /// stream's, [`crate::stream::learn_stream`]).
+    pub map: String,
     /// The gate's surprise in bits on the first tick of the episode with a pedestrian on
     /// the crosswalk under a green light (Fig. 9a; None if that never happened).
     pub event_surprise_bits: Option<f64>,
@@ -253,23 +256,41 @@ pub fn learn(
     seed: u64,
     progress: &dyn Progress,
 ) -> Result<Vec<LearnPoint>, Error> {
-    let mut env = Env::new(map, EnvConfig::default())?;
-    let disc = env.discretizer().clone();
-    check_compatible(bundle, map)?;
+    learn_over(bundle, params, &[map], &vec![0; episodes as usize], seed, progress)
+}
+
+/// [`learn`] over several maps: one scaled agent learning across the episodes in order,
+/// episode `k` on `maps[schedule[k]]` with the seeds of episode `k` of that map
+/// ([`eval_seeds`]). The event state of Fig. 9c is the first one met on any map.
+pub fn learn_over(
+    bundle: &AgentBundle,
+    params: &ScaledParams,
+    maps: &[&Map],
+    schedule: &[usize],
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<Vec<LearnPoint>, Error> {
+    let mut envs = Vec::with_capacity(maps.len());
+    for map in maps {
+        check_compatible(bundle, map)?;
+        envs.push(Env::new(map, EnvConfig::default())?);
+    }
+    let discs: Vec<Discretizer> = envs.iter().map(|e| e.discretizer().clone()).collect();
     let mut agent = crate::methods::scaled_agent(bundle, {
         let mut p = params.clone();
         p.learning.enabled = true;
         p
     })?;
-    progress.phase("learning", episodes);
+    progress.phase("learning", schedule.len() as u64);
     let mut event_state: Option<usize> = None;
     let mut points = Vec::new();
     let slow = Action::SlowDown.index();
-    for ep in 0..episodes {
+    for (ep, &m) in schedule.iter().enumerate() {
+        let (map, env, disc) = (maps[m], &mut envs[m], &discs[m]);
         let p_pedestrian_green_d2 = pedestrian_on_green_d2(&agent);
         let p_stay_green_d2 = agent.model().cpt_prob(3, 1, &[1, 1, 2], None);
         let before = agent.nu().to_vec();
-        let (result, ticks) = run_episode(&mut env, &mut agent, eval_seeds(seed, map, Method::Scaled, ep), true)?;
+        let (result, ticks) = run_episode(env, &mut agent, eval_seeds(seed, map, Method::Scaled, ep as u64), true)?;
         if event_state.is_none() {
             event_state = ticks
                 .iter()
@@ -286,7 +307,8 @@ pub fn learn(
         });
         let row = &before[es * Action::ALL.len()..(es + 1) * Action::ALL.len()];
         points.push(LearnPoint {
-            episode: ep,
+            episode: ep as u64,
+            map: map.name.clone(),
             event_surprise_bits: result.jaywalk_surprise.map(|s| s / std::f64::consts::LN_2),
             p_pedestrian_green_d2,
             p_stay_green_d2,

@@ -16,8 +16,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use crate::batch::{
-    KeptLine, ParamSet, ResultLine, RunIdentity, SummaryRow, Unit, UnitKey, line_problem, read_results, summarize,
-    summary_path, units,
+    KeptLine, ParamSet, ResultLine, RunIdentity, SummaryRow, Unit, UnitKey, line_problem, read_results,
+    stream_learning, summarize, summary_path, units,
 };
 use crate::error::Error;
 use crate::methods::Method;
@@ -280,7 +280,9 @@ pub fn merge(parts: &[PathBuf]) -> Result<Merged, Error> {
 }
 
 /// The summary file of a run's results (as `unforeseen batch` writes it beside
-/// `results`): the rows over training seeds and the expectations checked on their means.
+/// `results`): the rows over training seeds and the expectations checked on their means,
+/// and for a stream run under both protocols what learning does to each map within it
+/// (`learning`, [`stream_learning`]; left out otherwise).
 pub fn summary_document(
     results: &Path,
     shard: Option<&str>,
@@ -289,7 +291,7 @@ pub fn summary_document(
 ) -> serde_json::Value {
     let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
     let failed: usize = rows.iter().map(|r| r.checks.iter().filter(|c| !c.pass).count()).sum();
-    serde_json::json!({
+    let mut doc = serde_json::json!({
         "schema": 1,
         "results": results.display().to_string(),
         "shard": shard,
@@ -297,7 +299,12 @@ pub fn summary_document(
         "checked": checked,
         "failed": failed,
         "rows": rows,
-    })
+    });
+    let learning = stream_learning(rows);
+    if !learning.is_empty() {
+        doc["learning"] = serde_json::json!(learning);
+    }
+    doc
 }
 
 /// Writes the merged results to `out` (the identity, then every line in canonical order)

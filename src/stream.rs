@@ -17,13 +17,20 @@
 //!
 //! A map is a file relative to the stream file, else an embedded map by name. Episode `k`
 //! of the stream runs on the map the order gives it, with the world seed of episode `k` of
-//! that map ([`crate::experiments::eval_seeds`]); results are reported per map within the
-//! stream. Syntax errors name the file, line and column; semantic ones the file and field.
+//! that map ([`crate::experiments::eval_seeds`]); the order draws from the evaluation seed
+//! alone, so every method, protocol and agent meets the same maps in the same order.
+//! Results are reported per map within the stream ([`per_map`]). Syntax errors name the
+//! file, line and column; semantic ones the file and field ([`StreamError`]).
+//!
+//! [`evaluate_stream`] runs a method over a stream (`eval --stream`, and a stream unit of
+//! `batch --stream`: [`crate::batch::ScenarioKind::Stream`]); [`learn_stream`] gives the
+//! test-time learning curves over one (`learn --stream`).
 
 use std::path::{Path, PathBuf};
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::ScaledParams;
@@ -32,7 +39,7 @@ use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::Map;
 
 use crate::agent_file::check_compatible;
-use crate::experiments::eval_seeds;
+use crate::experiments::{LearnPoint, eval_seeds, learn_over};
 use crate::methods::Method;
 use crate::metrics::Aggregate;
 use crate::progress::Progress;
@@ -94,53 +101,7 @@ pub struct Stream {
     pub order: Order,
 }
 
-/// A stream file that cannot be used.
-#[derive(Debug, thiserror::Error)]
-pub enum StreamError {
-    /// Unreadable, too large or not UTF-8.
-    #[error("{file}: {message}")]
-    Read {
-        /// The stream file.
-        file: String,
-        /// What went wrong.
-        message: String,
-    },
-    /// Not valid RON for a stream.
-    #[error(
-        "{file}:{line}:{column}: {message} (a stream is Stream(maps: [(map: \"FILE\", weight: W), ...], order: Weighted | Sequence))"
-    )]
-    Syntax {
-        /// The stream file.
-        file: String,
-        /// Line, from 1.
-        line: usize,
-        /// Column, from 1.
-        column: usize,
-        /// What the parser said.
-        message: String,
-    },
-    /// A field with a value that cannot be used.
-    #[error("{file}: {field}: {message}")]
-    Invalid {
-        /// The stream file.
-        file: String,
-        /// The field, e.g. `maps[1].weight`.
-        field: String,
-        /// What is wrong and how to fix it.
-        message: String,
-    },
-    /// A map of the stream could not be loaded.
-    #[error("{file}: maps[{index}]: {source}")]
-    Map {
-        /// The stream file.
-        file: String,
-        /// The entry.
-        index: usize,
-        /// Why the map could not be loaded.
-        #[source]
-        source: crate::error::MapLookupError,
-    },
-}
+pub use crate::error::StreamError;
 
 impl Stream {
     /// Loads and checks a stream file (module docs).
@@ -280,8 +241,11 @@ pub struct StreamRow {
 }
 
 /// Runs `episodes` episodes of the stream with `method` under `protocol`: zero-shot, each
-/// episode from the trained agent; continual, one controller learning across the stream in
-/// order. Episode `k` on map `m` uses the world seed of episode `k` of `m`.
+/// episode from the trained agent (episodes in parallel, rayon); continual, one controller
+/// learning across the stream in order. Episode `k` on map `m` uses the world seed of
+/// episode `k` of `m`, so results do not depend on the number of threads. Without a
+/// `bundle`, `method` is a scripted reference. Advances `progress` by one per episode
+/// (the caller announces and finishes the phase).
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate_stream(
     stream: &Stream,
@@ -293,14 +257,13 @@ pub fn evaluate_stream(
     seed: u64,
     progress: &dyn Progress,
 ) -> Result<Vec<StreamEpisode>, crate::error::Error> {
-    let mut envs = Vec::with_capacity(stream.maps.len());
-    for (map, _) in &stream.maps {
+    let new_env = |m: usize| Env::new(&stream.maps[m].0, EnvConfig::default());
+    for (m, (map, _)) in stream.maps.iter().enumerate() {
         if let Some(b) = bundle {
             check_compatible(b, map)?;
         }
-        envs.push(Env::new(map, EnvConfig::default())?);
+        new_env(m)?;
     }
-    let first = &stream.maps[0].0;
     let make = |map: &Map| -> Result<Box<dyn Controller>, crate::error::Error> {
         match bundle {
             Some(b) => method.controller_for(b, params, map),
@@ -314,28 +277,46 @@ pub fn evaluate_stream(
             }
         }
     };
-    let continual = bundle.is_some() && protocol.effective(method, params) == Protocol::Continual;
-    let mut shared = if continual { Some(make(first)?) } else { None };
-    let mut out = Vec::with_capacity(episodes as usize);
-    for (k, m) in stream.schedule(episodes, seed).into_iter().enumerate() {
+    let run = |env: &mut Env,
+               controller: &mut dyn Controller,
+               k: usize,
+               m: usize|
+     -> Result<StreamEpisode, crate::error::Error> {
         let map = &stream.maps[m].0;
-        let mut fresh;
-        let controller: &mut dyn Controller = match &mut shared {
-            Some(c) => c.as_mut(),
-            None => {
-                fresh = make(map)?;
-                fresh.as_mut()
-            }
-        };
-        let result = run_episode(&mut envs[m], controller, eval_seeds(seed, map, method, k as u64), false)?.0;
-        out.push(StreamEpisode {
+        let result = run_episode(env, controller, eval_seeds(seed, map, method, k as u64), false)?.0;
+        progress.advance(1);
+        Ok(StreamEpisode {
             episode: k as u64,
             map: map.name.clone(),
             result,
-        });
-        progress.advance(1);
+        })
+    };
+    let schedule = stream.schedule(episodes, seed);
+    let continual = bundle.is_some() && protocol.effective(method, params) == Protocol::Continual;
+    if continual {
+        let mut controller = make(&stream.maps[0].0)?;
+        let mut envs = (0..stream.maps.len()).map(new_env).collect::<Result<Vec<_>, _>>()?;
+        return schedule
+            .iter()
+            .enumerate()
+            .map(|(k, &m)| run(&mut envs[m], controller.as_mut(), k, m))
+            .collect();
     }
-    Ok(out)
+    // Zero-shot: independent episodes, each worker building the envs of the maps it meets.
+    schedule
+        .par_iter()
+        .enumerate()
+        .map_init(
+            || -> Vec<Option<Env>> { (0..stream.maps.len()).map(|_| None).collect() },
+            |envs, (k, &m)| {
+                if envs[m].is_none() {
+                    envs[m] = Some(new_env(m)?);
+                }
+                let env = envs[m].as_mut().expect("built above");
+                run(env, make(&stream.maps[m].0)?.as_mut(), k, m)
+            },
+        )
+        .collect()
 }
 
 /// The figures per map of a stream run, in the stream's order (maps no episode drew are left out).
@@ -355,6 +336,21 @@ pub fn per_map(stream: &Stream, episodes: &[StreamEpisode]) -> Vec<StreamRow> {
             })
         })
         .collect()
+}
+
+/// The test-time learning curves of the scaled agent over `episodes` episodes of the
+/// stream ([`crate::experiments::learn_over`] on the stream's schedule): one agent
+/// learning across the stream in order, each point naming its map.
+pub fn learn_stream(
+    stream: &Stream,
+    bundle: &AgentBundle,
+    params: &ScaledParams,
+    episodes: u64,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<Vec<LearnPoint>, crate::error::Error> {
+    let maps: Vec<&Map> = stream.maps.iter().map(|(m, _)| m).collect();
+    learn_over(bundle, params, &maps, &stream.schedule(episodes, seed), seed, progress)
 }
 
 #[cfg(test)]

@@ -263,10 +263,7 @@ fn run_units(
         } else {
             unforeseen::maps::load_file(Path::new(place)).map_err(errors::to_py)?
         };
-        scenarios.push(Scenario {
-            map,
-            source: source.clone(),
-        });
+        scenarios.push(Scenario::of_map(map, source.clone()));
     }
     let names: Vec<String> = from(&spec, "methods")?;
     let methods: Vec<Method> = names.iter().map(|n| method(n)).collect::<PyResult<_>>()?;

@@ -1,5 +1,6 @@
-//! `unforeseen batch`: run scenario suites headless, with expectations, sweeps, shards,
-//! both protocols and training-seed studies.
+//! `unforeseen batch`: run scenario suites (maps, or one deployment stream with
+//! `--stream`) headless, with expectations, sweeps, shards, both protocols and
+//! training-seed studies.
 
 use clap::Args;
 use std::path::PathBuf;
@@ -10,10 +11,12 @@ use super::table::{cell, print_grid, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use crate::agents::Agent;
 use crate::batch::{
-    BatchConfig, DEFAULT_METHODS, ResultLine, Scenario, Shard, SummaryRow, agent_file_identity, checked_sweep,
-    load_scenarios, run_plan, summarize, summary_path, trained_agents_identity,
+    BatchConfig, DEFAULT_METHODS, ResultLine, Scenario, ScenarioKind, Shard, SummaryRow, agent_file_identity,
+    checked_sweep, load_scenarios, load_stream_scenario, run_plan, stream_learning, summarize, summary_path,
+    trained_agents_identity,
 };
 use crate::maps;
+use crate::merge::summary_document;
 use crate::methods::Method;
 use crate::report::write_json;
 use crate::survivability::{Witness, warnings};
@@ -25,6 +28,12 @@ pub struct BatchArgs {
     /// Map files or folders of maps (every *.ron); default: the embedded maps.
     #[arg(value_name = "MAP|DIR")]
     pub maps: Vec<PathBuf>,
+    /// A deployment stream (a RON file listing maps with weights or a sequence; see
+    /// `src/stream.rs` and `maps/streams/`) as the one scenario, instead of maps: each
+    /// unit runs `--episodes` episodes over the stream's maps, and its line and the
+    /// summary report per map within the stream.
+    #[arg(long, value_name = "FILE", conflicts_with = "maps")]
+    pub stream: Option<PathBuf>,
     /// Episodes per (scenario, method, parameter set, protocol, training seed).
     #[arg(long, default_value_t = 100, value_parser = super::episodes)]
     pub episodes: u64,
@@ -96,7 +105,10 @@ fn default_jobs() -> usize {
 
 /// Runs `batch`; fails (exit 1) when any expectation fails on the mean over seeds.
 pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
-    let scenarios = load_scenarios(&args.maps)?;
+    let scenarios = match &args.stream {
+        Some(file) => vec![load_stream_scenario(file)?],
+        None => load_scenarios(&args.maps)?,
+    };
     let summary = summary_path(&args.out);
     check_out(&args, &scenarios, &summary)?;
     let methods = if args.methods.is_empty() {
@@ -171,11 +183,16 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         jobs: memory_bound_jobs(args.jobs, states),
         ..planning
     };
+    let what = match &scenarios[0].kind {
+        ScenarioKind::Stream(stream) if scenarios.len() == 1 => {
+            format!("the stream '{}' ({} maps)", stream.name, stream.maps.len())
+        }
+        _ => format!("{} scenario(s)", scenarios.len()),
+    };
     progress::phase(
         args.quiet,
         format_args!(
-            "running {} scenario(s) x {} method(s) x {} parameter set(s) x {} protocol(s) x {} agent(s) on {} thread(s), {} episodes each, into {}",
-            scenarios.len(),
+            "running {what} x {} method(s) x {} parameter set(s) x {} protocol(s) x {} agent(s) on {} thread(s), {} episodes each, into {}",
             methods.len(),
             params.len(),
             protocols.len(),
@@ -206,17 +223,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     }
     let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
     let failures = failures(&rows);
+    let shard = args.shard.map(|s| format!("{}/{}", s.index, s.count));
     write_json(
         &summary,
-        &serde_json::json!({
-            "schema": 1,
-            "results": args.out.display().to_string(),
-            "shard": args.shard.map(|s| format!("{}/{}", s.index, s.count)),
-            "run": plan.identity,
-            "checked": checked,
-            "failed": failures.len(),
-            "rows": rows,
-        }),
+        &summary_document(&args.out, shard.as_deref(), &plan.identity, &rows),
     )?;
     outln!(
         "wrote {} ({} lines) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
@@ -279,7 +289,13 @@ fn check_out(args: &BatchArgs, scenarios: &[Scenario], summary: &std::path::Path
     outputs::file("--out", &args.out)?;
     outputs::file("--out (its summary)", summary)?;
     let mut inputs: Vec<(&str, &std::path::Path)> = args.agent.iter().map(|p| ("--agent", p.as_path())).collect();
-    inputs.extend(scenarios.iter().map(|s| ("MAP", std::path::Path::new(&s.source))));
+    inputs.extend(scenarios.iter().map(|s| {
+        let flag = match s.kind {
+            ScenarioKind::Map(_) => "MAP",
+            ScenarioKind::Stream(_) => "--stream",
+        };
+        (flag, std::path::Path::new(&s.source))
+    }));
     outputs::not_an_input("--out", &args.out, &inputs)?;
     outputs::not_an_input("--out (its summary)", summary, &inputs)?;
     if !args.force && !args.resume {
@@ -331,35 +347,36 @@ fn lock_results(out: &std::path::Path) -> anyhow::Result<std::fs::File> {
     }
 }
 
-/// Prints one row per (scenario, method, parameters, protocol) over its training seeds.
+/// Prints one row per (scenario, method, parameters, protocol) over its training seeds
+/// (a stream's row followed by one per map within it, `STREAM/MAP`, with its episodes),
+/// then, for a stream run under both protocols, what learning does to each map within
+/// it, warning on stderr about each map it makes worse.
 pub(super) fn print_summary(rows: &[SummaryRow]) {
     let many = rows.iter().any(|r| r.train_seeds.len() > 1);
-    let mut grid = vec![
-        [
-            "scenario",
-            "method",
-            "parameters",
-            "protocol",
-            "seeds",
-            "success",
-            "collision",
-            "red light",
-            "reward",
-            "inference",
-            "worst seed",
-        ]
-        .map(String::from)
-        .to_vec(),
-    ];
+    let streams = rows.iter().any(|r| r.stream.is_some());
+    let mut head = vec!["scenario", "method", "parameters", "protocol", "seeds"];
+    if streams {
+        head.push("episodes");
+    }
+    head.extend(["success", "collision", "red light", "reward", "inference", "worst seed"]);
+    let mut grid = vec![head.into_iter().map(String::from).collect::<Vec<_>>()];
     for r in rows {
         let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
         let w = &r.worst_seed;
-        grid.push(vec![
-            r.scenario.clone(),
+        let mut row = vec![
+            match &r.stream {
+                Some(stream) => format!("{stream}/{}", r.scenario),
+                None => r.scenario.clone(),
+            },
             r.method.clone(),
             r.param_set.clone(),
             protocols.join("+"),
             r.train_seeds.len().to_string(),
+        ];
+        if streams {
+            row.push(r.episodes.to_string());
+        }
+        row.extend([
             cell(&r.success_rate, 1, true),
             cell(&r.collision_rate, 1, true),
             cell(&r.red_light_rate, 1, true),
@@ -367,11 +384,60 @@ pub(super) fn print_summary(rows: &[SummaryRow]) {
             cell(&r.inference_rate, 1, true),
             format!("{} ({:.0}%)", seed_text(w.train_seed), 100.0 * w.success_rate),
         ]);
+        grid.push(row);
     }
     if many {
         outln!("each figure: mean ± half-width of the 95% interval over training seeds (Student t)");
     }
     print_grid(&grid);
+    let learning = stream_learning(rows);
+    if learning.is_empty() {
+        return;
+    }
+    outln!(
+        "learning within the stream, per map: continual against zero-shot on the same episodes (means over training seeds)"
+    );
+    let mut grid = vec![
+        [
+            "map",
+            "method",
+            "parameters",
+            "episodes",
+            "success zero-shot",
+            "continual",
+            "reward zero-shot",
+            "continual",
+            "",
+        ]
+        .map(String::from)
+        .to_vec(),
+    ];
+    for l in &learning {
+        grid.push(vec![
+            format!("{}/{}", l.stream, l.map),
+            l.method.clone(),
+            l.param_set.clone(),
+            l.episodes.to_string(),
+            format!("{:.1}%", 100.0 * l.zero_shot_success),
+            format!("{:.1}%", 100.0 * l.continual_success),
+            format!("{:.2}", l.zero_shot_reward),
+            format!("{:.2}", l.continual_reward),
+            if l.worse { "worse".into() } else { String::new() },
+        ]);
+    }
+    print_grid(&grid);
+    for l in learning.iter().filter(|l| l.worse) {
+        errln!(
+            "warning: stream '{}': learning makes map '{}' worse for {} [{}]: success {:.1}% continual, {:.1}% zero-shot over its {} episodes",
+            l.stream,
+            l.map,
+            l.method,
+            l.param_set,
+            100.0 * l.continual_success,
+            100.0 * l.zero_shot_success,
+            l.episodes
+        );
+    }
 }
 
 /// One message per expectation that fails on the mean, naming the worst seed.
@@ -409,7 +475,8 @@ pub(super) fn failures(rows: &[SummaryRow]) -> Vec<String> {
 
 /// The survivability warnings of `check-map`, from the brake-on-pedestrian and
 /// never-brake units that ran (scripted methods ignore parameter sets, protocols and
-/// training seeds, so the first line of each is taken), for scenarios with pedestrian rules.
+/// training seeds, so the first line of each is taken), for map scenarios with pedestrian
+/// rules.
 fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<String> {
     let witness = |scenario: &str, method: Method| {
         lines
@@ -424,9 +491,10 @@ fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<S
     };
     scenarios
         .iter()
-        .filter(|s| !s.map.pedestrians.is_empty())
-        .flat_map(|s| {
-            let name = &s.map.name;
+        .filter_map(|s| s.map().map(|map| (s, map)))
+        .filter(|(_, map)| !map.pedestrians.is_empty())
+        .flat_map(|(s, map)| {
+            let name = &map.name;
             warnings(
                 name,
                 witness(name, Method::BrakeOnPedestrian).as_ref(),

@@ -38,7 +38,7 @@ pub struct EvalArgs {
     /// A deployment stream (a RON file listing maps with weights or a sequence; see
     /// `src/stream.rs` and `maps/streams/`): run the episodes over its maps instead of
     /// `--map`, and report per map within the stream.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with = "map")]
     pub stream: Option<PathBuf>,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]

@@ -163,6 +163,7 @@ pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
             .downcast_ref::<crate::error::Error>()
             .is_some_and(crate::error::Error::is_user_input)
             || e.is::<crate::maps::MapLookupError>()
+            || e.is::<crate::error::StreamError>()
             || e.is::<unforeseen_sim::MapError>();
         if bad_input {
             return 2;

@@ -738,6 +738,7 @@ fn result_line(
         mean_ticks: agg.mean_ticks,
         checks: Vec::new(),
         timing_us_per_tick: agg.us_per_tick,
+        per_map: Vec::new(),
     }
 }
 

@@ -129,7 +129,7 @@ fn resume_after_a_truncated_file_completes_the_set_without_duplicates() {
 fn expectations_pass_and_fail_as_declared() {
     let mut scenarios = scenarios();
     scenarios.truncate(1); // jaywalk
-    let map = &mut scenarios[0].map;
+    let map = scenarios[0].map_mut().unwrap();
     use unforeseen_sim::Expectation;
     let none = Expectation {
         method: "QLearning".into(),
@@ -200,7 +200,7 @@ fn expectations_pass_and_fail_as_declared() {
     // In a sweep, expectations gate the default parameters only: a scaled expectation no
     // point of `horizon=1,2` could meet is reported on neither, and q-learning (not swept)
     // is still checked once.
-    scenarios[0].map.expect = vec![
+    scenarios[0].map_mut().unwrap().expect = vec![
         Expectation {
             method: "Scaled".into(),
             min_success: Some(1.1),
@@ -337,7 +337,7 @@ fn resume_refuses_another_runs_file_and_keeps_its_own_byte_for_byte() {
         "maps",
     );
     let mut edited = scenarios.clone();
-    edited[0].map.reward.goal += 1.0;
+    edited[0].map_mut().unwrap().reward.goal += 1.0;
     refused(
         BatchConfig {
             scenarios: &edited,

@@ -23,5 +23,6 @@ mod replay;
 mod robustness;
 mod safety;
 mod search;
+mod stream;
 mod svg_text;
 mod train_seeds;
