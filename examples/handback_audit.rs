@@ -2,7 +2,7 @@
 //! "The safe hand-back"): reasoning ticks with and without a pedestrian on the crosswalk,
 //! ticks the hand-back check refused, learned triggers it declined, reasoning per block of 50 episodes, and what drifts:
 //! the gate's table `P(p = 1 | L, d)`, the habit's total counts `Σ ν` and its largest
-//! state's `Σ_u ν[s, u]`, every 50 episodes.
+//! state's `Σ_u ν[s, u]`, and the largest off-diagonal `P(o | s)` of `A`, every 50 episodes.
 //!
 //! ```sh
 //! cargo build --release --example handback_audit
@@ -50,7 +50,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             })
             .unwrap_or_default();
         serde_json::json!({"episode": episode, "p_pedestrian_by_L_d": table, "nu_total": agent.nu().iter().sum::<f64>(),
-            "nu_largest_state": agent.nu().chunks(3).map(|r| r.iter().sum::<f64>()).fold(0.0, f64::max)})
+            "nu_largest_state": agent.nu().chunks(3).map(|r| r.iter().sum::<f64>()).fold(0.0, f64::max),
+            "a_largest_off_diagonal": largest_off_diagonal(agent.model().generative())})
     };
     for ep in 0..episodes {
         if ep % 50 == 0 {
@@ -86,4 +87,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
     );
     Ok(())
+}
+
+/// The largest `P(o | s)` with `o != s`: 0 for an exact observation model.
+fn largest_off_diagonal(gm: &unforeseen_agent::model::GenerativeModel) -> f64 {
+    let a = &gm.a;
+    let mut largest = 0.0f64;
+    for s in 0..a.ncols() {
+        for o in (0..a.nrows()).filter(|&o| o != s) {
+            largest = largest.max(a[(o, s)]);
+        }
+    }
+    largest
 }

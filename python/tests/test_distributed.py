@@ -30,8 +30,8 @@ REPO = Path(__file__).resolve().parents[2]
 PORT = 6379
 ADDRESS = f"127.0.0.1:{PORT}"
 # Every wait has a deadline (seconds).
-START_TIMEOUT = 60
-RUN_TIMEOUT = 90
+START_TIMEOUT = 180
+RUN_TIMEOUT = 300
 # The sweep: two maps, two training seeds, one unit per task.
 SWEEP = ["batch", str(REPO / "maps" / "jaywalk.ron"), str(REPO / "maps" / "stop_midway.ron"),
          "--train-seeds", "1..2", "--train-episodes", "200", "--episodes", "6", "--seed", "5"]

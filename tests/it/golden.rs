@@ -183,22 +183,26 @@ fn timeouts_truncate_and_learners_bootstrap() {
     assert_ne!(truncating.q_learning, terminating.q_learning);
 }
 
-/// Digests of [`timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before`].
+/// Digests of [`timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before`]: the
+/// agent and the zero-shot episodes as recorded on the code before the episode API; the
+/// continual episodes of the intersection and the noisy jaywalk re-recorded when test-time
+/// learning of `A` started keeping its structural zeros (agent/src/learning.rs `update_a`).
 const GOLDEN_TIMEOUT_AS_TERMINATION: [&str; 4] = [
     "10356990b4c98627",
-    "72e903b779f23fb4",
+    "06f2fc67eefe1e0a",
     "fd86969ccbedd97b",
-    "35e3e279adc323a8",
+    "42645404ec0bad2e",
 ];
 
 /// Digests of [`trained_agent_and_decisions_are_unchanged`].
 const GOLDEN: [&str; 4] = GOLDEN_TIMEOUT_AS_TERMINATION;
 
 /// Digests of [`the_theta_handback_ablation_reproduces_the_decisions_of_before`]: those of
-/// the code before the safe hand-back (the default's, [`GOLDEN`], until then).
+/// the code before the safe hand-back (the default's, [`GOLDEN`], until then), with the
+/// continual episodes re-recorded as [`GOLDEN_TIMEOUT_AS_TERMINATION`]'s.
 const GOLDEN_THETA_HANDBACK: [&str; 4] = [
     "10356990b4c98627",
-    "72e903b779f23fb4",
+    "06f2fc67eefe1e0a",
     "fd86969ccbedd97b",
-    "35e3e279adc323a8",
+    "42645404ec0bad2e",
 ];

@@ -93,10 +93,10 @@ fn continual_ticks(handback: &str) -> Vec<Vec<(bool, bool, f64)>> {
     (0..15)
         .map(|ep| {
             let (_, trace) = run_episode(&mut env, &mut agent, eval_seeds(7, &map, Method::Scaled, ep), true).unwrap();
-            let declined = agent.declined_history();
             trace
                 .iter()
-                .map(|t| (t.reasoned, declined[t.step as usize], t.theta.unwrap()))
+                .zip(agent.declined_history())
+                .map(|(t, declined)| (t.reasoned, *declined, t.theta.unwrap()))
                 .collect()
         })
         .collect()

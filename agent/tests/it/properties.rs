@@ -190,9 +190,17 @@ proptest! {
         w.materialize();
         for a in 0..3 { for s in 0..n { prop_assert!((w.b(a).column(s).sum() - 1.0).abs() < 1e-9); } }
         // A and ν counts.
-        let mut a_counts = DMatrix::zeros(n, n);
+        let mut a_counts = DMatrix::from_element(n, n, 1.0);
         update_a(&mut a_counts, 2, &q_prev, lr);
-        prop_assert!((a_counts.row(2).sum() - lr).abs() < 1e-12 && (a_counts.sum() - lr).abs() < 1e-12);
+        let total = (n * n) as f64;
+        prop_assert!((a_counts.row(2).sum() - n as f64 - lr).abs() < 1e-9 && (a_counts.sum() - total - lr).abs() < 1e-9);
+        // A structural zero of A (an exact observation model's off-diagonal) stays zero.
+        let mut exact = DMatrix::identity(n, n) * 1000.0;
+        update_a(&mut exact, 2, &q_prev, lr);
+        for s in (0..n).filter(|&s| s != 2) {
+            prop_assert_eq!(exact[(2, s)], 0.0);
+        }
+        prop_assert!((exact[(2, 2)] - 1000.0 - lr * q_prev[2]).abs() < 1e-9);
         // ν from a one-hot policy (the action taken) and from a spread one (π' of reasoning).
         let mut nu = vec![1.0; n * 3];
         let mut one_hot = [0.0; 3];
