@@ -143,10 +143,16 @@ impl Habit for TableHabit {
         learning::update_nu(&mut self.learned, self.n_actions, q, pi, lr);
     }
     fn bound_memory(&mut self, memory: f64) {
-        if memory.is_finite() {
-            rescale_rows(&mut self.learned, self.n_actions, memory);
-            for ((n, p), c) in self.nu.iter_mut().zip(&self.prior).zip(&self.learned) {
-                *n = p + c;
+        let na = self.n_actions.max(1);
+        let rows = self.learned.chunks_mut(na).zip(self.nu.chunks_mut(na)).zip(self.prior.chunks(na));
+        for ((learned, nu), prior) in rows {
+            let total: f64 = learned.iter().sum();
+            if total > memory {
+                let k = memory / total;
+                for ((c, n), p) in learned.iter_mut().zip(nu.iter_mut()).zip(prior) {
+                    *c *= k;
+                    *n = p + *c;
+                }
             }
         }
     }

@@ -261,7 +261,7 @@ pub enum RootStep {
 /// | `learning` | `learning_rate` | 1.0 | finite and >= 0 | multiplies the expected counts added in §V |
 /// | `learning` | `nu0` ν0 | 10.0 | finite and > 0 | prior strength of ν = ν0 σ(Q/T) (docs/ARCHITECTURE.md §4.8) |
 /// | `learning` | `nu_temperature` T | 1.0 | finite and > 0 | temperature of ν's softmax over Q |
-/// | `learning` | `habit_memory` | `inf` | > 0 (`inf` allowed) | counts of reasoning a state of the habit keeps beyond its prior: each state's counts are rescaled to at most this many at the end of an episode (beyond the paper; [`crate::habit::Habit::bound_memory`]) |
+/// | `learning` | `habit_memory` | 20.0 | > 0 (`inf` allowed) | counts of reasoning a state of the habit keeps beyond its prior: each state's counts are rescaled to at most this many at the end of an episode (beyond the paper; [`crate::habit::Habit::bound_memory`]) |
 ///
 /// Where each range is enforced: numbers and enum values when set by name and by
 /// [`ScaledParams::check`]; the spelling of `gate_factor` and `persistence_ignores` (names
@@ -440,7 +440,7 @@ impl Default for LearningParams {
             learning_rate: 1.0,
             nu0: 10.0,
             nu_temperature: 1.0,
-            habit_memory: f64::INFINITY,
+            habit_memory: 20.0,
         }
     }
 }
