@@ -144,7 +144,11 @@ impl Habit for TableHabit {
     }
     fn bound_memory(&mut self, memory: f64) {
         let na = self.n_actions.max(1);
-        let rows = self.learned.chunks_mut(na).zip(self.nu.chunks_mut(na)).zip(self.prior.chunks(na));
+        let rows = self
+            .learned
+            .chunks_mut(na)
+            .zip(self.nu.chunks_mut(na))
+            .zip(self.prior.chunks(na));
         for ((learned, nu), prior) in rows {
             let total: f64 = learned.iter().sum();
             if total > memory {
