@@ -139,9 +139,7 @@ fn batch_json(
     };
     let scenarios = names
         .iter()
-        .map(|n| {
-            Ok(Scenario::of_map(crate::maps::load(n, None)?, n.clone()))
-        })
+        .map(|n| Ok(Scenario::of_map(crate::maps::load(n, None)?, n.clone())))
         .collect::<PyResult<Vec<_>>>()?;
     // Sweep lists as `--set key=v1,v2` (a sweep's points are labelled by that text).
     let text = |x: &Bound<'_, PyAny>| -> PyResult<String> {
