@@ -146,11 +146,7 @@ impl StateGate {
 
     /// `Σ_s q(s) P(x(s) | parents(s))`: the probability the habit gives the state under belief `q`.
     pub fn evidence(&self, q: &[f64]) -> f64 {
-        q.iter()
-            .zip(&self.prob)
-            .filter(|(w, _)| **w != 0.0)
-            .map(|(w, p)| w * p)
-            .sum()
+        expectation(q, &self.prob)
     }
 
     /// Number of cells `(x | parents)` of the table.
@@ -174,13 +170,7 @@ impl StateGate {
     /// no longer does, test-time learning has made the situation familiar: that is the
     /// hand-back [`crate::handback`] checks.
     pub fn trained_surprise(&self, q: &[f64]) -> f64 {
-        let evidence: f64 = q
-            .iter()
-            .zip(&self.trained)
-            .filter(|(w, _)| **w != 0.0)
-            .map(|(w, p)| w * p)
-            .sum();
-        -ln(evidence)
+        -ln(expectation(q, &self.trained))
     }
 
     /// The surprise in excess of what is expected where the habit has proven itself:
@@ -194,13 +184,7 @@ impl StateGate {
     /// the trigger for either outcome, so without this the agent reasons there forever,
     /// although its habit already does what reasoning would (EXPERIMENTS.md).
     pub fn excess_surprise(&self, q: &[f64], surprise: f64) -> f64 {
-        let expected: f64 = q
-            .iter()
-            .zip(&self.expected)
-            .filter(|(w, _)| **w != 0.0)
-            .map(|(w, h)| w * h)
-            .sum();
-        (surprise - expected).max(0.0)
+        (surprise - expectation(q, &self.expected)).max(0.0)
     }
 
     /// Records that on a reasoning tick in state `s`, reasoning's policy endorsed the
@@ -263,6 +247,11 @@ impl StateGate {
         let r = &self.data[row * self.size..(row + 1) * self.size];
         (self.prior + r[value]) / (self.size as f64 * self.prior + r.iter().sum::<f64>())
     }
+}
+
+/// `Σ_s q(s) x(s)` over the states the belief `q` gives weight to.
+fn expectation(q: &[f64], x: &[f64]) -> f64 {
+    q.iter().zip(x).filter(|(w, _)| **w != 0.0).map(|(w, v)| w * v).sum()
 }
 
 #[cfg(test)]

@@ -76,10 +76,8 @@ fn rescale_rows(counts: &mut [f64], n_actions: usize, memory: f64) {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TableHabit {
     n_actions: usize,
-    /// The prior counts the table was built with.
+    /// The prior counts the table was built with (`ν - prior` is what reasoning added).
     prior: Vec<f64>,
-    /// The counts reasoning added, `ν - prior`.
-    learned: Vec<f64>,
     nu: Vec<f64>,
 }
 
@@ -113,7 +111,6 @@ impl TableHabit {
     fn with_prior(n_actions: usize, prior: Vec<f64>) -> TableHabit {
         TableHabit {
             n_actions,
-            learned: vec![0.0; prior.len()],
             nu: prior.clone(),
             prior,
         }
@@ -140,23 +137,14 @@ impl Habit for TableHabit {
     }
     fn learn(&mut self, q: &[f64], pi: &[f64], lr: f64) {
         learning::update_nu(&mut self.nu, self.n_actions, q, pi, lr);
-        learning::update_nu(&mut self.learned, self.n_actions, q, pi, lr);
     }
     fn bound_memory(&mut self, memory: f64) {
         let na = self.n_actions.max(1);
-        let rows = self
-            .learned
-            .chunks_mut(na)
-            .zip(self.nu.chunks_mut(na))
-            .zip(self.prior.chunks(na));
-        for ((learned, nu), prior) in rows {
-            let total: f64 = learned.iter().sum();
-            if total > memory {
-                let k = memory / total;
-                for ((c, n), p) in learned.iter_mut().zip(nu.iter_mut()).zip(prior) {
-                    *c *= k;
-                    *n = p + *c;
-                }
+        for (nu, prior) in self.nu.chunks_mut(na).zip(self.prior.chunks(na)) {
+            let learned: f64 = nu.iter().zip(prior).map(|(n, p)| n - p).sum();
+            if learned > memory {
+                let k = memory / learned;
+                nu.iter_mut().zip(prior).for_each(|(n, p)| *n = p + k * (*n - p));
             }
         }
     }

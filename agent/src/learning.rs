@@ -22,8 +22,9 @@ use nalgebra::DMatrix;
 /// no mass on such an `s` given `o`, so it stays zero. Perception's floored `ln A` leaves a
 /// rounding residue there (about 1e-18) which, learned, feeds back (more mass in `A`, more
 /// spread in the next posteriors) and grew geometrically over a long continual run
-/// (measured: the largest off-diagonal of an identity `A` reached 0.07 after 190 episodes,
-/// and beliefs blurred across neighbouring states; EXPERIMENTS.md, "The safe hand-back").
+/// (measured on seed 7's agent on stop_midway: the largest off-diagonal of an identity `A`
+/// reached 0.07 after 190 episodes and beliefs blurred across neighbouring states;
+/// EXPERIMENTS.md, "The safe hand-back").
 pub fn update_a(counts: &mut DMatrix<f64>, o: usize, q: &[f64], lr: f64) {
     for (s, p) in q.iter().enumerate() {
         if *p != 0.0 && counts[(o, s)] > 0.0 {

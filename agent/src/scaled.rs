@@ -302,7 +302,6 @@ impl<H: Habit> ScaledAgent<H> {
     fn decline_trigger(&mut self, obs: usize) -> bool {
         if self.params.gate.handback != HandBackRule::RiskChecked
             || !self.learned
-            || self.gate.is_none()
             || self.trained_trigger_fires().is_some()
         {
             return false;
@@ -580,7 +579,9 @@ impl<H: Habit> Controller for ScaledAgent<H> {
     /// Test-time learning (§V): A, factor CPTs, the gate's table and ν from the episode's
     /// posteriors. `ν` consolidates the actions reasoning took (§V-C: "the policy π_o needs
     /// to consolidate the actions sampled from its scaled version π'"), `ν[s,a_τ] += lr q_τ[s]`
-    /// on reasoning ticks only: feed-forward ticks do not reinforce the habit's own choices.
+    /// on reasoning ticks only: feed-forward ticks do not reinforce the habit's own choices;
+    /// then each habit state keeps at most `habit_memory` of those counts
+    /// ([`Habit::bound_memory`]).
     /// The gate's table then learns the episode's states; with [`GateLearning::Endorsed`],
     /// each situation of the table (a cell `(x | parents)`) counts with the smallest
     /// endorsement, over this episode's reasoning ticks in it, of the updated habit's action

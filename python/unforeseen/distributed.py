@@ -91,6 +91,17 @@ def _ray() -> Any:
     return ray
 
 
+def _check_task_options(jobs: int, per_task_name: str, per_task: int | None, max_retries: int) -> None:
+    """Raises ``ValueError`` for task options out of range (threads per task, work items per
+    task, retries), before Ray is needed."""
+    if jobs < 1 or jobs > 256:
+        raise ValueError(f"jobs {jobs}: expected a number of threads per task from 1 to 256")
+    if per_task is not None and per_task < 1:
+        raise ValueError(f"{per_task_name} {per_task}: expected at least 1")
+    if max_retries < 0:
+        raise ValueError(f"max_retries {max_retries}: expected 0 or more")
+
+
 def _task_options(max_retries: int) -> dict[str, Any]:
     """Ray options of every task: retried when its worker or node dies, never for an
     exception it raises (an input error fails the same way on every attempt)."""
@@ -236,12 +247,7 @@ def run_batch(
     any, as ``batch`` does).
     """
     out = Path(out)
-    if jobs < 1 or jobs > 256:
-        raise ValueError(f"jobs {jobs}: expected a number of threads per task from 1 to 256")
-    if units_per_task is not None and units_per_task < 1:
-        raise ValueError(f"units_per_task {units_per_task}: expected at least 1")
-    if max_retries < 0:
-        raise ValueError(f"max_retries {max_retries}: expected 0 or more")
+    _check_task_options(jobs, "units_per_task", units_per_task, max_retries)
     plan = json.loads(
         _unforeseen.plan_batch(
             [str(m) for m in maps],
@@ -335,12 +341,7 @@ def run_search(
     store. ``command`` is written in the failure maps' comments (``Found by: ...``).
     Returns ``summary.json``'s contents.
     """
-    if jobs < 1 or jobs > 256:
-        raise ValueError(f"jobs {jobs}: expected a number of threads per task from 1 to 256")
-    if candidates_per_task is not None and candidates_per_task < 1:
-        raise ValueError(f"candidates_per_task {candidates_per_task}: expected at least 1")
-    if max_retries < 0:
-        raise ValueError(f"max_retries {max_retries}: expected 0 or more")
+    _check_task_options(jobs, "candidates_per_task", candidates_per_task, max_retries)
     seeds = None if train_seeds is None else list(train_seeds)
     if seeds is not None and agent is not None:
         raise ValueError("--train-seeds and --agent: give one (train agents per seed, or search with one agent file)")
