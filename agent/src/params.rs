@@ -194,14 +194,23 @@ pub enum GateBaseline {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum HandBackRule {
-    /// Where test-time learning changed the trigger's verdict, the crash-risk check decides
-    /// who drives. A hand-back that learning made (the trained agent's trigger would still
-    /// fire) is made only if the habit, rolled forward `handback_horizon` ticks through the
-    /// learned model, enters a crash-risk state at most `handback_risk` more likely than
-    /// the safest action; otherwise the agent reasons. A reasoning tick that learning made
-    /// (the trained trigger would hand back, the learned one fires) is taken only if that
-    /// check finds the habit at risk; otherwise the habit acts, as the trained agent's would.
+    /// Where test-time learning changed the trigger's verdict, learning may only take
+    /// reasoning away, and only where the habit is safe. A hand-back that learning made
+    /// (the trained agent's trigger would still fire) is made only if the habit, rolled
+    /// forward `handback_horizon` ticks through the learned model, enters a crash-risk
+    /// state at most `handback_risk` more likely than the safest action; otherwise the
+    /// agent reasons. A reasoning tick that learning alone made (the trained trigger would
+    /// hand back, the learned one fires: learning that pedestrians are common makes an
+    /// empty road read as surprising) is declined: the habit acts, as the trained agent's
+    /// would. So the agent reasons only where its trained trigger fires.
     #[default]
+    DeclineLearned,
+    /// Option: the crash-risk check decides both ways. Hand-backs as `DeclineLearned`; a
+    /// reasoning tick that learning alone made is taken where the check finds the habit at
+    /// risk (e.g. about to run a red light into a crosswalk where pedestrians cross on red),
+    /// otherwise declined. It saves what the planner knows and the habit does not (the
+    /// rule-aware maps/red_light/), at the cost of reasoning on an empty road
+    /// (EXPERIMENTS.md, "The safe hand-back").
     RiskChecked,
     /// Ablation: only hand-backs that learning made are checked; every tick the learned
     /// trigger fires on reasons.
@@ -240,7 +249,7 @@ pub enum RootStep {
 /// | `gate` | `gate_memory` | 20.0 | > 0 (`inf` allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
 /// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
 /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `none` is the paper's trigger) ([`GateBaseline`]) |
-/// | `gate` | `handback` | `risk-checked` | `risk-checked`, `hand-back-checked`, `theta` | where test-time learning changed the trigger's verdict, the world model's crash-risk check of the habit decides whether the habit or reasoning acts (beyond the paper; `hand-back-checked` checks only the hand-backs learning made, `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
+/// | `gate` | `handback` | `decline-learned` | `decline-learned`, `risk-checked`, `hand-back-checked`, `theta` | where test-time learning changed the trigger's verdict: a hand-back learning made goes to the habit only if the world model's crash-risk check passes, a reasoning tick learning alone made is declined (beyond the paper; `risk-checked` takes such a tick where the check finds the habit at risk, `hand-back-checked` takes every one, `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
 /// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
 /// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |
 /// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
@@ -324,7 +333,7 @@ impl Default for GateParams {
             gate_memory: 20.0,
             gate_learning: GateLearning::Endorsed,
             gate_baseline: GateBaseline::Endorsed,
-            handback: HandBackRule::RiskChecked,
+            handback: HandBackRule::DeclineLearned,
             handback_risk: 0.08,
             handback_horizon: 3,
         }

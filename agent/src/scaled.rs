@@ -297,17 +297,20 @@ impl<H: Habit> ScaledAgent<H> {
 
     /// The check of a reasoning tick that learning made: on a tick whose learned trigger
     /// fires, `true` when the trained agent's trigger would have handed back and the habit
-    /// is not at risk, so the habit acts (with [`HandBackRule::RiskChecked`]). Leaves the
-    /// habit's policy in `self.pi` when it returns `true`.
+    /// is not at risk ([`HandBackRule::RiskChecked`]) or whatever the risk
+    /// ([`HandBackRule::DeclineLearned`]), so the habit acts. Leaves the habit's policy in
+    /// `self.pi` when it returns `true`.
     fn decline_trigger(&mut self, obs: usize) -> bool {
-        if self.params.gate.handback != HandBackRule::RiskChecked
-            || !self.learned
-            || self.trained_trigger_fires().is_some()
-        {
+        let checked = match self.params.gate.handback {
+            HandBackRule::RiskChecked => true,
+            HandBackRule::DeclineLearned => false,
+            HandBackRule::HandBackChecked | HandBackRule::Theta => return false,
+        };
+        if !self.learned || self.trained_trigger_fires().is_some() {
             return false;
         }
         self.habit_policy(obs);
-        !self.habit_at_risk()
+        !checked || !self.habit_at_risk()
     }
 
     /// The habit's policy `π_o` for this tick into `self.pi`.
@@ -351,7 +354,8 @@ impl<H: Habit> ScaledAgent<H> {
     }
     /// Whether each tick of the current (or last) episode went to the habit although the
     /// learned trigger fired, because only test-time learning made it fire and the check
-    /// found the habit safe ([`HandBackRule::RiskChecked`]).
+    /// found the habit safe ([`HandBackRule::RiskChecked`]), or always
+    /// ([`HandBackRule::DeclineLearned`]).
     pub fn declined_history(&self) -> &[bool] {
         &self.hist_declined
     }

@@ -9,8 +9,9 @@
 //! embedded intersection; and, ignored in debug builds, the agent `unforeseen train --seed
 //! 7` writes), over continual episodes of that map: no episode the agent without learning
 //! survives is lost, and reasoning falls as it learns. Under the `hand-back-checked`
-//! ablation the shared test agent loses 11 of these 40 episodes (EXPERIMENTS.md, "The safe
-//! hand-back").
+//! ablation, which takes every reasoning tick learning made, the shared test agent loses 11
+//! of these 40 episodes (EXPERIMENTS.md, "The safe hand-back"). The default
+//! (`decline-learned`) never reasons with nobody on the crosswalk.
 
 use std::path::Path;
 use std::sync::OnceLock;
@@ -102,10 +103,10 @@ fn continual_ticks(handback: &str) -> Vec<Vec<(bool, bool, f64)>> {
         .collect()
 }
 
-/// A tick the learned trigger fires on only because of test-time learning goes to the
-/// habit where the check finds the habit safe: such ticks exist once the agent has learned
-/// (never in the first episode), each has `θ > ε` and did not reason; the ablation
-/// `hand-back-checked` declines none.
+/// Under `risk-checked`, a tick the learned trigger fires on only because of test-time
+/// learning goes to the habit where the check finds the habit safe: such ticks exist once
+/// the agent has learned (never in the first episode), each has `θ > ε` and did not
+/// reason; the ablation `hand-back-checked` declines none.
 #[test]
 fn triggers_only_learning_made_go_to_a_safe_habit() {
     let epsilon = ScaledParams::default().gate.epsilon;
@@ -124,4 +125,31 @@ fn triggers_only_learning_made_go_to_a_safe_habit() {
     }
     let ablation = continual_ticks("hand-back-checked");
     assert!(ablation.iter().flatten().all(|(_, d, _)| !d));
+}
+
+/// Reasoning ticks over continual episodes of the embedded training map whose true state
+/// has nobody on the crosswalk, with hand-back rule `handback`.
+fn empty_road_reasoning(map: &str, handback: &str, episodes: u64) -> usize {
+    let mut params = ScaledParams::default();
+    params.set_str("handback", handback).unwrap();
+    let map = unforeseen::maps::load(map).unwrap();
+    let mut agent = scaled_agent(common::bundle(), params).unwrap();
+    let mut env = Env::new(&map, EnvConfig::default()).unwrap();
+    (0..episodes)
+        .map(|ep| {
+            let (_, trace) = run_episode(&mut env, &mut agent, eval_seeds(7, &map, Method::Scaled, ep), true).unwrap();
+            trace.iter().filter(|t| t.reasoned && t.state.p == 0).count()
+        })
+        .sum()
+}
+
+/// `decline-learned` (issue 20's "no reasoning on ticks without a pedestrian"): over 40
+/// continual episodes the agent never reasons with nobody on the crosswalk, on the training
+/// map and on slow_walker, where `risk-checked` does (it takes the reasoning learning made
+/// wherever the check finds the habit at risk).
+#[test]
+fn decline_learned_never_reasons_on_an_empty_road() {
+    assert_eq!(empty_road_reasoning("intersection", "decline-learned", 40), 0);
+    assert_eq!(empty_road_reasoning("maps/slow_walker.ron", "decline-learned", 40), 0);
+    assert!(empty_road_reasoning("maps/slow_walker.ron", "risk-checked", 40) > 0);
 }
