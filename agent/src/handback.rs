@@ -48,8 +48,8 @@
 //! walker. With [`crate::params::HandBackRule::RiskChecked`] the check decides this case
 //! too, and the tick is taken where it finds the habit at risk (on red, where the habit
 //! would run the light): on the rule-free maps that changes no episode's success for the
-//! agents of seeds 1..20, on the rule-aware maps it saves cars the habit would take through a red
-//! (EXPERIMENTS.md, "The safe hand-back"). Where learning changed nothing, the habit acts
+//! agents of seeds 1..20, on the rule-aware maps it saves cars the habit would take
+//! through a red (EXPERIMENTS.md, "The safe hand-back"). Where learning changed nothing, the habit acts
 //! as training left it, as in the paper; so the zero-shot agent, which has learned
 //! nothing, decides exactly as before.
 

@@ -208,9 +208,10 @@ pub enum HandBackRule {
     /// Option: the crash-risk check decides both ways. Hand-backs as `DeclineLearned`; a
     /// reasoning tick that learning alone made is taken where the check finds the habit at
     /// risk (e.g. about to run a red light into a crosswalk where pedestrians cross on red),
-    /// otherwise declined. It saves what the planner knows and the habit does not (the
-    /// rule-aware maps/red_light/), at the cost of reasoning on an empty road
-    /// (EXPERIMENTS.md, "The safe hand-back").
+    /// otherwise declined. There the planner acts on what it knows and the habit has not
+    /// learnt (a traffic rule: on the rule-aware maps/red_light/ it saves cars of two of
+    /// 20 agents), at the cost of reasoning on an empty road (EXPERIMENTS.md, "The safe
+    /// hand-back").
     RiskChecked,
     /// Ablation: only hand-backs that learning made are checked; every tick the learned
     /// trigger fires on reasons.

@@ -84,20 +84,20 @@ fn learning_loses_no_crowd_episode_that_the_full_agent_without_learning_survives
     check_learning_loses_nothing(full_agent());
 }
 
-/// Per episode of a continual run on the crowd: (reasoned, declined, θ) per tick.
-fn continual_ticks(handback: &str) -> Vec<Vec<(bool, bool, f64)>> {
+/// Per episode of a continual run of the shared test agent on `map` with hand-back rule
+/// `handback`, per tick: (reasoned, declined, θ, a pedestrian on the crosswalk).
+fn continual_ticks(map: &unforeseen_sim::Map, handback: &str, episodes: u64) -> Vec<Vec<(bool, bool, f64, bool)>> {
     let mut params = ScaledParams::default();
     params.set_str("handback", handback).unwrap();
-    let map = crowd();
     let mut agent = scaled_agent(common::bundle(), params).unwrap();
-    let mut env = Env::new(&map, EnvConfig::default()).unwrap();
-    (0..15)
+    let mut env = Env::new(map, EnvConfig::default()).unwrap();
+    (0..episodes)
         .map(|ep| {
-            let (_, trace) = run_episode(&mut env, &mut agent, eval_seeds(7, &map, Method::Scaled, ep), true).unwrap();
+            let (_, trace) = run_episode(&mut env, &mut agent, eval_seeds(7, map, Method::Scaled, ep), true).unwrap();
             trace
                 .iter()
                 .zip(agent.declined_history())
-                .map(|(t, declined)| (t.reasoned, *declined, t.theta.unwrap()))
+                .map(|(t, declined)| (t.reasoned, *declined, t.theta.unwrap(), t.state.p == 1))
                 .collect()
         })
         .collect()
@@ -110,37 +110,33 @@ fn continual_ticks(handback: &str) -> Vec<Vec<(bool, bool, f64)>> {
 #[test]
 fn triggers_only_learning_made_go_to_a_safe_habit() {
     let epsilon = ScaledParams::default().gate.epsilon;
-    let episodes = continual_ticks("risk-checked");
+    let episodes = continual_ticks(&crowd(), "risk-checked", 15);
     assert!(
-        episodes[0].iter().all(|(_, declined, _)| !declined),
+        episodes[0].iter().all(|(_, declined, _, _)| !declined),
         "nothing learned yet"
     );
-    let declined: Vec<_> = episodes.iter().flatten().filter(|(_, d, _)| *d).collect();
+    let declined: Vec<_> = episodes.iter().flatten().filter(|(_, d, _, _)| *d).collect();
     assert!(
         !declined.is_empty(),
         "the crowd makes the gate fire where the trained one would not"
     );
-    for (reasoned, _, theta) in declined {
+    for (reasoned, _, theta, _) in declined {
         assert!(!reasoned && *theta > epsilon, "theta {theta}, reasoned {reasoned}");
     }
-    let ablation = continual_ticks("hand-back-checked");
-    assert!(ablation.iter().flatten().all(|(_, d, _)| !d));
+    let ablation = continual_ticks(&crowd(), "hand-back-checked", 15);
+    assert!(ablation.iter().flatten().all(|(_, d, _, _)| !d));
 }
 
-/// Reasoning ticks over continual episodes of the embedded training map whose true state
-/// has nobody on the crosswalk, with hand-back rule `handback`.
-fn empty_road_reasoning(map: &str, handback: &str, episodes: u64) -> usize {
-    let mut params = ScaledParams::default();
-    params.set_str("handback", handback).unwrap();
+/// Reasoning ticks over 40 continual episodes on `map` (a file or an embedded name) whose
+/// true state has nobody on the crosswalk, with hand-back rule `handback`.
+fn empty_road_reasoning(map: &str, handback: &str) -> usize {
     let map = unforeseen::maps::load(map).unwrap();
-    let mut agent = scaled_agent(common::bundle(), params).unwrap();
-    let mut env = Env::new(&map, EnvConfig::default()).unwrap();
-    (0..episodes)
-        .map(|ep| {
-            let (_, trace) = run_episode(&mut env, &mut agent, eval_seeds(7, &map, Method::Scaled, ep), true).unwrap();
-            trace.iter().filter(|t| t.reasoned && t.state.p == 0).count()
-        })
-        .sum()
+    let episodes = continual_ticks(&map, handback, 40);
+    episodes
+        .iter()
+        .flatten()
+        .filter(|(reasoned, _, _, pedestrian)| *reasoned && !pedestrian)
+        .count()
 }
 
 /// `decline-learned` (issue 20's "no reasoning on ticks without a pedestrian"): over 40
@@ -149,7 +145,7 @@ fn empty_road_reasoning(map: &str, handback: &str, episodes: u64) -> usize {
 /// wherever the check finds the habit at risk).
 #[test]
 fn decline_learned_never_reasons_on_an_empty_road() {
-    assert_eq!(empty_road_reasoning("intersection", "decline-learned", 40), 0);
-    assert_eq!(empty_road_reasoning("maps/slow_walker.ron", "decline-learned", 40), 0);
-    assert!(empty_road_reasoning("maps/slow_walker.ron", "risk-checked", 40) > 0);
+    assert_eq!(empty_road_reasoning("intersection", "decline-learned"), 0);
+    assert_eq!(empty_road_reasoning("maps/slow_walker.ron", "decline-learned"), 0);
+    assert!(empty_road_reasoning("maps/slow_walker.ron", "risk-checked") > 0);
 }
