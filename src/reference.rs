@@ -118,7 +118,7 @@ impl BrakeOnPedestrian {
     /// reward has the red-light rule ([`RedLightStop::of`], with the map's bins).
     pub fn for_map(sizes: &[usize], map: &Map) -> Result<Self, Error> {
         let mut c = Self::new(sizes)?;
-        let disc = Discretizer::new(&map.bins)?;
+        let disc = Discretizer::new(&map)?;
         if disc.factor_sizes() == c.sizes {
             c.red_light = RedLightStop::of(map, &disc);
         }
@@ -178,10 +178,10 @@ impl Controller for NeverBrake {
 mod tests {
     use super::*;
     use unforeseen_discretizer::{Discretizer, State};
-    use unforeseen_sim::Bins;
+    use unforeseen_sim::{Bins, DistanceEdges, Map};
 
     fn disc() -> Discretizer {
-        Discretizer::new(&Bins::default()).unwrap()
+        Discretizer::new(&Map::default()).unwrap()
     }
 
     fn brake() -> BrakeOnPedestrian {
@@ -230,11 +230,11 @@ mod tests {
     fn decodes_other_bin_counts() {
         // Five distance bins and two speed bins: s = ((d*2 + v)*2 + L)*2 + p.
         let bins = Bins {
-            distance_edges: vec![0.0, 20.0, 40.0, 80.0],
+            distance_edges: DistanceEdges::Goal(vec![0.0, 20.0, 40.0, 80.0]),
             speed_edges: vec![4.0],
             observation_noise: 0.0,
         };
-        let disc = Discretizer::new(&bins).unwrap();
+        let disc = Discretizer::new(&Map { bins, ..Map::default() }).unwrap();
         let c = BrakeOnPedestrian::new(&disc.factor_sizes()).unwrap();
         for s in 0..disc.n_states() {
             let st = disc.decode(s);

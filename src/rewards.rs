@@ -51,12 +51,12 @@ pub fn terminal_states(map: &Map, disc: &Discretizer) -> Vec<usize> {
 
 /// Distance bins that lie wholly at or past the crosswalk's near edge and before the goal:
 /// a car observed in one of them has entered the crosswalk (its front crossed the near
-/// edge). Empty unless an edge of `bins.distance_edges` lies at or before the near edge
-/// (e.g. `[0, 26, 60]` for the default crosswalk: d = 1 is (0, 26] m, from the near edge
-/// on). docs/ARCHITECTURE.md §4.3.
+/// edge). Empty unless a distance edge lies at or before the near edge (e.g.
+/// `Crosswalk(lead: 0.0, ...)`, the edges `[0, 26, 60]` for the default crosswalk: d = 1
+/// is (0, 26] m, from the near edge on). docs/ARCHITECTURE.md §4.3.
 pub fn entered_bins(map: &Map, disc: &Discretizer) -> Vec<usize> {
     let near = map.crosswalk_distance_to_goal().0;
-    let edges = &map.bins.distance_edges;
+    let edges = disc.distance_edges();
     // Bin d >= 1 holds distances (edges[d - 1], edges[d]]; the last bin is unbounded.
     (1..disc.factor_sizes()[0])
         .filter(|&d| edges.get(d).is_some_and(|&hi| hi <= near))

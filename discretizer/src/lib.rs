@@ -13,18 +13,26 @@
 //! 4 x 4 x 2 x 2). Bin edges come from the map ([`unforeseen_sim::Bins`]), so a finer
 //! state space is a map change, not a code change.
 //!
+//! The paper's `d = 1` is the intersection. By default the distance edges are anchored
+//! to the crosswalk ([`distance_edges`]), so that `d` means the same on every map: `d = 1`
+//! from 4 m before the crosswalk's near edge to the goal, `d = 2` the approach in which
+//! the car can still stop, `d = 3` beyond. On the training intersection these are the
+//! paper's edges `[0, 30, 60]`; a map that moves the crosswalk moves them with it.
+//!
 //! ```
 //! use unforeseen_discretizer::Discretizer;
-//! use unforeseen_sim::Bins;
-//! let bins = Bins { distance_edges: vec![0.0, 30.0, 60.0], speed_edges: vec![1.5, 4.5, 7.5], observation_noise: 0.0 };
-//! let disc = Discretizer::new(&bins).unwrap();
+//! let mut map = unforeseen_sim::Map::default();
+//! let disc = Discretizer::new(&map).unwrap();
+//! assert_eq!(disc.distance_edges(), [0.0, 30.0, 60.0]);
 //! assert_eq!(disc.factor_sizes(), [4, 4, 2, 2]);
 //! assert_eq!(disc.distance_bin(45.0), 2);
 //! assert_eq!(disc.speed_bin(9.0), 3);
+//! map.crosswalk.x = 81.0; // near edge 11 m before the goal
+//! assert_eq!(Discretizer::new(&map).unwrap().distance_edges(), [0.0, 15.0, 45.0]);
 //! ```
 
 use rand::{Rng, RngExt};
-use unforeseen_sim::{Bins, LightPhase, Snapshot};
+use unforeseen_sim::{DistanceEdges, LightPhase, Map, Snapshot};
 
 /// One discrete state of the paper's §VI state space, factor by factor.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -55,6 +63,34 @@ pub enum DiscretizerError {
     BadNoise(f64),
 }
 
+/// The distance edges of a map, m to the goal, strictly increasing.
+///
+/// A list in the map is used as written. `Crosswalk(lead, approach)` gives three edges
+/// anchored to the crosswalk's near edge, `n` m before the goal:
+///
+/// ```text
+/// e1 = n + lead                                       d = 1: the crosswalk zone, (0, e1]
+/// e2 = e1 + max(approach, v_max·Δt + v_max² / (2 b))  d = 2: the approach, (e1, e2]
+///                                                     d = 3: beyond e2
+/// ```
+///
+/// where `v_max` is the car's top speed, `b` its braking and `Δt` a decision tick: the
+/// approach is never shorter than the distance in which a car at top speed, braking one
+/// tick after it sees a pedestrian, comes to a stop. On the training intersection
+/// (`n = 26`, 9 m/s, 3 m/s², 1 s: 22.5 m) this is `[0, 30, 60]`, the paper's edges.
+pub fn distance_edges(map: &Map) -> Vec<f64> {
+    match &map.bins.distance_edges {
+        DistanceEdges::Goal(edges) => edges.clone(),
+        DistanceEdges::Crosswalk(c) => {
+            let near = map.crosswalk_distance_to_goal().0;
+            let v = &map.vehicle;
+            let stopping = v.max_speed * map.episode.decision_dt + v.max_speed * v.max_speed / (2.0 * v.max_brake);
+            let e1 = near + c.lead;
+            vec![0.0, e1, e1 + c.approach.max(stopping)]
+        }
+    }
+}
+
 /// Maps [`Snapshot`]s to discrete states using a map's bin edges (docs/ARCHITECTURE.md §3).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Discretizer {
@@ -69,8 +105,10 @@ impl Discretizer {
     /// Number of pedestrian values (absent, present).
     pub const PEDESTRIAN_VALUES: usize = 2;
 
-    /// Builds a discretizer from a map's bins, checking the edges.
-    pub fn new(bins: &Bins) -> Result<Self, DiscretizerError> {
+    /// Builds a discretizer from a map's bins (its distance edges derived by
+    /// [`distance_edges`]), checking the edges.
+    pub fn new(map: &Map) -> Result<Self, DiscretizerError> {
+        let bins = &map.bins;
         let check = |field, edges: &[f64]| {
             let ok = edges.iter().all(|e| e.is_finite()) && edges.windows(2).all(|w| w[0] < w[1]);
             if ok {
@@ -87,10 +125,15 @@ impl Discretizer {
             return Err(DiscretizerError::BadNoise(noise));
         }
         Ok(Self {
-            distance_edges: check("distance_edges", &bins.distance_edges)?,
+            distance_edges: check("distance_edges", &distance_edges(map))?,
             speed_edges: check("speed_edges", &bins.speed_edges)?,
             noise,
         })
+    }
+
+    /// The distance edges in use, m to the goal (`[0, 30, 60]` on the training map).
+    pub fn distance_edges(&self) -> &[f64] {
+        &self.distance_edges
     }
 
     /// Factor sizes `[n_d, n_v, 2, 2]`, in the order of the joint index.

@@ -2,15 +2,20 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use unforeseen_discretizer::{Discretizer, State};
-use unforeseen_sim::{Bins, LightPhase, PedestrianSnapshot, Snapshot};
+use unforeseen_discretizer::{Discretizer, State, distance_edges};
+use unforeseen_sim::{Bins, CrosswalkBins, DistanceEdges, LightPhase, Map, PedestrianSnapshot, Snapshot};
 
-fn paper_bins(noise: f64) -> Bins {
-    Bins {
-        distance_edges: vec![0.0, 30.0, 60.0],
+/// The training intersection with the paper's bins as fixed edges and `noise`.
+fn paper_bins(noise: f64) -> Map {
+    with_bins(Bins {
+        distance_edges: DistanceEdges::Goal(vec![0.0, 30.0, 60.0]),
         speed_edges: vec![1.5, 4.5, 7.5],
         observation_noise: noise,
-    }
+    })
+}
+
+fn with_bins(bins: Bins) -> Map {
+    Map { bins, ..Map::default() }
 }
 
 fn snapshot(distance: f64, speed: f64, light: LightPhase, peds_on: &[bool]) -> Snapshot {
@@ -85,11 +90,11 @@ fn joint_index_matches_the_paper_layout_and_round_trips() {
 #[test]
 fn finer_bins_are_a_map_change() {
     let bins = Bins {
-        distance_edges: (0..8).map(|i| i as f64 * 10.0).collect(),
+        distance_edges: DistanceEdges::Goal((0..8).map(|i| i as f64 * 10.0).collect()),
         speed_edges: vec![1.0, 2.0],
         observation_noise: 0.0,
     };
-    let disc = Discretizer::new(&bins).unwrap();
+    let disc = Discretizer::new(&with_bins(bins)).unwrap();
     assert_eq!(disc.factor_sizes(), [9, 3, 2, 2]);
     assert_eq!(disc.n_states(), 108);
     assert_eq!(disc.distance_bin(75.0), 8);
@@ -102,7 +107,7 @@ fn finer_bins_are_a_map_change() {
 #[test]
 fn bad_edges_and_noise_are_typed_errors() {
     let mut bins = paper_bins(0.0);
-    bins.speed_edges = vec![1.0, 1.0];
+    bins.bins.speed_edges = vec![1.0, 1.0];
     assert!(
         Discretizer::new(&bins)
             .unwrap_err()
@@ -110,7 +115,7 @@ fn bad_edges_and_noise_are_typed_errors() {
             .contains("bins.speed_edges")
     );
     let mut bins = paper_bins(0.0);
-    bins.distance_edges = vec![0.0, f64::NAN];
+    bins.bins.distance_edges = DistanceEdges::Goal(vec![0.0, f64::NAN]);
     assert!(
         Discretizer::new(&bins)
             .unwrap_err()
@@ -145,4 +150,47 @@ fn noise_free_observation_is_the_state_and_the_confusion_model_is_stochastic() {
     let expect = 0.9f64.powi(4);
     let sigma = (expect * (1.0 - expect) / n as f64).sqrt();
     assert!((clean_hits - expect).abs() < 3.0 * sigma, "{clean_hits} vs {expect}");
+}
+
+/// Hand-worked crosswalk-anchored edges: `e1 = near + lead`, `e2 = e1 + max(approach,
+/// v_max·Δt + v_max²/(2b))`.
+#[test]
+fn anchored_edges_follow_the_crosswalk_and_the_car() {
+    // The training intersection: near edge 26 m from the goal; stopping 9 + 81/6 = 22.5 m.
+    let mut map = Map::default();
+    assert_eq!(distance_edges(&map), [0.0, 30.0, 60.0]);
+    // The crosswalk at x = 81 (near edge 11 m), top speed 10.6: stopping 10.6 + 18.73 < 30.
+    map.crosswalk.x = 81.0;
+    map.vehicle.max_speed = 10.6;
+    assert_eq!(distance_edges(&map), [0.0, 15.0, 45.0]);
+    // 11 m/s braking at 2 m/s²: 11 + 121/4 = 41.25 m of approach.
+    map.vehicle.max_speed = 11.0;
+    map.vehicle.max_brake = 2.0;
+    assert_eq!(distance_edges(&map), [0.0, 15.0, 56.25]);
+    // A lead of 0 puts the edge at the near edge (maps/red_light/: [0, 26, 60]).
+    let mut map = Map::default();
+    map.bins.distance_edges = DistanceEdges::Crosswalk(CrosswalkBins {
+        lead: 0.0,
+        approach: 34.0,
+    });
+    assert_eq!(distance_edges(&map), [0.0, 26.0, 60.0]);
+}
+
+/// Wherever the crosswalk and whatever the car, the crosswalk lies wholly in d = 1 and
+/// the approach d = 2 is at least the stopping distance from top speed.
+#[test]
+fn the_crosswalk_is_always_in_d1_and_the_approach_lets_the_car_stop() {
+    let mut map = Map::default();
+    for x in [10.0, 30.0, 45.0, 66.0, 82.0, 87.9] {
+        for (speed, brake) in [(6.0, 5.0), (9.0, 3.0), (11.0, 1.5), (20.0, 0.5)] {
+            map.crosswalk.x = x;
+            map.vehicle.max_speed = speed;
+            map.vehicle.max_brake = brake;
+            let disc = Discretizer::new(&map).unwrap();
+            let (near, far) = map.crosswalk_distance_to_goal();
+            assert_eq!((disc.distance_bin(near), disc.distance_bin(far)), (1, 1), "x {x}");
+            let e = disc.distance_edges();
+            assert!(e[2] - e[1] >= speed + speed * speed / (2.0 * brake) - 1e-9);
+        }
+    }
 }

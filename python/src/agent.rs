@@ -216,7 +216,7 @@ fn load_agent(path: PathBuf) -> PyResult<PyAgent> {
 fn scripted_controller(method: &str, map: &str) -> PyResult<PyController> {
     let m = self::method(method)?;
     let map = crate::maps::load(map, None)?;
-    let sizes = unforeseen_discretizer::Discretizer::new(&map.bins)
+    let sizes = unforeseen_discretizer::Discretizer::new(&map)
         .map_err(errors::to_py)?
         .factor_sizes()
         .to_vec();

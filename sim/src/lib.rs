@@ -38,8 +38,8 @@ pub mod world;
 pub use light::{LightPhase, light_at};
 pub use load::{Diagnostic, MAX_BASE_DEPTH, MAX_FILE_BYTES, MAX_NESTING, MapError};
 pub use map::{
-    Bins, Crosswalk, Episode, Expectation, Light, LightCondition, Map, Offset, Pause, Phase, Reward, Road, Side,
-    SpawnRule, Trigger, Vehicle,
+    Bins, Crosswalk, CrosswalkBins, DistanceEdges, Episode, Expectation, Light, LightCondition, Map, Offset, Pause,
+    Phase, Reward, Road, Side, SpawnRule, Trigger, Vehicle,
 };
 pub use validate::{
     DECISION_DT, MAX_EPISODE_PLANNING, MAX_EPISODE_SUBSTEPS, MAX_JOINT_STATES, MAX_LIST, MAX_METRES, MAX_PEDESTRIANS,

@@ -177,12 +177,101 @@ config_struct! {
     }
 }
 
+/// Where the distance bins' edges lie (the paper's `d` factor, §VI).
+///
+/// Written in a map as a list (`[0.0, 30.0, 60.0]`: edges on the distance to the goal,
+/// the same on every map) or as `Crosswalk(lead: 4.0, approach: 30.0)`: edges derived
+/// from the map's crosswalk and car, so that `d` means the same on every map
+/// (`d = 1` the crosswalk zone, `d = 2` the approach, `d = 3` beyond). The discretizer
+/// derives the edges (`unforeseen_discretizer::distance_edges`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum DistanceEdges {
+    /// Edges on the distance to the goal, m, strictly increasing; `d` = the number of
+    /// edges `e` with distance > `e`.
+    Goal(Vec<f64>),
+    /// Three edges anchored to the crosswalk's near edge.
+    Crosswalk(CrosswalkBins),
+}
+
+/// The crosswalk-anchored distance bins: `d = 1` from `lead` metres before the
+/// crosswalk's near edge to the goal, `d = 2` the approach before it, at least `approach`
+/// metres and at least the car's stopping distance from its top speed with one decision
+/// tick of reaction, `d = 3` beyond.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Crosswalk")]
+pub struct CrosswalkBins {
+    /// Metres before the crosswalk's near edge where `d = 1` starts (>= 0). Default 4.
+    pub lead: f64,
+    /// Shortest length of the approach bin `d = 2`, m (> 0). Default 30.
+    pub approach: f64,
+}
+
+/// A list of numbers is [`DistanceEdges::Goal`]; a struct, named `Crosswalk` or not, is
+/// [`DistanceEdges::Crosswalk`] (its fields checked as the struct's own).
+impl<'de> Deserialize<'de> for DistanceEdges {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct EdgesVisitor;
+        impl<'de> serde::de::Visitor<'de> for EdgesVisitor {
+            type Value = DistanceEdges;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "a list of edges in m to the goal, e.g. [0.0, 30.0, 60.0], or Crosswalk(lead: 4.0, approach: 30.0)",
+                )
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<DistanceEdges, A::Error> {
+                Vec::deserialize(serde::de::value::SeqAccessDeserializer::new(seq)).map(DistanceEdges::Goal)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<DistanceEdges, A::Error> {
+                CrosswalkBins::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(DistanceEdges::Crosswalk)
+            }
+        }
+        deserializer.deserialize_any(EdgesVisitor)
+    }
+}
+
+impl Default for DistanceEdges {
+    /// `Crosswalk(lead: 4.0, approach: 30.0)`: on the training intersection (near edge
+    /// 26 m from the goal) the paper's edges `[0, 30, 60]`.
+    fn default() -> Self {
+        DistanceEdges::Crosswalk(CrosswalkBins {
+            lead: 4.0,
+            approach: 30.0,
+        })
+    }
+}
+
+impl std::fmt::Display for DistanceEdges {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DistanceEdges::Goal(edges) => write!(f, "{edges:?} m to the goal"),
+            DistanceEdges::Crosswalk(c) => write!(
+                f,
+                "anchored to the crosswalk ({} m lead, approach at least {} m)",
+                c.lead, c.approach
+            ),
+        }
+    }
+}
+
+impl DistanceEdges {
+    /// Number of distance bins `n_d` (edges + 1).
+    pub fn bin_count(&self) -> usize {
+        match self {
+            DistanceEdges::Goal(edges) => edges.len() + 1,
+            DistanceEdges::Crosswalk(_) => 4,
+        }
+    }
+}
+
 config_struct! {
     /// Discretizer bins (the paper's d and v factors).
     pub struct Bins / BinsPatch as "Bins" {
-        /// Edges on distance-to-goal, m, strictly increasing; d = number of edges e with D > e.
-        /// Default [0, 30, 60]: d = 0 arrived, 1 within 30 m, 2 30–60 m, 3 beyond 60 m.
-        distance_edges: Vec<f64> = vec![0.0, 30.0, 60.0],
+        /// Distance bins: anchored to the crosswalk (default `Crosswalk(lead: 4.0,
+        /// approach: 30.0)`, the paper's `[0, 30, 60]` on the training intersection) or
+        /// fixed edges on the distance to the goal (`[0.0, 30.0, 60.0]`); see [`DistanceEdges`].
+        distance_edges: DistanceEdges = DistanceEdges::default(),
         /// Edges on speed, m/s, strictly increasing; v = number of edges e with speed >= e.
         /// Default [1.5, 4.5, 7.5].
         speed_edges: Vec<f64> = vec![1.5, 4.5, 7.5],
@@ -687,7 +776,7 @@ impl Map {
         let b = &self.bins;
         let _ = writeln!(
             s,
-            "bins: distance {:?} m, speed {:?} m/s, observation noise {}",
+            "bins: distance {}, speed {:?} m/s, observation noise {}",
             b.distance_edges, b.speed_edges, b.observation_noise
         );
         let w = &self.reward;

@@ -7,7 +7,7 @@
 //! bins give a bounded number of joint states (so the agent's model fits in memory).
 
 use crate::light::LightPhase;
-use crate::map::{Map, Offset, Trigger};
+use crate::map::{DistanceEdges, Map, Offset, Trigger};
 
 /// Largest number of physics sub-steps per decision tick.
 pub const MAX_SUBSTEPS: f64 = 10_000.0;
@@ -456,11 +456,23 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
     }
 
     let b = &map.bins;
-    c.edges("bins.distance_edges", &b.distance_edges, "m");
+    match &b.distance_edges {
+        DistanceEdges::Goal(edges) => c.edges("bins.distance_edges", edges, "m"),
+        DistanceEdges::Crosswalk(cw) => {
+            c.within("bins.distance_edges.lead", cw.lead, (0.0, MAX_METRES), "m", "");
+            c.within(
+                "bins.distance_edges.approach",
+                cw.approach,
+                (f64::MIN_POSITIVE, MAX_METRES),
+                "m",
+                "",
+            );
+        }
+    }
     c.edges("bins.speed_edges", &b.speed_edges, "m/s");
     c.probability("bins.observation_noise", b.observation_noise, true);
-    if b.distance_edges.len() <= MAX_LIST && b.speed_edges.len() <= MAX_LIST {
-        let (nd, nv) = (b.distance_edges.len() + 1, b.speed_edges.len() + 1);
+    if b.distance_edges.bin_count() <= MAX_LIST + 1 && b.speed_edges.len() <= MAX_LIST {
+        let (nd, nv) = (b.distance_edges.bin_count(), b.speed_edges.len() + 1);
         let states = nd * nv * 4;
         if states > MAX_JOINT_STATES {
             let gb = (states * states * 370) as f64 / 1e9;
@@ -535,10 +547,10 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
     let b = &map.bins;
     if e.max_steps >= 1
         && e.max_steps <= MAX_STEPS
-        && b.distance_edges.len() <= MAX_LIST
+        && b.distance_edges.bin_count() <= MAX_LIST + 1
         && b.speed_edges.len() <= MAX_LIST
     {
-        let states = ((b.distance_edges.len() + 1) * (b.speed_edges.len() + 1) * 4) as f64;
+        let states = (b.distance_edges.bin_count() * (b.speed_edges.len() + 1) * 4) as f64;
         let work = f64::from(e.max_steps) * states * states;
         if states <= MAX_JOINT_STATES as f64 && work > MAX_EPISODE_PLANNING {
             c.fail(

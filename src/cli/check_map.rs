@@ -30,7 +30,14 @@ pub fn run(args: CheckMapArgs) -> anyhow::Result<()> {
     for file in &args.files {
         match crate::maps::load_file(file) {
             Ok(map) => {
-                outln!("{}: ok\n{}\n", file.display(), map.summary());
+                let edges = unforeseen_discretizer::Discretizer::new(&map)?
+                    .distance_edges()
+                    .to_vec();
+                outln!(
+                    "{}: ok\n{}distance bins: edges {edges:?} m to the goal\n",
+                    file.display(),
+                    map.summary()
+                );
                 for warning in survivability::check(&map, args.survivability_episodes, args.seed)? {
                     errln!("{}: {warning}\n", file.display());
                 }

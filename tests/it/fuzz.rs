@@ -183,7 +183,7 @@ fn mutated_maps_are_refused_or_run_within_the_limits() {
         };
         accepted += 1;
         // Accepted maps stay within the stated limits...
-        let states = Discretizer::new(&map.bins).expect("valid bins").n_states();
+        let states = Discretizer::new(&map).expect("valid bins").n_states();
         assert!(
             states <= unforeseen_sim::MAX_JOINT_STATES,
             "case {case}: {states} states\n{text}"

@@ -23,9 +23,9 @@ fn load(rel: &str) -> unforeseen_sim::Map {
 #[test]
 fn the_planner_pays_for_entering_the_crosswalk_on_red() {
     let map = load("red_light/intersection.ron");
-    let disc = Discretizer::new(&map.bins).unwrap();
+    let disc = Discretizer::new(&map).unwrap();
     // Edges [0, 26, 60]: d = 1 is (0, 26] m to go, from the near edge (26 m) to the goal.
-    assert_eq!(map.bins.distance_edges, [0.0, 26.0, 60.0]);
+    assert_eq!(disc.distance_edges(), [0.0, 26.0, 60.0]);
     assert_eq!(entered_bins(&map, &disc), [1]);
     let rule = red_light_cost(&map, &disc, 1.0).expect("the rule with an edge at the near edge");
     assert_eq!(rule.cost, 100.0, "-red_light / tau_c nats");
@@ -62,7 +62,7 @@ fn the_planner_pays_for_entering_the_crosswalk_on_red() {
 fn maps_without_the_rule_or_without_the_edge_keep_the_papers_preferences() {
     for name in ["intersection", "jaywalk", "stuck_green", "slow_walker"] {
         let map = unforeseen::maps::load(name).unwrap();
-        let disc = Discretizer::new(&map.bins).unwrap();
+        let disc = Discretizer::new(&map).unwrap();
         let r = state_rewards(&map, &disc);
         // Only the goal and the crash risk, as in the paper (§VI).
         assert!(
@@ -74,7 +74,7 @@ fn maps_without_the_rule_or_without_the_edge_keep_the_papers_preferences() {
     // The rule with the default bins: d = 1 holds 4 m before the crosswalk, so no state
     // says the car has entered, and R(s) stays the rule-free one bit for bit.
     let mut map = unforeseen::maps::load("intersection").unwrap();
-    let disc = Discretizer::new(&map.bins).unwrap();
+    let disc = Discretizer::new(&map).unwrap();
     let free = state_rewards(&map, &disc);
     map.reward.red_light = -100.0;
     assert!(entered_bins(&map, &disc).is_empty());

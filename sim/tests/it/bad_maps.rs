@@ -83,6 +83,26 @@ fn non_increasing_bin_edges_are_rejected() {
 }
 
 #[test]
+fn bad_crosswalk_anchored_bins_are_rejected() {
+    let (_, lines) = reject("Map(bins: (distance_edges: Crosswalk(lead: -1.0, approach: 0.0)))");
+    assert!(has(&lines, &["bins.distance_edges.lead", "below"]), "{lines:?}");
+    assert!(
+        has(&lines, &["bins.distance_edges.approach", "greater than 0"]),
+        "{lines:?}"
+    );
+    let (file, lines) = reject("Map(bins: (distance_edges: Crosswalk(lead: 4.0, aproach: 30.0)))");
+    assert!(
+        lines[0].starts_with(&format!("{file}:1:")) && has(&lines, &["aproach", "approach"]),
+        "{lines:?}"
+    );
+    let (_, lines) = reject("Map(bins: (distance_edges: 30.0))");
+    assert!(
+        has(&lines, &["bins.distance_edges", "Crosswalk(lead: 4.0, approach: 30.0)"]),
+        "{lines:?}"
+    );
+}
+
+#[test]
 fn every_unknown_field_is_listed() {
     let (_, lines) =
         reject("Map(\n  road: (lane_widht: 3.5),\n  colour: \"red\",\n  pedestrians: [(speeed: (1.0, 1.2))],\n)");
