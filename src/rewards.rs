@@ -3,7 +3,8 @@
 //! of its planning model, and a one-line description of a map's reward. The per-tick
 //! reward the env pays is [`unforeseen_env::RewardTerms`].
 
-use unforeseen_agent::model::TransitionCost;
+use unforeseen_agent::maths::log_softmax;
+use unforeseen_agent::model::{CrashModel, TransitionCost};
 use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::Map;
 
@@ -81,6 +82,65 @@ pub fn state_rewards(map: &Map, disc: &Discretizer) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// The crosswalk's crash model for planning (beyond the paper; docs/ARCHITECTURE.md §4.3):
+/// from a state with a pedestrian on the crosswalk and the car in a crosswalk bin, a tick
+/// of action `u` ends in a collision with probability
+///
+/// ```text
+/// hazard[u][s] = min(1, distance the car covers in the tick / (v_max Δt))
+/// ```
+///
+/// the distance from the middle of the state's speed bin (the top bin's middle is
+/// between its edge and the top speed) under `u`: maintain `v Δt`; speed up to
+/// `min(v_max, v + a Δt)`, `Δt (v + v') / 2`; slow down, `Δt (v + v') / 2` with
+/// `v' = v - b Δt`, or `v² / 2b` when the car stops within the tick. A car at top speed
+/// crashes for sure (the paper's crash-risk state); a slower one, or one that brakes,
+/// less. A crashed episode is worth the crash penalty and the goal it forfeits,
+/// `R = crash - goal`, on the scale of `C = log_softmax(R / τ_c)`; the hazard states
+/// themselves are worth what a state without reward is.
+pub fn crash_model(map: &Map, disc: &Discretizer, tau_c: f64) -> CrashModel {
+    let zone = crosswalk_bins(map, disc);
+    let v = &map.vehicle;
+    let dt = map.episode.decision_dt;
+    let edges = &map.bins.speed_edges;
+    let middle = |bin: usize| -> f64 {
+        let lo = if bin == 0 { 0.0 } else { edges[bin - 1] };
+        let hi = edges.get(bin).copied().unwrap_or(v.max_speed.max(lo));
+        (lo + hi) / 2.0
+    };
+    let distance = |speed: f64, u: usize| -> f64 {
+        match u {
+            1 => (speed + (speed + v.max_accel * dt).min(v.max_speed.max(speed))) / 2.0 * dt,
+            2 if speed <= v.max_brake * dt => speed * speed / (2.0 * v.max_brake),
+            2 => (2.0 * speed - v.max_brake * dt) / 2.0 * dt,
+            _ => speed * dt,
+        }
+    };
+    let full = v.max_speed * dt;
+    let hazard = (0..3)
+        .map(|u| {
+            (0..disc.n_states())
+                .map(|s| {
+                    let st = disc.decode(s);
+                    if st.p == 1 && zone.contains(&st.d) {
+                        (distance(middle(st.v), u) / full).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    // C = R / τ_c - ln Z over the states: the same ln Z places the two new values.
+    let scaled: Vec<f64> = state_rewards(map, disc).iter().map(|r| r / tau_c).collect();
+    let ln_z = scaled[0] - log_softmax(&scaled)[0];
+    CrashModel {
+        hazard,
+        crashed: (map.reward.crash - map.reward.goal) / tau_c - ln_z,
+        neutral: -ln_z,
+    }
 }
 
 /// The red-light rule as the planner's preference over transitions (docs/ARCHITECTURE.md

@@ -17,7 +17,7 @@ use unforeseen_sim::{Action, Map};
 
 use crate::error::Error;
 use crate::progress::{NoProgress, Progress};
-use crate::rewards::{red_light_cost, state_rewards, terminal_states};
+use crate::rewards::{crash_model, red_light_cost, state_rewards, terminal_states};
 use crate::seeds::episode_seed;
 
 /// Everything training needs besides the map.
@@ -176,6 +176,7 @@ pub fn train_with_progress(
     model.set_preferences(&state_rewards(map, &disc), cfg.tau_c)?;
     model.set_terminal_states(&terminal_states(map, &disc))?;
     model.set_transition_cost(red_light_cost(map, &disc, cfg.tau_c))?;
+    model.set_crash_model(Some(crash_model(map, &disc, cfg.tau_c)))?;
     let mut meta = BTreeMap::new();
     meta.insert("map".into(), map.name.clone());
     meta.insert("episodes".into(), cfg.episodes.to_string());

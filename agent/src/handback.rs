@@ -73,10 +73,18 @@ impl HandBack {
     /// that of every state that does not end the episode. A model without terminal states
     /// has none, and its habit is never found at risk.
     pub fn new(model: &WorldModel) -> HandBack {
-        let gm = model.generative();
+        // The planning model's preferences: with a crash model its hazard states are
+        // neither terminal nor crashes; the crash is a transition (`crash_risk`).
+        let gm = model.planning_generative();
         let n = gm.n_states();
         let preference = |s: usize| -> f64 { (0..gm.n_obs()).map(|o| gm.a[(o, s)] * gm.c[o]).sum() };
-        let terminal = model.terminal_states();
+        let hazard = gm.crash.as_ref().map(|c| c.hazard_states()).unwrap_or_default();
+        let terminal: Vec<usize> = model
+            .terminal_states()
+            .iter()
+            .copied()
+            .filter(|s| !hazard.contains(s))
+            .collect();
         let floor = (0..n)
             .filter(|s| !terminal.contains(s))
             .map(preference)
@@ -110,10 +118,18 @@ impl HandBack {
         then: &[usize],
         horizon: usize,
     ) -> f64 {
-        if self.harmful.is_empty() || horizon == 0 {
+        if (self.harmful.is_empty() && plan.crash.is_none()) || horizon == 0 {
             return 0.0;
         }
-        root.transition_into(first, q, &mut self.x, &mut self.scratch);
+        // With a crash model, the part of the belief that crashes in a tick leaves it.
+        let mut crashed = 0.0;
+        match &plan.crash {
+            Some(cm) => {
+                crashed += cm.split(first, q, &mut self.masked);
+                root.transition_into(first, &self.masked, &mut self.x, &mut self.scratch);
+            }
+            None => root.transition_into(first, q, &mut self.x, &mut self.scratch),
+        }
         for _ in 1..horizon {
             self.y.fill(0.0);
             for u in 0..plan.n_actions() {
@@ -121,7 +137,9 @@ impl HandBack {
                 for (s, m) in self.masked.iter_mut().enumerate() {
                     *m = if then[s] == u && self.x[s] != 0.0 {
                         any = true;
-                        self.x[s]
+                        let hit = plan.crash.as_ref().map_or(0.0, |cm| self.x[s] * cm.hazard[u][s]);
+                        crashed += hit;
+                        self.x[s] - hit
                     } else {
                         0.0
                     };
@@ -133,13 +151,14 @@ impl HandBack {
             }
             std::mem::swap(&mut self.x, &mut self.y);
         }
-        self.harmful.iter().map(|&s| self.x[s]).sum()
+        crashed + self.harmful.iter().map(|&s| self.x[s]).sum::<f64>()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::CrashModel;
     use crate::params::ModelPriors;
     use crate::structure::Structure;
 
@@ -171,6 +190,41 @@ mod tests {
         let q = vec![1.0 / 64.0; 64];
         let gm = plain.generative();
         assert_eq!(hb.crash_risk(gm, gm, &q, 0, &[0; 64], 3), 0.0);
+    }
+
+    /// With a crash model the hazard state is no longer harmful (it is not a crash) and
+    /// the risk is the mass that crashes: from the hazard state, `h` in the first tick,
+    /// then `h` of what stays there.
+    #[test]
+    fn the_crash_model_risk_is_the_crashed_mass() {
+        let mut w = toy();
+        let st = w.structure().clone();
+        let harm = st.encode(&[1, 1, 1, 1]);
+        let mut hazard = vec![vec![0.0; 64]; 3];
+        for h in &mut hazard {
+            h[harm] = 0.25;
+        }
+        let crash = CrashModel {
+            hazard,
+            crashed: -100.0,
+            neutral: -50.0,
+        };
+        w.set_crash_model(Some(crash)).unwrap();
+        w.plan_with_crash_model(true);
+        let mut hb = HandBack::new(&w);
+        assert!(hb.harmful().is_empty());
+        let mut q = vec![0.0; 64];
+        q[harm] = 1.0;
+        let (root, plan) = (w.generative(), w.planning_generative());
+        let one = hb.crash_risk(root, plan, &q, 0, &[0; 64], 1);
+        assert!((one - 0.25).abs() < 1e-12, "{one}");
+        // Two ticks: 0.25, then 0.25 of the 0.75 that survived and is still (by B) there.
+        let root_stay = root.b[0][(harm, harm)];
+        let two = hb.crash_risk(root, plan, &q, 0, &[0; 64], 2);
+        assert!((two - (0.25 + 0.25 * 0.75 * root_stay)).abs() < 1e-12, "{two}");
+        // Without planning with it, the paper's harmful state is back.
+        w.plan_with_crash_model(false);
+        assert_eq!(HandBack::new(&w).harmful(), &[harm]);
     }
 
     #[test]

@@ -38,6 +38,9 @@ pub struct GenerativeModel {
     /// A preference over transitions, beside `C` (docs/ARCHITECTURE.md §4.3): planning adds
     /// its expected cost to every step's `G`.
     pub transition_cost: Option<TransitionCost>,
+    /// The crash hazard planning uses in place of absorbing crash-risk states
+    /// ([`CrashModel`]; only on the planning model, and only when the agent plans with it).
+    pub crash: Option<CrashModel>,
     /// Initial state prior `D`.
     pub d: Vec<f64>,
     /// The same `B[u]` as per-factor steps (§II-A), when the model came from a factored
@@ -63,6 +66,55 @@ pub struct TransitionCost {
     pub cost: f64,
 }
 
+/// The crosswalk's crash model (beyond the paper; docs/ARCHITECTURE.md §4.3): the
+/// probability that one tick ends in a collision, per action and state, and what a crashed
+/// episode is worth to the planner.
+///
+/// The paper's planner treats a pedestrian on the crosswalk while the car moves in the
+/// crosswalk's distance bin as a crash, whatever the car does, so braking there earns
+/// nothing and dashing to the goal looks like the shortest way out. With this model the
+/// crash happens on a transition: a tick from a state with `hazard[u][s] > 0` ends in a
+/// collision with that probability, which grows with the distance the car covers in the
+/// tick under `u`; the crashed mass leaves the drive (it can reach nothing else) and is
+/// worth `crashed` nats of preference for the rest of the horizon.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrashModel {
+    /// Per action, per state: the probability in [0, 1] that a tick ends in a collision.
+    pub hazard: Vec<Vec<f64>>,
+    /// The log preference of a crashed episode, on the scale of `C` (nats).
+    pub crashed: f64,
+    /// The log preference planning gives the hazard states themselves (where the paper's
+    /// model has its crash preference): that of a state with no reward, on `C`'s scale.
+    pub neutral: f64,
+}
+
+impl CrashModel {
+    /// States with a hazard under some action.
+    pub fn hazard_states(&self) -> Vec<usize> {
+        let n = self.hazard.first().map_or(0, Vec::len);
+        (0..n).filter(|&s| self.hazard.iter().any(|h| h[s] > 0.0)).collect()
+    }
+
+    /// The mass of belief `x` that crashes in one tick of `u`: `Σ_s x[s] hazard[u][s]`,
+    /// and `survive = x ⊙ (1 - hazard[u])`.
+    pub fn split(&self, u: usize, x: &[f64], survive: &mut [f64]) -> f64 {
+        let mut crashed = 0.0;
+        for ((out, xs), h) in survive.iter_mut().zip(x).zip(&self.hazard[u]) {
+            let hit = xs * h;
+            crashed += hit;
+            *out = xs - hit;
+        }
+        crashed
+    }
+
+    /// The risk term of a crashed mass `m`, `m (ln m - crashed)`: the crashed episode as
+    /// one more outcome of the step's KL risk (Prop. 1).
+    pub fn risk(&self, m: f64) -> f64 {
+        if m > 0.0 { m * (ln(m) - self.crashed) } else { 0.0 }
+    }
+}
+
 impl GenerativeModel {
     /// Build from `A`, `B`, `C` (already normalised log preferences) and `D`, computing
     /// the derived quantities. Shapes are the caller's responsibility (see `inspect`).
@@ -84,6 +136,7 @@ impl GenerativeModel {
             ln_b_t,
             c,
             transition_cost: None,
+            crash: None,
             d,
             factored: None,
             log_factored: None,
@@ -159,6 +212,8 @@ struct WorldModelRepr {
     terminal: Vec<usize>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     transition_cost: Option<TransitionCost>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    crash: Option<CrashModel>,
 }
 
 /// A `DMatrix` stored as nalgebra writes it, `(data, nrows, ncols)` in column-major
@@ -286,6 +341,30 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
             ));
         }
     }
+    if let Some(c) = &r.crash {
+        check_crash(c, n, r.n_actions)?;
+    }
+    Ok(())
+}
+
+/// A crash model fits `n` states and `n_actions` actions, with probabilities in [0, 1] and
+/// finite preferences.
+fn check_crash(c: &CrashModel, n: usize, n_actions: usize) -> Result<(), FieldError> {
+    check::len("crash.hazard", c.hazard.len(), n_actions, "one row per action")?;
+    for (u, h) in c.hazard.iter().enumerate() {
+        check::len(&format!("crash.hazard[{u}]"), h.len(), n, "one probability per state")?;
+        if let Some(s) = h.iter().position(|p| !(0.0..=1.0).contains(p)) {
+            return Err(FieldError::new(
+                format!("crash.hazard[{u}][{s}]"),
+                format!("{} is not a probability in [0, 1]", h[s]),
+            ));
+        }
+    }
+    for (name, v) in [("crash.crashed", c.crashed), ("crash.neutral", c.neutral)] {
+        if !v.is_finite() {
+            return Err(FieldError::new(name, format!("{v} is not finite")));
+        }
+    }
     Ok(())
 }
 
@@ -304,6 +383,10 @@ pub struct WorldModel {
     d_counts: Vec<f64>,
     /// Episode-ending states, absorbing in the planning model.
     terminal: Vec<usize>,
+    /// The crash model of the map the agent was trained on, if it has one.
+    crash: Option<CrashModel>,
+    /// Whether planning uses [`WorldModel::crash_model`] (not serialised; set by the agent).
+    plan_crash: bool,
     /// Persistence pooling of one factor (not serialised; set by the agent that uses it).
     pooling: Option<Pooling>,
     gm: GenerativeModel,
@@ -323,6 +406,7 @@ impl From<WorldModel> for WorldModelRepr {
             d_counts: w.d_counts,
             terminal: w.terminal,
             transition_cost: w.gm.transition_cost,
+            crash: w.crash,
         }
     }
 }
@@ -337,6 +421,8 @@ impl TryFrom<WorldModelRepr> for WorldModel {
             gm,
             gm_plan: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], vec![], vec![]),
             terminal: r.terminal,
+            crash: r.crash,
+            plan_crash: false,
             pooling: None,
             d_counts: r.d_counts,
             structure: r.structure,
@@ -463,6 +549,8 @@ impl WorldModel {
             gm: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], c, vec![]),
             gm_plan: GenerativeModel::new(DMatrix::zeros(0, 0), vec![], vec![], vec![]),
             terminal: Vec::new(),
+            crash: None,
+            plan_crash: false,
             pooling: None,
             d_counts: d,
             structure,
@@ -546,16 +634,30 @@ impl WorldModel {
         let rule = self.gm.transition_cost.take();
         let mut d = self.d_counts.clone();
         crate::maths::normalize_in_place(&mut d);
+        // Planning with the crash hazard: its states are neither absorbing nor crashes.
+        let crash = self.crash.as_ref().filter(|_| self.plan_crash);
+        let hazard_states = crash.map(CrashModel::hazard_states).unwrap_or_default();
+        let absorbing: Vec<usize> = self
+            .terminal
+            .iter()
+            .copied()
+            .filter(|s| !hazard_states.contains(s))
+            .collect();
         let mut b_plan = b.clone();
         for m in &mut b_plan {
-            for &s in &self.terminal {
+            for &s in &absorbing {
                 m.column_mut(s).fill(0.0);
                 m[(s, s)] = 1.0;
             }
         }
-        self.gm_plan = GenerativeModel::new(a.clone(), b_plan, c.clone(), d.clone());
+        let mut c_plan = c.clone();
+        if let Some(cm) = crash {
+            hazard_states.iter().for_each(|&s| c_plan[s] = cm.neutral);
+        }
+        self.gm_plan = GenerativeModel::new(a.clone(), b_plan, c_plan, d.clone());
         self.gm_plan.transition_cost.clone_from(&rule);
-        self.gm_plan.factored = factored.as_ref().map(|ft| ft.with_terminal(&self.terminal));
+        self.gm_plan.crash = crash.cloned();
+        self.gm_plan.factored = factored.as_ref().map(|ft| ft.with_terminal(&absorbing));
         // Perception's messages through ln B factor by factor, when no entry of B is under
         // the log floor (then the per-factor sum is the floored ln B up to rounding).
         let log_factored = if b.iter().all(|m| m.iter().all(|p| *p >= LN_FLOOR)) {
@@ -755,8 +857,34 @@ impl WorldModel {
         }
         let scaled: Vec<f64> = rewards.iter().map(|r| r / tau_c).collect();
         self.gm.c = log_softmax(&scaled);
-        self.gm_plan.c = self.gm.c.clone();
+        self.materialize();
         Ok(())
+    }
+
+    /// Set (or clear) the crash model of the map the agent is trained on ([`CrashModel`];
+    /// docs/ARCHITECTURE.md §4.3). Planning uses it only after
+    /// [`WorldModel::plan_with_crash_model`]. Re-materializes.
+    pub fn set_crash_model(&mut self, crash: Option<CrashModel>) -> Result<(), AgentError> {
+        if let Some(c) = &crash {
+            check_crash(c, self.n_states(), self.n_actions)?;
+        }
+        self.crash = crash;
+        self.materialize();
+        Ok(())
+    }
+
+    /// The crash model, if the agent was trained with one.
+    pub fn crash_model(&self) -> Option<&CrashModel> {
+        self.crash.as_ref()
+    }
+
+    /// Plan with the crash model (`true`, where the model has one) or with the paper's
+    /// crash-risk states (`false`, the default). Re-materializes when it changes.
+    pub fn plan_with_crash_model(&mut self, on: bool) {
+        if self.plan_crash != on {
+            self.plan_crash = on;
+            self.materialize();
+        }
     }
 
     /// Set (or, with `None`, clear) the preference over transitions planning adds to `G`

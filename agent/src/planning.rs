@@ -81,6 +81,7 @@ pub fn efe_brute_force(gm: &GenerativeModel, q_t: &[f64], policy: &[usize]) -> f
     let mut next = vec![0.0; n];
     let mut obuf = vec![0.0; gm.n_obs()];
     let mut g = 0.0;
+    let mut crashed = 0.0;
     for u in policy {
         if let Some(t) = &gm.transition_cost {
             // The step's cost straight from its definition, state pair by state pair.
@@ -90,10 +91,17 @@ pub fn efe_brute_force(gm: &GenerativeModel, q_t: &[f64], policy: &[usize]) -> f
                 }
             }
         }
+        if let Some(cm) = &gm.crash {
+            // Straight from the definition: each state's hazard leaves the drive.
+            for (j, x) in s.iter_mut().enumerate() {
+                crashed += *x * cm.hazard[*u][j];
+                *x *= 1.0 - cm.hazard[*u][j];
+            }
+        }
         axpy_columns(gm.b[*u].as_slice(), n, &s, &mut next);
         std::mem::swap(&mut s, &mut next);
         let (r, a) = step_efe(gm, &s, &mut obuf);
-        g += r + a;
+        g += r + a + gm.crash.as_ref().map_or(0.0, |cm| cm.risk(crashed));
     }
     g
 }
@@ -148,12 +156,18 @@ pub struct EfeTree {
     /// prediction.
     masked: Vec<f64>,
     masked_next: Vec<f64>,
+    /// The part of a belief that does not crash in the step ([`crate::model::CrashModel`]).
+    survive: Vec<f64>,
+    /// `crashed[k]`: the mass that crashed in the first k steps of the current branch.
+    crashed: Vec<f64>,
     /// `q_t` of the last evaluation (the root), for [`EfeTree::evaluate_reusing`].
     memo_root: Vec<f64>,
     /// Per internal node (depths 1..H-1, breadth-first): its predicted belief...
     memo_s: Vec<f64>,
-    /// ...and its accumulated `G`.
+    /// ...its accumulated `G`...
     memo_g: Vec<f64>,
+    /// ...and its crashed mass.
+    memo_c: Vec<f64>,
     /// Whether the memo describes the last evaluation.
     memo_valid: bool,
     /// `G(π)` per policy, lexicographic.
@@ -183,9 +197,12 @@ impl EfeTree {
             scratch: vec![0.0; n_states],
             masked: vec![0.0; n_states],
             masked_next: vec![0.0; n_states],
+            survive: vec![0.0; n_states],
+            crashed: vec![0.0; horizon + 1],
             memo_root: vec![0.0; n_states],
             memo_s: vec![0.0; internal * n_states],
             memo_g: vec![0.0; internal],
+            memo_c: vec![0.0; internal],
             memo_valid: false,
             g: vec![0.0; np],
             q_pi: vec![0.0; np],
@@ -256,13 +273,26 @@ impl EfeTree {
         let n = self.n_states;
         let step_model = if depth == 0 { root } else { gm };
         for u in 0..self.n_actions {
-            {
-                let (lo, hi) = self.bufs.split_at_mut(depth + 1);
-                step_model.transition_into(u, &lo[depth], &mut hi[0], &mut self.scratch);
-            }
+            let (lo, hi) = self.bufs.split_at_mut(depth + 1);
+            // With a crash model the crashing part of the belief leaves the drive first.
+            let hit = match &gm.crash {
+                Some(cm) => {
+                    let hit = cm.split(u, &lo[depth], &mut self.survive);
+                    step_model.transition_into(u, &self.survive, &mut hi[0], &mut self.scratch);
+                    hit
+                }
+                None => {
+                    step_model.transition_into(u, &lo[depth], &mut hi[0], &mut self.scratch);
+                    0.0
+                }
+            };
+            self.crashed[depth + 1] = self.crashed[depth] + hit;
             self.matvecs += 1;
             let (r, a) = step_efe(gm, &self.bufs[depth + 1], &mut self.obuf);
             let mut g = g_acc + r + a;
+            if let Some(cm) = &gm.crash {
+                g += cm.risk(self.crashed[depth + 1]);
+            }
             if step_model.transition_cost.is_some() {
                 g += step_model.transition_cost_of(
                     u,
@@ -280,13 +310,23 @@ impl EfeTree {
             if reuse {
                 // Internal nodes are numbered breadth-first: depth d starts after U + ... + U^(d-1).
                 let node = (1..depth + 1).map(|k| self.n_actions.pow(k as u32)).sum::<usize>() + child;
-                let (ms, mg) = (&mut self.memo_s[node * n..(node + 1) * n], &mut self.memo_g[node]);
-                if self.memo_valid && mg.to_bits() == g.to_bits() && same_bits(ms, &self.bufs[depth + 1]) {
+                let (ms, mg, mc) = (
+                    &mut self.memo_s[node * n..(node + 1) * n],
+                    &mut self.memo_g[node],
+                    &mut self.memo_c[node],
+                );
+                let crashed = self.crashed[depth + 1];
+                if self.memo_valid
+                    && mg.to_bits() == g.to_bits()
+                    && mc.to_bits() == crashed.to_bits()
+                    && same_bits(ms, &self.bufs[depth + 1])
+                {
                     self.reused += self.below(depth + 1);
                     continue;
                 }
                 ms.copy_from_slice(&self.bufs[depth + 1]);
                 *mg = g;
+                *mc = crashed;
             }
             self.recurse(gm, root, depth + 1, g, child, reuse);
         }

@@ -22,8 +22,8 @@ use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{
-    ActionSelection, CheckedScaledParams, GateBaseline, GateLearning, GateMode, HandBackRule, ReasoningMode, RootStep,
-    ScaledParams, ScalingMode,
+    ActionSelection, CheckedScaledParams, CrashPlanning, GateBaseline, GateLearning, GateMode, HandBackRule,
+    ReasoningMode, RootStep, ScaledParams, ScalingMode,
 };
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s_into};
@@ -183,6 +183,7 @@ impl<H: Habit> ScaledAgent<H> {
             params.planning.persistence_ignores.as_str(),
         ));
         model.set_persistence_pooling(pooling)?;
+        model.plan_with_crash_model(params.planning.crash_model == CrashPlanning::Hazard);
         let n = model.n_states();
         let na = model.n_actions();
         if crate::limits::policies(na, params.planning.horizon).is_none() {

@@ -137,7 +137,8 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
 /// tree's first step that matters (EXPERIMENTS.md, item 6): the braking car enters the
 /// crash-risk state (d = 1, still moving) and, with the planning model absorbing from
 /// the root on (`root_step=absorbing`), every action from there ends alike; that planner
-/// loses episodes here, which shows the test sees the difference.
+/// loses episodes here, which shows the test sees the difference. (With the crash model,
+/// the default, no state is a crash and the root step does not matter here.)
 #[test]
 fn scaled_waits_for_the_slow_walker() {
     let bundle = common::bundle();
@@ -148,6 +149,8 @@ fn scaled_waits_for_the_slow_walker() {
     };
     assert_eq!(success(&ScaledParams::default()), 1.0);
     let mut absorbing = ScaledParams::default();
+    absorbing.planning.crash_model = unforeseen_agent::params::CrashPlanning::States;
+    assert_eq!(success(&absorbing), 1.0);
     absorbing.planning.root_step = unforeseen_agent::params::RootStep::Absorbing;
     assert!(
         success(&absorbing) < 1.0,

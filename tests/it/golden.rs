@@ -16,7 +16,7 @@ use unforeseen::protocol::Protocol;
 use unforeseen::runner::{EpisodeResult, Tick};
 use unforeseen::seeds::content_hash;
 use unforeseen::training::{TimeoutAs, train};
-use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::params::{CrashPlanning, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 
 fn bits(x: f64) -> String {
@@ -74,6 +74,10 @@ fn push_episode(out: &mut String, result: &EpisodeResult, ticks: &[Tick]) {
 fn agent_digest(bundle: &AgentBundle) -> String {
     let mut bundle = bundle.clone();
     bundle.meta.clear();
+    // The tables of before: the crash model (docs/ARCHITECTURE.md §4.3) is an addition,
+    // whose own values `crosswalk::hazards_by_hand` checks.
+    assert!(bundle.world_model.crash_model().is_some());
+    bundle.world_model.set_crash_model(None).unwrap();
     content_hash(bundle.to_ron_string().as_bytes())
 }
 
@@ -118,6 +122,14 @@ fn digests(bundle: &AgentBundle) -> [String; 4] {
     digests_with(bundle, &ScaledParams::default())
 }
 
+/// [`digests`] planning with the paper's crash-risk states (`crash_model = states`, the
+/// ablation), which decides as the code before the crash model did.
+fn digests_of_before(bundle: &AgentBundle) -> [String; 4] {
+    let mut params = ScaledParams::default();
+    params.planning.crash_model = CrashPlanning::States;
+    digests_with(bundle, &params)
+}
+
 /// [`digests`] with the scaled agent's parameters `params`.
 fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
     [
@@ -134,6 +146,7 @@ fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
 fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
     let mut params = ScaledParams::default();
     params.set_str("handback", "theta").unwrap();
+    params.planning.crash_model = CrashPlanning::States;
     assert_eq!(digests_with(common::bundle(), &params), GOLDEN_THETA_HANDBACK);
 }
 
@@ -146,7 +159,7 @@ fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
     let mut cfg = common::small_config(7);
     cfg.timeout_as = TimeoutAs::Termination;
     let (bundle, _) = train(&map, &cfg).unwrap();
-    assert_eq!(digests(&bundle), GOLDEN_TIMEOUT_AS_TERMINATION);
+    assert_eq!(digests_of_before(&bundle), GOLDEN_TIMEOUT_AS_TERMINATION);
 }
 
 /// The default training (time-outs truncate: the learners bootstrap through them). None of
@@ -157,7 +170,15 @@ fn trained_agent_and_decisions_are_unchanged() {
     let map = unforeseen::maps::load("intersection").unwrap();
     let (_, log) = train(&map, &common::small_config(7)).unwrap();
     assert_eq!(log.timeouts, 0);
-    assert_eq!(digests(common::bundle()), GOLDEN);
+    assert_eq!(digests_of_before(common::bundle()), GOLDEN);
+}
+
+/// The default plans with the crash model (docs/ARCHITECTURE.md §4.3): the same agent
+/// tables; the episodes change where the planner reasons (digests recorded when the
+/// crash model became the default).
+#[test]
+fn the_crash_model_decisions_are_recorded() {
+    assert_eq!(digests(common::bundle()), GOLDEN_CRASH_MODEL);
 }
 
 /// On a map whose episodes often time out (the tiny map: 12 ticks), the two settings
@@ -196,6 +217,14 @@ const GOLDEN_TIMEOUT_AS_TERMINATION: [&str; 4] = [
 
 /// Digests of [`trained_agent_and_decisions_are_unchanged`].
 const GOLDEN: [&str; 4] = GOLDEN_TIMEOUT_AS_TERMINATION;
+
+/// Digests of [`the_crash_model_decisions_are_recorded`].
+const GOLDEN_CRASH_MODEL: [&str; 4] = [
+    "10356990b4c98627",
+    "a82992ccf57b2219",
+    "edd28553a6b36eb0",
+    "69af290d4e23083f",
+];
 
 /// Digests of [`the_theta_handback_ablation_reproduces_the_decisions_of_before`]: those of
 /// the code before the safe hand-back (the default's, [`GOLDEN`], until then), with the

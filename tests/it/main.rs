@@ -7,6 +7,7 @@ mod cli;
 mod common;
 mod compare_determinism;
 mod corrupt_agent_files;
+mod crosswalk;
 mod doc_paths;
 mod end_to_end;
 mod figures;

@@ -87,8 +87,19 @@ fn learning_loses_no_crowd_episode_that_the_full_agent_without_learning_survives
 /// Per episode of a continual run of the shared test agent on `map` with hand-back rule
 /// `handback`, per tick: (reasoned, declined, θ, a pedestrian on the crosswalk).
 fn continual_ticks(map: &unforeseen_sim::Map, handback: &str, episodes: u64) -> Vec<Vec<(bool, bool, f64, bool)>> {
+    continual_ticks_with(map, &[("handback", handback)], episodes)
+}
+
+/// [`continual_ticks`] with the parameters `settings` (key, value) changed.
+fn continual_ticks_with(
+    map: &unforeseen_sim::Map,
+    settings: &[(&str, &str)],
+    episodes: u64,
+) -> Vec<Vec<(bool, bool, f64, bool)>> {
     let mut params = ScaledParams::default();
-    params.set_str("handback", handback).unwrap();
+    for (key, value) in settings {
+        params.set_str(key, value).unwrap();
+    }
     let mut agent = scaled_agent(common::bundle(), params).unwrap();
     let mut env = Env::new(map, EnvConfig::default()).unwrap();
     (0..episodes)
@@ -128,10 +139,10 @@ fn triggers_only_learning_made_go_to_a_safe_habit() {
 }
 
 /// Reasoning ticks over 40 continual episodes on `map` (a file or an embedded name) whose
-/// true state has nobody on the crosswalk, with hand-back rule `handback`.
-fn empty_road_reasoning(map: &str, handback: &str) -> usize {
+/// true state has nobody on the crosswalk, with the parameters `settings` changed.
+fn empty_road_reasoning(map: &str, settings: &[(&str, &str)]) -> usize {
     let map = unforeseen::maps::load(map).unwrap();
-    let episodes = continual_ticks(&map, handback, 40);
+    let episodes = continual_ticks_with(&map, settings, 40);
     episodes
         .iter()
         .flatten()
@@ -141,11 +152,17 @@ fn empty_road_reasoning(map: &str, handback: &str) -> usize {
 
 /// `decline-learned` (issue 20's "no reasoning on ticks without a pedestrian"): over 40
 /// continual episodes the agent never reasons with nobody on the crosswalk, on the training
-/// map and on slow_walker, where `risk-checked` does (it takes the reasoning learning made
-/// wherever the check finds the habit at risk).
+/// map and on slow_walker, under either crash model, where `risk-checked` with the paper's
+/// crash-risk states does (it takes the reasoning learning made wherever the check finds
+/// the habit at risk).
 #[test]
 fn decline_learned_never_reasons_on_an_empty_road() {
-    assert_eq!(empty_road_reasoning("intersection", "decline-learned"), 0);
-    assert_eq!(empty_road_reasoning("maps/slow_walker.ron", "decline-learned"), 0);
-    assert!(empty_road_reasoning("maps/slow_walker.ron", "risk-checked") > 0);
+    for crash in ["hazard", "states"] {
+        for map in ["intersection", "maps/slow_walker.ron"] {
+            let settings = [("handback", "decline-learned"), ("crash_model", crash)];
+            assert_eq!(empty_road_reasoning(map, &settings), 0, "{map}, {crash}");
+        }
+    }
+    let settings = [("handback", "risk-checked"), ("crash_model", "states")];
+    assert!(empty_road_reasoning("maps/slow_walker.ron", &settings) > 0);
 }

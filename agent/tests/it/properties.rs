@@ -7,7 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use unforeseen_agent::learning::{update_a, update_cpts, update_nu};
 use unforeseen_agent::maths::{kl, log_softmax};
-use unforeseen_agent::model::{GenerativeModel, WorldModel};
+use unforeseen_agent::model::{CrashModel, GenerativeModel, WorldModel};
 use unforeseen_agent::params::ModelPriors;
 use unforeseen_agent::perception::{VmpWorkspace, free_energy, neg_log_evidence, vmp};
 use unforeseen_agent::planning::{EfeTree, efe_brute_force, policies, step_efe, step_efe_long_form};
@@ -88,6 +88,36 @@ proptest! {
             bayes_step(&gm, obs[0], &gm.d, &mut exact);
             for (a, b) in exact.iter().zip(&qs[0]) { prop_assert!((a - b).abs() < 1e-8); }
         }
+    }
+
+    /// With a crash model (docs/ARCHITECTURE.md §4.3) the prefix tree still equals the
+    /// brute-force rollout, and a hazard of zero everywhere changes no bit of `G`.
+    #[test]
+    fn crash_model_tree_equals_brute_force(seed in any::<u64>(), h in 1usize..4, gamma in 0.1f64..16.0) {
+        let plain = random_model(seed);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(2));
+        let q = dist(&mut rng, plain.n_states());
+        let (ns, nu) = (plain.n_states(), plain.n_actions());
+        let floor = plain.c.iter().copied().fold(f64::INFINITY, f64::min);
+        let crash = |hazard: Vec<Vec<f64>>| CrashModel { hazard, crashed: floor - 5.0, neutral: floor };
+        let mut zero = plain.clone();
+        zero.crash = Some(crash(vec![vec![0.0; ns]; nu]));
+        let mut gm = plain.clone();
+        gm.crash = Some(crash((0..nu).map(|_| (0..ns).map(|_| rng.random::<f64>()).collect()).collect()));
+        let (mut t_plain, mut t_zero, mut t_crash) = (
+            EfeTree::new(ns, plain.n_obs(), nu, h),
+            EfeTree::new(ns, plain.n_obs(), nu, h),
+            EfeTree::new(ns, plain.n_obs(), nu, h),
+        );
+        t_plain.evaluate(&plain, &plain, &q, gamma);
+        t_zero.evaluate(&zero, &zero, &q, gamma);
+        t_crash.evaluate(&gm, &gm, &q, gamma);
+        for (i, p) in policies(nu, h).iter().enumerate() {
+            prop_assert_eq!(t_zero.g[i].to_bits(), t_plain.g[i].to_bits());
+            let bf = efe_brute_force(&gm, &q, p);
+            prop_assert!((bf - t_crash.g[i]).abs() < 1e-9, "tree {} brute force {}", t_crash.g[i], bf);
+        }
+        prop_assert!(is_dist(&t_crash.psi));
     }
 
     #[test]
