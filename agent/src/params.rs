@@ -238,17 +238,17 @@ pub enum RootStep {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum CrashPlanning {
-    /// Beyond the paper: a tick in the crosswalk zone with a pedestrian on the crosswalk
-    /// ends in a crash with a probability that grows with the distance the car covers
-    /// under the action, and a crashed episode forfeits the goal
-    /// ([`crate::model::CrashModel`]); braking there earns what it saves. Agents without
-    /// a crash model plan as `states`.
+    /// The paper's model: every state with a pedestrian on the crosswalk while the car
+    /// moves in the crosswalk's distance bin is a crash, absorbing, whatever the car does.
     #[default]
-    Hazard,
-    /// Ablation (the paper's model): every state with a pedestrian on the crosswalk while
-    /// the car moves in the crosswalk's distance bin is a crash, absorbing, whatever the
-    /// car does.
     States,
+    /// Beyond the paper, an option: a tick in the crosswalk zone with a pedestrian on the
+    /// crosswalk ends in a crash with a probability that grows with the distance the car
+    /// covers under the action, and a crashed episode forfeits the goal
+    /// ([`crate::model::CrashModel`]); braking there earns what it saves, also where the
+    /// car is already on the crosswalk and stopping there is what gets it hit
+    /// (EXPERIMENTS.md). Agents without a crash model plan as `states`.
+    Hazard,
 }
 
 /// Hyperparameters of the paper's agent ([`crate::scaled::ScaledAgent`]), grouped by the
@@ -277,7 +277,7 @@ pub enum CrashPlanning {
 /// | `planning` | `gamma` γ | 0.5 | finite and > 0 | Cor. 1 q(π) = σ(-γG), §VI |
 /// | `planning` | `horizon` H | 3 | 1..=8 | policy length (n_actions^H policies, Prop. 1) |
 /// | `planning` | `root_step` | `learned` | `learned`, `absorbing` | the EFE tree's first step uses the learned `B`, later steps the absorbing planning model ([`RootStep`]; `absorbing` absorbs from the root on) |
-/// | `planning` | `crash_model` | `hazard` | `hazard`, `states` | a crash at the crosswalk is a transition whose probability grows with the distance the car covers, and forfeits the goal (beyond the paper; `states`: the paper's absorbing crash-risk states) ([`CrashPlanning`]) |
+/// | `planning` | `crash_model` | `states` | `states`, `hazard` | the paper's absorbing crash-risk states, or a crash as a transition whose probability grows with the distance the car covers, forfeiting the goal (beyond the paper) ([`CrashPlanning`]) |
 /// | `planning` | `persistence_ignores` | `"d+L"` | next-time parents' names joined by `+`, or `""` (also written `none`) | the watched factor's persistence (rows where it was present) is pooled over these parents in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
 /// | `scaling` | `varsigma` ς | 0.05 | finite and >= 0 | eq. "stopping_criterion", §VI |
 /// | `scaling` | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
@@ -408,7 +408,7 @@ impl Default for PlanningParams {
             gamma: 0.5,
             horizon: 3,
             root_step: RootStep::Learned,
-            crash_model: CrashPlanning::Hazard,
+            crash_model: CrashPlanning::States,
             persistence_ignores: "d+L".into(),
         }
     }

@@ -30,13 +30,13 @@ pub fn run(args: CheckMapArgs) -> anyhow::Result<()> {
     for file in &args.files {
         match crate::maps::load_file(file) {
             Ok(map) => {
-                let edges = unforeseen_discretizer::Discretizer::new(&map)?
-                    .distance_edges()
-                    .to_vec();
+                let disc = unforeseen_discretizer::Discretizer::new(&map)?;
+                let edges: Vec<String> = disc.distance_edges().iter().map(|e| format!("{e:.3}")).collect();
                 outln!(
-                    "{}: ok\n{}distance bins: edges {edges:?} m to the goal\n",
+                    "{}: ok\n{}distance bins: edges [{}] m to the goal\n",
                     file.display(),
-                    map.summary()
+                    map.summary(),
+                    edges.join(", ")
                 );
                 for warning in survivability::check(&map, args.survivability_episodes, args.seed)? {
                     errln!("{}: {warning}\n", file.display());

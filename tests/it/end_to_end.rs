@@ -138,7 +138,7 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
 /// crash-risk state (d = 1, still moving) and, with the planning model absorbing from
 /// the root on (`root_step=absorbing`), every action from there ends alike; that planner
 /// loses episodes here, which shows the test sees the difference. (With the crash model,
-/// the default, no state is a crash and the root step does not matter here.)
+/// `crash_model = hazard`, no state is a crash and the root step does not matter here.)
 #[test]
 fn scaled_waits_for_the_slow_walker() {
     let bundle = common::bundle();
@@ -148,9 +148,10 @@ fn scaled_waits_for_the_slow_walker() {
         Aggregate::of(&evaluate(&map, agent.as_mut(), Method::Scaled, 10, 7, &NoProgress).unwrap()).success_rate
     };
     assert_eq!(success(&ScaledParams::default()), 1.0);
+    let mut hazard = ScaledParams::default();
+    hazard.planning.crash_model = unforeseen_agent::params::CrashPlanning::Hazard;
+    assert_eq!(success(&hazard), 1.0);
     let mut absorbing = ScaledParams::default();
-    absorbing.planning.crash_model = unforeseen_agent::params::CrashPlanning::States;
-    assert_eq!(success(&absorbing), 1.0);
     absorbing.planning.root_step = unforeseen_agent::params::RootStep::Absorbing;
     assert!(
         success(&absorbing) < 1.0,

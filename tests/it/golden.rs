@@ -122,14 +122,6 @@ fn digests(bundle: &AgentBundle) -> [String; 4] {
     digests_with(bundle, &ScaledParams::default())
 }
 
-/// [`digests`] planning with the paper's crash-risk states (`crash_model = states`, the
-/// ablation), which decides as the code before the crash model did.
-fn digests_of_before(bundle: &AgentBundle) -> [String; 4] {
-    let mut params = ScaledParams::default();
-    params.planning.crash_model = CrashPlanning::States;
-    digests_with(bundle, &params)
-}
-
 /// [`digests`] with the scaled agent's parameters `params`.
 fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
     [
@@ -146,7 +138,6 @@ fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
 fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
     let mut params = ScaledParams::default();
     params.set_str("handback", "theta").unwrap();
-    params.planning.crash_model = CrashPlanning::States;
     assert_eq!(digests_with(common::bundle(), &params), GOLDEN_THETA_HANDBACK);
 }
 
@@ -159,7 +150,7 @@ fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
     let mut cfg = common::small_config(7);
     cfg.timeout_as = TimeoutAs::Termination;
     let (bundle, _) = train(&map, &cfg).unwrap();
-    assert_eq!(digests_of_before(&bundle), GOLDEN_TIMEOUT_AS_TERMINATION);
+    assert_eq!(digests(&bundle), GOLDEN_TIMEOUT_AS_TERMINATION);
 }
 
 /// The default training (time-outs truncate: the learners bootstrap through them). None of
@@ -170,15 +161,17 @@ fn trained_agent_and_decisions_are_unchanged() {
     let map = unforeseen::maps::load("intersection").unwrap();
     let (_, log) = train(&map, &common::small_config(7)).unwrap();
     assert_eq!(log.timeouts, 0);
-    assert_eq!(digests_of_before(common::bundle()), GOLDEN);
+    assert_eq!(digests(common::bundle()), GOLDEN);
 }
 
-/// The default plans with the crash model (docs/ARCHITECTURE.md §4.3): the same agent
-/// tables; the episodes change where the planner reasons (digests recorded when the
-/// crash model became the default).
+/// Planning with the crash model (`crash_model = hazard`, docs/ARCHITECTURE.md §4.3): the
+/// same agent tables; the episodes change where the planner reasons (digests recorded
+/// when the option was added).
 #[test]
 fn the_crash_model_decisions_are_recorded() {
-    assert_eq!(digests(common::bundle()), GOLDEN_CRASH_MODEL);
+    let mut params = ScaledParams::default();
+    params.planning.crash_model = CrashPlanning::Hazard;
+    assert_eq!(digests_with(common::bundle(), &params), GOLDEN_CRASH_MODEL);
 }
 
 /// On a map whose episodes often time out (the tiny map: 12 ticks), the two settings
