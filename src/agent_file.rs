@@ -108,7 +108,7 @@ fn check_intersection(bundle: &AgentBundle) -> Result<(), (String, String)> {
 /// Checks that `bundle` can drive `map`: the world model's factor sizes are the ones the
 /// map's bins give (the same joint state space, factor by factor).
 pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> Result<(), Error> {
-    let disc = Discretizer::new(&map)?;
+    let disc = Discretizer::new(map)?;
     let agent = bundle.world_model.structure().sizes();
     let map_sizes = disc.factor_sizes();
     if agent != map_sizes {

@@ -122,7 +122,7 @@ pub fn evaluate_scripted(
     seed: u64,
     progress: &dyn Progress,
 ) -> Result<Vec<EpisodeResult>, Error> {
-    let sizes = Discretizer::new(&map)?.factor_sizes();
+    let sizes = Discretizer::new(map)?.factor_sizes();
     let make = || {
         method
             .scripted_controller_for(&sizes, map)?

@@ -118,7 +118,7 @@ impl BrakeOnPedestrian {
     /// reward has the red-light rule ([`RedLightStop::of`], with the map's bins).
     pub fn for_map(sizes: &[usize], map: &Map) -> Result<Self, Error> {
         let mut c = Self::new(sizes)?;
-        let disc = Discretizer::new(&map)?;
+        let disc = Discretizer::new(map)?;
         if disc.factor_sizes() == c.sizes {
             c.red_light = RedLightStop::of(map, &disc);
         }

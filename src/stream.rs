@@ -268,7 +268,7 @@ pub fn evaluate_stream(
         match bundle {
             Some(b) => method.controller_for(b, params, map),
             None => {
-                let sizes = unforeseen_discretizer::Discretizer::new(&map)?.factor_sizes();
+                let sizes = unforeseen_discretizer::Discretizer::new(map)?.factor_sizes();
                 method
                     .scripted_controller_for(&sizes, map)?
                     .ok_or_else(|| crate::error::Error::NotScripted {

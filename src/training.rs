@@ -124,7 +124,7 @@ pub fn train_with_progress(
     cfg: &TrainConfig,
     progress: &dyn Progress,
 ) -> Result<(AgentBundle, TrainLog), Error> {
-    let disc = Discretizer::new(&map)?;
+    let disc = Discretizer::new(map)?;
     let n = disc.n_states();
     let n_actions = Action::ALL.len();
     let mut q = QLearning::try_new(n, n_actions, cfg.q.clone())?;

@@ -234,7 +234,7 @@ impl Env {
     /// An env of `map` (as returned by the map loaders, so already validated) observing
     /// as `config` says. Call [`Env::reset`] before stepping.
     pub fn new(map: &Map, config: EnvConfig) -> Result<Env, EnvError> {
-        let disc = Discretizer::new(&map).map_err(|source| EnvError::Bins {
+        let disc = Discretizer::new(map).map_err(|source| EnvError::Bins {
             map: map.name.clone(),
             source,
         })?;
