@@ -1,28 +1,34 @@
 //! Build script: a fingerprint of the source that determines a trained agent (the sim,
 //! discretizer, env and agent crates, the training loop, the rewards and the locked
-//! dependency versions), so the agent cache of `--train-seeds` (src/agents.rs) never
-//! serves an agent trained by different code; and one of all the source that determines
-//! results (the same plus the whole `src/`), so that `batch --resume` never mixes lines
-//! of two programs (src/batch.rs, `RunIdentity`).
+//! dependency versions), so the agent cache of `--train-seeds`
+//! (harness/src/training/seed_agents.rs) never serves an agent trained by different
+//! code; and one of all the source that determines results (the same plus the whole
+//! harness, `harness/src/`), so that `batch --resume` never mixes lines of two programs
+//! (harness/src/runs/batch/identity.rs, `RunIdentity`).
 
 use std::path::{Path, PathBuf};
 
-/// Sources whose contents determine training.
+/// Sources whose contents determine training, relative to the repository's root.
 const INPUTS: &[&str] = &[
     "sim/src",
     "discretizer/src",
     "env/src",
     "agent/src",
-    "src/training.rs",
-    "src/rewards.rs",
+    "harness/src/training/mod.rs",
+    "harness/src/episodes/rewards.rs",
     "Cargo.lock",
 ];
 
 /// Further sources whose contents determine evaluation results.
-const RESULT_INPUTS: &[&str] = &["src"];
+const RESULT_INPUTS: &[&str] = &["harness/src"];
 
 fn main() {
-    let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    // This crate is `harness/` of the repository; paths are hashed relative to its root.
+    let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    let root = manifest
+        .parent()
+        .expect("harness/ lies in the repository")
+        .to_path_buf();
     let training = fingerprint(&root, INPUTS);
     println!("cargo:rustc-env=UNFORESEEN_TRAINING_FINGERPRINT={training:016x}");
     let all: Vec<&str> = INPUTS.iter().chain(RESULT_INPUTS).copied().collect();
@@ -36,7 +42,7 @@ fn main() {
 fn fingerprint(root: &Path, inputs: &[&str]) -> u64 {
     let mut files = Vec::new();
     for input in inputs {
-        println!("cargo:rerun-if-changed={input}");
+        println!("cargo:rerun-if-changed={}", root.join(input).display());
         collect(&root.join(input), &mut files);
     }
     files.sort();

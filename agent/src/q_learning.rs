@@ -172,11 +172,6 @@ impl QLearning {
     pub fn decay_epsilon(&mut self) {
         self.epsilon = (self.epsilon * self.params.epsilon_decay).max(self.params.epsilon_min);
     }
-
-    /// Set the exploration rate directly (e.g. a custom schedule).
-    pub fn set_epsilon(&mut self, epsilon: f64) {
-        self.epsilon = epsilon.clamp(0.0, 1.0);
-    }
 }
 
 impl Controller for QLearning {

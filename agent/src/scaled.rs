@@ -343,10 +343,6 @@ impl<H: Habit> ScaledAgent<H> {
     pub fn last_surprise_history(&self) -> &[f64] {
         &self.hist_surprise
     }
-    /// Whether each tick of the current (or last) episode reasoned.
-    pub fn reasoned_history(&self) -> &[bool] {
-        &self.hist_reasoned
-    }
     /// Whether each tick of the current (or last) episode reasoned because the hand-back
     /// check refused to hand the state to the habit ([`crate::handback`]).
     pub fn refused_history(&self) -> &[bool] {

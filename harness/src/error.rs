@@ -3,8 +3,9 @@
 //! file, a map, a flag, a results file), and say what is wrong and how to fix it; the
 //! others are failures of the machine or of a component (a file that cannot be written,
 //! an episode the env refused, a learner that cannot be built). [`Error::is_user_input`]
-//! tells them apart; only the command line ([`crate::cli`]) turns an error into a message
-//! and an exit code. The errors of other crates keep their own types and messages inside
+//! tells them apart, and [`crate::user_input::in_chain`] over a chain of causes; only the fronts
+//! (the command line, the Python package) turn an error into a message and an exit code
+//! or an exception. The errors of other crates keep their own types and messages inside
 //! it (map errors, [`unforeseen_env::EnvError`], [`unforeseen_agent::error::AgentError`], ...).
 
 use std::path::PathBuf;
@@ -34,6 +35,18 @@ pub enum Error {
         problem: String,
         /// How to fix it.
         fix: String,
+    },
+    /// A value out of its allowed range, named by its field (`episodes`,
+    /// `train_episodes`, ...); a front adds its own spelling of the field (a flag, a
+    /// keyword argument) where it needs one.
+    #[error("{field} {value}: expected {expected}")]
+    OutOfRange {
+        /// The field, e.g. `episodes`.
+        field: String,
+        /// The value given.
+        value: String,
+        /// What is allowed, e.g. `1..=1000000`.
+        expected: String,
     },
     /// A command-line value: `--set`, `--obs` and the like.
     #[error("{flag}: {problem}")]
@@ -111,7 +124,7 @@ pub enum Error {
     Env(#[from] unforeseen_env::EnvError),
     /// An episode could not run (the controller chose an action the env refused).
     #[error(transparent)]
-    Episode(#[from] crate::runner::EpisodeError),
+    Episode(#[from] crate::episodes::runner::EpisodeError),
     /// A learner or an agent could not be built from its parameters and sizes.
     #[error(transparent)]
     Learner(#[from] unforeseen_agent::error::AgentError),
@@ -153,6 +166,7 @@ impl Error {
             Error::AgentFile { .. }
             | Error::Agent { .. }
             | Error::Flag { .. }
+            | Error::OutOfRange { .. }
             | Error::Results { .. }
             | Error::NotRegularFile { .. }
             | Error::DuplicateScenario { .. }

@@ -6,9 +6,9 @@
 use std::path::Path;
 use unforeseen_sim::{Diagnostic, Map, MapError, embedded};
 
+use crate::episodes::methods::Method;
+use crate::episodes::protocol::Protocol;
 pub use crate::error::MapLookupError;
-use crate::methods::Method;
-use crate::protocol::Protocol;
 
 /// Loads `arg` as a map file if such a path exists, else as an embedded map name
 /// (with or without `.ron`).

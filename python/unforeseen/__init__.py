@@ -132,7 +132,7 @@ def rollout(
     def make() -> Controller:
         if agent is None:
             return scripted_controller(method, map)
-        return agent.controller(method, **params)
+        return agent.controller(method, map, **params)
 
     controller = make()
     results = []

@@ -11,14 +11,14 @@ use unforeseen_discretizer::{Discretizer, State};
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::{Action, Map};
 
-use crate::agent_file::check_compatible;
+use crate::episodes::methods::Method;
+use crate::episodes::metrics::Aggregate;
+use crate::episodes::protocol::Protocol;
+use crate::episodes::runner::{EpisodeResult, EpisodeSeeds, Tick, run_episode};
 use crate::error::Error;
-use crate::methods::Method;
-use crate::metrics::Aggregate;
 use crate::progress::Progress;
-use crate::protocol::Protocol;
-use crate::runner::{EpisodeResult, EpisodeSeeds, Tick, run_episode};
 use crate::seeds::episode_seed;
+use crate::training::agent_file::check_compatible;
 
 /// Seeds of evaluation episode `episode` of `method` on `map`: the world seed depends
 /// on the map and episode only (every method meets the same pedestrians), the
@@ -71,7 +71,7 @@ pub fn evaluate_under(
     progress: &dyn Progress,
 ) -> Result<Vec<EpisodeResult>, Error> {
     check_compatible(bundle, map)?;
-    let make = || method.controller_for(bundle, params, map);
+    let make = || method.controller(bundle, params, map);
     evaluate_with(protocol, map, method, params, &make, episodes, seed, progress)
 }
 
@@ -125,7 +125,7 @@ pub fn evaluate_scripted(
     let sizes = Discretizer::new(&map.bins)?.factor_sizes();
     let make = || {
         method
-            .scripted_controller_for(&sizes, map)?
+            .scripted_controller(&sizes, map)?
             .ok_or_else(|| Error::NotScripted {
                 method: method.to_string(),
             })
@@ -202,7 +202,7 @@ pub fn trace(
 ) -> Result<(EpisodeResult, Vec<Tick>), Error> {
     let mut env = Env::new(map, EnvConfig::default())?;
     check_compatible(bundle, map)?;
-    let mut controller = method.controller_for(bundle, params, map)?;
+    let mut controller = method.controller(bundle, params, map)?;
     if protocol.effective(method, params) == Protocol::Continual {
         for ep in 0..episode {
             run_episode(&mut env, controller.as_mut(), eval_seeds(seed, map, method, ep), false)?;
@@ -223,7 +223,7 @@ pub struct LearnPoint {
     /// Episode index (0 = first encounter).
     pub episode: u64,
     /// The map the episode ran on (one map for a map's curve; the stream's draw for a
-    /// stream's, [`crate::stream::learn_stream`]).
+    /// stream's, [`crate::runs::stream::learn_stream`]).
     pub map: String,
     /// The gate's surprise in bits on the first tick of the episode with a pedestrian on
     /// the crosswalk under a green light (Fig. 9a; None if that never happened).
@@ -276,7 +276,7 @@ pub fn learn_over(
         envs.push(Env::new(map, EnvConfig::default())?);
     }
     let discs: Vec<Discretizer> = envs.iter().map(|e| e.discretizer().clone()).collect();
-    let mut agent = crate::methods::scaled_agent(bundle, {
+    let mut agent = crate::episodes::methods::scaled_agent(bundle, {
         let mut p = params.clone();
         p.learning.enabled = true;
         p
@@ -343,4 +343,80 @@ fn pedestrian_on_green_d2(agent: &ScaledAgent) -> Option<f64> {
         })
         .collect::<Option<Vec<usize>>>()?;
     Some(gate.probability(1, &values))
+}
+
+/// The report of one method evaluated on one map (eval.json), built by [`evaluate_map`]
+/// alone, which the command line and the Python package both call.
+#[derive(Debug, Clone, Serialize)]
+pub struct EvalReport {
+    /// The method.
+    pub method: Method,
+    /// The map's name.
+    pub map: String,
+    /// The protocol asked.
+    pub protocol: Protocol,
+    /// The protocol the results hold for: zero-shot for a method that does not learn
+    /// across episodes, whatever was asked ([`Protocol::effective`]).
+    pub computed_under: Protocol,
+    /// Evaluation seed (episode seeds derive from it).
+    pub seed: u64,
+    /// The training seed the agent file records (null for a scripted method, or an
+    /// agent file that does not say).
+    pub train_seed: Option<String>,
+    /// The map's reward settings.
+    pub reward: unforeseen_sim::Reward,
+    /// The figures over every episode.
+    pub aggregate: Aggregate,
+    /// Every episode, in order.
+    pub episodes: Vec<EpisodeResult>,
+}
+
+impl EvalReport {
+    /// The report as eval.json holds it: a JSON object with its keys sorted at every
+    /// level (the layout eval.json has always had).
+    pub fn document(&self) -> Result<serde_json::Value, Error> {
+        Ok(serde_json::to_value(self)?)
+    }
+}
+
+/// Evaluates `method` on `map` for `episodes` episodes from `seed` under `protocol`, as
+/// one phase of `progress`, and reports it ([`EvalReport`]): a scripted reference
+/// ([`Method::REFERENCE`]) needs no agent and ignores `bundle`; every other method runs
+/// the agent `bundle` with the scaled agent's parameters `params`, and without one is an
+/// [`Error::Agent`].
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_map(
+    map: &Map,
+    method: Method,
+    protocol: Protocol,
+    bundle: Option<&AgentBundle>,
+    params: &ScaledParams,
+    episodes: u64,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<EvalReport, Error> {
+    let (results, train_seed) = match (method.is_scripted(), bundle) {
+        (true, _) => (evaluate_scripted(map, method, episodes, seed, progress)?, None),
+        (false, Some(b)) => (
+            evaluate_under(protocol, map, b, params, method, episodes, seed, progress)?,
+            b.meta.get("seed").cloned(),
+        ),
+        (false, None) => {
+            return Err(Error::Agent {
+                problem: format!("{method} needs a trained agent"),
+                fix: "give an agent file, or train one first".into(),
+            });
+        }
+    };
+    Ok(EvalReport {
+        method,
+        map: map.name.clone(),
+        protocol,
+        computed_under: protocol.effective(method, params),
+        seed,
+        train_seed,
+        reward: map.reward.clone(),
+        aggregate: Aggregate::of(&results),
+        episodes: results,
+    })
 }

@@ -7,8 +7,8 @@ use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_sim::Map;
 
+use crate::episodes::reference::{BrakeOnPedestrian, NeverBrake};
 use crate::error::Error;
-use crate::reference::{BrakeOnPedestrian, NeverBrake};
 
 /// A method (or ablation) the runner can drive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
@@ -36,10 +36,10 @@ pub enum Method {
     /// Scripted reference (not a method of the paper): slows down while a pedestrian is
     /// on the crosswalk and the car has not arrived, else speeds up; never reasons,
     /// never learns. Whether it survives a map says whether the map is survivable
-    /// ([`crate::reference::BrakeOnPedestrian`]).
+    /// ([`crate::episodes::reference::BrakeOnPedestrian`]).
     BrakeOnPedestrian,
     /// Scripted reference: always speeds up. Whether it is hit says whether a map is
-    /// dangerous ([`crate::reference::NeverBrake`]).
+    /// dangerous ([`crate::episodes::reference::NeverBrake`]).
     NeverBrake,
 }
 
@@ -67,7 +67,7 @@ impl Method {
         Method::ScaledOneStepGate,
         Method::ScaledGateLearnsAll,
     ];
-    /// The scripted references ([`crate::reference`]): the careful driver and the car
+    /// The scripted references ([`crate::episodes::reference`]): the careful driver and the car
     /// that never brakes. They need no trained agent.
     pub const REFERENCE: [Method; 2] = [Method::BrakeOnPedestrian, Method::NeverBrake];
 
@@ -199,51 +199,31 @@ impl Method {
         Method::REFERENCE.contains(&self)
     }
 
-    /// A fresh scripted controller for observations of factor sizes `sizes`
-    /// (`[n_d, n_v, n_L, n_p]`), or `None` for a method that needs a trained agent.
-    /// [`Method::controller`] builds its scripted methods here, with the sizes of the
-    /// bundle's world model; callers without an agent (`check-map`, `eval` without
-    /// `--agent`) pass the map discretizer's sizes.
-    /// Without a map, `brake-on-pedestrian` ignores the light
-    /// ([`Method::scripted_controller_for`] gives the witness of a map).
-    pub fn scripted_controller(self, sizes: &[usize]) -> Result<Option<Box<dyn Controller>>, Error> {
+    /// A fresh scripted controller for episodes on `map`, for observations of factor
+    /// sizes `sizes` (`[n_d, n_v, n_L, n_p]`), or `None` for a method that needs a
+    /// trained agent: `brake-on-pedestrian` also stops for red where the map's reward
+    /// has the red-light rule ([`BrakeOnPedestrian::for_map`]). [`Method::controller`]
+    /// builds its scripted methods here, with the sizes of the bundle's world model;
+    /// callers without an agent (`check-map`, `eval` without `--agent`, Python's
+    /// `scripted_controller`) pass the map discretizer's sizes. The map is required, so
+    /// no front can build the witness without the map's rule.
+    pub fn scripted_controller(self, sizes: &[usize], map: &Map) -> Result<Option<Box<dyn Controller>>, Error> {
         Ok(match self {
-            Method::BrakeOnPedestrian => Some(Box::new(BrakeOnPedestrian::new(sizes)?)),
+            Method::BrakeOnPedestrian => Some(Box::new(BrakeOnPedestrian::for_map(sizes, map)?)),
             Method::NeverBrake => Some(Box::new(NeverBrake)),
             _ => None,
         })
     }
 
-    /// [`Method::scripted_controller`] for episodes on `map`: `brake-on-pedestrian` also
-    /// stops for red where the map's reward has the red-light rule
-    /// ([`BrakeOnPedestrian::for_map`]).
-    pub fn scripted_controller_for(self, sizes: &[usize], map: &Map) -> Result<Option<Box<dyn Controller>>, Error> {
-        Ok(match self {
-            Method::BrakeOnPedestrian => Some(Box::new(BrakeOnPedestrian::for_map(sizes, map)?)),
-            _ => self.scripted_controller(sizes)?,
-        })
-    }
-
-    /// [`Method::controller`] for episodes on `map` (the scripted witness follows the
-    /// map's red-light rule; every other method is the same).
-    pub fn controller_for(
+    /// Builds a fresh controller of this method from the trained bundle for episodes on
+    /// `map` (the scripted references take only the factor sizes of its world model, and
+    /// the witness follows the map's red-light rule: [`Method::scripted_controller`]).
+    pub fn controller(
         self,
         bundle: &AgentBundle,
         params: &ScaledParams,
         map: &Map,
     ) -> Result<Box<dyn Controller>, Error> {
-        if self.is_scripted() {
-            let sizes = bundle.world_model.structure().sizes();
-            return Ok(self
-                .scripted_controller_for(&sizes, map)?
-                .expect("scripted_controller_for builds every scripted method"));
-        }
-        self.controller(bundle, params)
-    }
-
-    /// Builds a fresh controller of this method from the trained bundle (the scripted
-    /// references take only the factor sizes of its world model).
-    pub fn controller(self, bundle: &AgentBundle, params: &ScaledParams) -> Result<Box<dyn Controller>, Error> {
         let scaled = |params: ScaledParams| -> Result<Box<dyn Controller>, Error> {
             Ok(Box::new(scaled_agent(bundle, params)?))
         };
@@ -267,7 +247,7 @@ impl Method {
             Method::ScaledGateLearnsAll => ablation(|p| p.gate.gate_learning = GateLearning::Every)?,
             Method::BrakeOnPedestrian | Method::NeverBrake => {
                 let sizes = bundle.world_model.structure().sizes();
-                self.scripted_controller(&sizes)?
+                self.scripted_controller(&sizes, map)?
                     .expect("scripted_controller builds every scripted method")
             }
         })

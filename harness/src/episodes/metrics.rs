@@ -2,7 +2,7 @@
 //! inference rate (share of ticks that ran planning) and measured reasoning time; and
 //! red-light violations per episode (the traffic rule, not in the paper).
 
-use crate::runner::EpisodeResult;
+use crate::episodes::runner::EpisodeResult;
 
 /// Aggregate over a set of episodes of one method on one map.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]

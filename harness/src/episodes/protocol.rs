@@ -12,7 +12,7 @@
 use serde::{Deserialize, Serialize};
 use unforeseen_agent::params::ScaledParams;
 
-use crate::methods::Method;
+use crate::episodes::methods::Method;
 
 /// How test episodes relate to each other.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

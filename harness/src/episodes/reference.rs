@@ -16,8 +16,8 @@
 //! witness: `check-map` has no trained agent, so its witness has to be scripted; and a
 //! trained Q-table is a weaker witness anyway (whether it brakes depends on its seed
 //! and on the light), while the warning is about the map's physics and timing. Making
-//! it a [`crate::methods::Method`] lets `batch` report both witnesses from ordinary
-//! units and print the same warnings as `check-map` ([`crate::survivability`]).
+//! it a [`crate::episodes::methods::Method`] lets `batch` report both witnesses from ordinary
+//! units and print the same warnings as `check-map` ([`crate::episodes::survivability`]).
 //!
 //! Both decode the observation index `s = ((d*n_v + v)*2 + L)*2 + p` (docs/ARCHITECTURE.md §3)
 //! with the factor sizes they are built with.
@@ -60,7 +60,7 @@ fn decision(action: Action) -> Decision {
 pub struct RedLightStop {
     /// The distance bin just before (farther from the goal than) the crosswalk's bins.
     pub approach: Option<usize>,
-    /// The distance bins that overlap the crosswalk ([`crate::rewards::crosswalk_bins`]).
+    /// The distance bins that overlap the crosswalk ([`crate::episodes::rewards::crosswalk_bins`]).
     pub crosswalk: Vec<usize>,
 }
 
@@ -70,7 +70,7 @@ impl RedLightStop {
         if map.reward.red_light >= 0.0 {
             return None;
         }
-        let crosswalk = crate::rewards::crosswalk_bins(map, disc);
+        let crosswalk = crate::episodes::rewards::crosswalk_bins(map, disc);
         let last = *crosswalk.last()?;
         let n_d = disc.factor_sizes()[0];
         Some(Self {
@@ -123,12 +123,6 @@ impl BrakeOnPedestrian {
             c.red_light = RedLightStop::of(map, &disc);
         }
         Ok(c)
-    }
-
-    /// The same witness stopping for red by `rule` (or not, for `None`).
-    pub fn with_red_light(mut self, rule: Option<RedLightStop>) -> Self {
-        self.red_light = rule;
-        self
     }
 
     /// The action for joint observation `obs`: slow down iff p = 1 and d >= 1, or the

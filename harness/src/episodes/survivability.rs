@@ -1,6 +1,6 @@
 //! Is a scenario a fair unforeseen test (§VI)? The jaywalk test means something only if
 //! a careful driver survives it and a careless one does not. Two scripted witnesses
-//! ([`crate::reference`]) answer that without any trained agent:
+//! ([`crate::episodes::reference`]) answer that without any trained agent:
 //!
 //! * **survivable**: [`Method::BrakeOnPedestrian`] succeeds in at least
 //!   [`SURVIVABLE_MIN_SUCCESS`] (99%) of the episodes;
@@ -11,15 +11,15 @@
 //!
 //! `check-map` measures both on every map with pedestrian rules; `batch` checks its
 //! brake-on-pedestrian and never-brake units. Both report the same warnings (returned
-//! here; the command line prints them on stderr) and neither changes the exit code. Episodes use [`crate::experiments::eval_seeds`], so `check-map
+//! here; the command line prints them on stderr) and neither changes the exit code. Episodes use [`crate::episodes::experiments::eval_seeds`], so `check-map
 //! --seed S` and `batch --seed S` meet the same pedestrians and report the same figures.
 
 use unforeseen_sim::Map;
 
+use crate::episodes::experiments::evaluate_scripted;
+use crate::episodes::methods::Method;
+use crate::episodes::metrics::Aggregate;
 use crate::error::Error;
-use crate::experiments::evaluate_scripted;
-use crate::methods::Method;
-use crate::metrics::Aggregate;
 use crate::progress::NoProgress;
 
 /// Lowest success rate of brake-on-pedestrian for a map to count as survivable.
@@ -67,7 +67,7 @@ impl Witness {
 }
 
 /// Runs `episodes` episodes of a scripted `method` on `map` (in parallel; seeded by
-/// [`crate::experiments::eval_seeds`], so the result does not depend on the number of threads).
+/// [`crate::episodes::experiments::eval_seeds`], so the result does not depend on the number of threads).
 pub fn witness(map: &Map, method: Method, episodes: u64, seed: u64) -> Result<Witness, Error> {
     let results = evaluate_scripted(map, method, episodes, seed, &NoProgress)?;
     Ok(Witness::of(&Aggregate::of(&results)))

@@ -24,10 +24,10 @@ use unforeseen_agent::scaled::ScaledAgent;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::Map;
 
+use crate::episodes::experiments::eval_seeds;
+use crate::episodes::methods::Method;
+use crate::episodes::runner::run_episode;
 use crate::error::Error;
-use crate::experiments::eval_seeds;
-use crate::methods::Method;
-use crate::runner::run_episode;
 
 /// One recorded episode.
 #[derive(Debug, Clone, PartialEq)]

@@ -13,7 +13,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 use crate::error::Error;
-use crate::report::write_atomic;
+use crate::reports::files::write_atomic;
 
 /// What the drawing functions return.
 type Result<T> = std::result::Result<T, Error>;
@@ -589,7 +589,12 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, Option<f64>, bool, S
 /// showing the road, the crosswalk, the light's colour, the car (orange on ticks that
 /// reasoned, blue on feed-forward ticks) and the pedestrians; left of each strip the
 /// tick, the action taken and the discrete state.
-pub fn filmstrip(path: &Path, title: &str, map: &unforeseen_sim::Map, ticks: &[crate::runner::Tick]) -> Result<()> {
+pub fn filmstrip(
+    path: &Path,
+    title: &str,
+    map: &unforeseen_sim::Map,
+    ticks: &[crate::episodes::runner::Tick],
+) -> Result<()> {
     use unforeseen_sim::LightPhase;
     const WIDTH: u32 = 1000;
     const LABEL_W: u32 = 150;

@@ -9,7 +9,7 @@
 use serde::Serialize;
 use unforeseen_sim::{LightPhase, Map};
 
-use crate::runner::Tick;
+use crate::episodes::runner::Tick;
 
 /// The road's geometry, in metres, as the replay draws it.
 #[derive(Debug, Serialize)]

@@ -9,14 +9,14 @@ use std::collections::BTreeMap;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::{Map, Reward};
 
-use crate::agents::Agent;
+use crate::episodes::experiments::{MethodRow, evaluate_under, method_row};
+use crate::episodes::methods::Method;
+use crate::episodes::metrics::Aggregate;
+use crate::episodes::protocol::Protocol;
 use crate::error::Error;
-use crate::experiments::{MethodRow, evaluate_under, method_row};
-use crate::methods::Method;
-use crate::metrics::Aggregate;
 use crate::progress::{Message, Progress};
-use crate::protocol::Protocol;
 use crate::stats::Stat;
+use crate::training::seed_agents::Agent;
 
 /// What a study evaluates.
 #[derive(Debug, Clone)]
@@ -172,6 +172,109 @@ fn jobs(setup: &StudySetup<'_>, n_agents: usize) -> Vec<Job> {
         }
     }
     out
+}
+
+/// The whole `compare.json` (schema 2: one table per protocol, each row summarized over
+/// training seeds with its per-seed rows kept), built by [`CompareReport::new`] alone,
+/// which the command line and the Python package both call.
+#[derive(Debug, serde::Serialize)]
+pub struct CompareReport {
+    /// Schema version of this file.
+    pub schema: u32,
+    /// The protocols, in table order.
+    pub protocols: Vec<Protocol>,
+    /// One table per protocol.
+    pub tables: Vec<ProtocolTable>,
+    /// What each column measures and on which map (train reward on the training map,
+    /// every other column on the test map).
+    pub columns: serde_json::Value,
+    /// The paper's values for the same columns (§VI, zero-shot; null where the paper
+    /// gives none, as for the collision rate).
+    pub paper: Vec<serde_json::Value>,
+    /// Training map name.
+    pub train_map: String,
+    /// Test map name.
+    pub test_map: String,
+    /// The reward settings of both maps (`train_map`, `test_map`).
+    pub reward: RewardPair,
+    /// Evaluation seed (episode seeds derive from it, the same for every agent).
+    pub seed: u64,
+    /// Training seeds of the agents (null for an agent file that does not say).
+    pub train_seeds: Vec<Option<u64>>,
+    /// Agent file given with --agent, if any.
+    pub agent_file: Option<String>,
+    /// Agent cache folder used by --train-seeds, if any.
+    pub agent_cache: Option<String>,
+    /// Training episodes per agent (null when unknown).
+    pub train_episodes: Option<u64>,
+    /// Evaluation episodes per method, map and agent.
+    pub episodes: u64,
+    /// How actions are chosen from the policy in evaluation.
+    pub action_selection: String,
+    /// The scaled agent's parameters.
+    pub scaled_params: serde_json::Value,
+}
+
+impl CompareReport {
+    /// The report of the comparison `setup` over `agents`, whose tables [`run_study`]
+    /// computed: the one builder of compare.json. `agent_file` is the agent file the
+    /// agent came from, if any; `agent_cache` the agent cache folder of a training-seed
+    /// study, if one was used.
+    pub fn new(
+        setup: &StudySetup<'_>,
+        agents: &[Agent],
+        tables: Vec<ProtocolTable>,
+        agent_file: Option<String>,
+        agent_cache: Option<String>,
+    ) -> Result<Self, Error> {
+        Ok(CompareReport {
+            schema: 2,
+            protocols: setup.protocols.to_vec(),
+            tables,
+            columns: columns(&setup.train_map.name, &setup.test_map.name, setup.episodes),
+            paper: paper_rows(),
+            train_map: setup.train_map.name.clone(),
+            test_map: setup.test_map.name.clone(),
+            reward: RewardPair::of(setup.train_map, setup.test_map),
+            seed: setup.seed,
+            train_seeds: agents.iter().map(|a| a.train_seed).collect(),
+            agent_file,
+            agent_cache,
+            train_episodes: agents.first().and_then(|a| a.train_episodes),
+            episodes: setup.episodes,
+            action_selection: format!("{:?}", setup.params.scaling.action_selection),
+            scaled_params: serde_json::to_value(setup.params)?,
+        })
+    }
+}
+
+/// The paper's values, one row per method of [`Method::PAPER`] with the columns of the
+/// table (null where the paper gives none: the collision and red-light rates).
+fn paper_rows() -> Vec<serde_json::Value> {
+    Method::PAPER
+        .iter()
+        .filter_map(|m| {
+            m.paper().map(|p| {
+                serde_json::json!({"method": m.name(), "train_reward": p.train_reward, "test_reward": p.test_reward,
+                    "success_rate": p.success_rate, "collision_rate": null, "red_light_rate": null,
+                    "inference_rate_relative_to_bayes_rl": p.inference_rate})
+            })
+        })
+        .collect()
+}
+
+/// What each column of the table measures, on which map and over how many episodes.
+fn columns(train_map: &str, test_map: &str, episodes: u64) -> serde_json::Value {
+    let on_test = |what: &str| format!("{what} on the test map '{test_map}', {episodes} episodes per method and agent");
+    serde_json::json!({
+        "train_reward": format!("mean return on the training map '{train_map}' after training, {episodes} episodes per method and agent"),
+        "test_reward": on_test("mean return"),
+        "success_rate": on_test("share of episodes reaching the destination without a collision"),
+        "collision_rate": format!("{}; the paper gives no value", on_test("share of episodes that hit a pedestrian")),
+        "red_light_rate": format!("{}; not in the paper", on_test("red-light violations per episode: the car's front entering the crosswalk on red (at most one per episode)")),
+        "inference_rate": on_test("share of decision ticks that ran planning"),
+        "reasoning_us_per_tick": on_test("wall-clock µs per tick inside the controller"),
+    })
 }
 
 /// Runs the study: every job in parallel (rayon; zero-shot episodes are parallel too),

@@ -15,12 +15,13 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use crate::batch::{
-    KeptLine, ParamSet, ResultLine, RunIdentity, SummaryRow, Unit, UnitKey, line_problem, read_results,
-    stream_learning, summarize, summary_path, units,
-};
+use crate::episodes::methods::Method;
 use crate::error::Error;
-use crate::methods::Method;
+use crate::runs::batch::results_file::line_problem;
+use crate::runs::batch::{
+    KeptLine, ParamSet, ResultLine, RunIdentity, SummaryRow, Unit, UnitKey, read_results, stream_learning, summarize,
+    summary_path, units,
+};
 
 /// The merged results of one run.
 #[derive(Debug, Clone)]
@@ -67,7 +68,7 @@ fn param_set_of(label: &str) -> Option<ParamSet> {
 }
 
 /// The units of the run `identity` describes, in canonical order (as
-/// [`crate::batch::BatchConfig::units`] gives them for that run), with their keys.
+/// [`crate::runs::batch::BatchConfig::units`] gives them for that run), with their keys.
 pub fn units_of(identity: &RunIdentity) -> Result<Vec<(Unit, UnitKey)>, String> {
     let methods = identity
         .methods
@@ -316,8 +317,8 @@ pub fn write_merged(merged: &Merged, out: &Path) -> Result<MergeReport, Error> {
     let rows = summarize(&merged.results());
     let summary = summary_path(out);
     let doc = summary_document(out, None, &merged.identity, &rows);
-    crate::report::write_atomic(out, text.as_bytes())?;
-    crate::report::write_json(&summary, &doc)?;
+    crate::reports::files::write_atomic(out, text.as_bytes())?;
+    crate::reports::files::write_json(&summary, &doc)?;
     Ok(MergeReport {
         out: out.to_path_buf(),
         summary,

@@ -17,13 +17,13 @@
 //!
 //! A map is a file relative to the stream file, else an embedded map by name. Episode `k`
 //! of the stream runs on the map the order gives it, with the world seed of episode `k` of
-//! that map ([`crate::experiments::eval_seeds`]); the order draws from the evaluation seed
+//! that map ([`crate::episodes::experiments::eval_seeds`]); the order draws from the evaluation seed
 //! alone, so every method, protocol and agent meets the same maps in the same order.
 //! Results are reported per map within the stream ([`per_map`]). Syntax errors name the
 //! file, line and column; semantic ones the file and field ([`StreamError`]).
 //!
 //! [`evaluate_stream`] runs a method over a stream (`eval --stream`, and a stream unit of
-//! `batch --stream`: [`crate::batch::ScenarioKind::Stream`]); [`learn_stream`] gives the
+//! `batch --stream`: [`crate::runs::batch::ScenarioKind::Stream`]); [`learn_stream`] gives the
 //! test-time learning curves over one (`learn --stream`).
 
 use std::path::{Path, PathBuf};
@@ -38,14 +38,14 @@ use unforeseen_agent::persist::AgentBundle;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::Map;
 
-use crate::agent_file::check_compatible;
-use crate::experiments::{LearnPoint, eval_seeds, learn_over};
-use crate::methods::Method;
-use crate::metrics::Aggregate;
+use crate::episodes::experiments::{LearnPoint, eval_seeds, learn_over};
+use crate::episodes::methods::Method;
+use crate::episodes::metrics::Aggregate;
+use crate::episodes::protocol::Protocol;
+use crate::episodes::runner::{EpisodeResult, run_episode};
 use crate::progress::Progress;
-use crate::protocol::Protocol;
-use crate::runner::{EpisodeResult, run_episode};
 use crate::seeds::episode_seed;
+use crate::training::agent_file::check_compatible;
 
 /// Largest stream file read (bytes).
 const MAX_BYTES: u64 = 1 << 20;
@@ -266,11 +266,11 @@ pub fn evaluate_stream(
     }
     let make = |map: &Map| -> Result<Box<dyn Controller>, crate::error::Error> {
         match bundle {
-            Some(b) => method.controller_for(b, params, map),
+            Some(b) => method.controller(b, params, map),
             None => {
                 let sizes = unforeseen_discretizer::Discretizer::new(&map.bins)?.factor_sizes();
                 method
-                    .scripted_controller_for(&sizes, map)?
+                    .scripted_controller(&sizes, map)?
                     .ok_or_else(|| crate::error::Error::NotScripted {
                         method: method.to_string(),
                     })
@@ -339,7 +339,7 @@ pub fn per_map(stream: &Stream, episodes: &[StreamEpisode]) -> Vec<StreamRow> {
 }
 
 /// The test-time learning curves of the scaled agent over `episodes` episodes of the
-/// stream ([`crate::experiments::learn_over`] on the stream's schedule): one agent
+/// stream ([`crate::episodes::experiments::learn_over`] on the stream's schedule): one agent
 /// learning across the stream in order, each point naming its map.
 pub fn learn_stream(
     stream: &Stream,

@@ -12,7 +12,7 @@ use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::{Action, Map};
 
 use crate::error::Error;
-use crate::report::write_atomic;
+use crate::reports::files::write_atomic;
 
 /// Saves `bundle` to `path` (temporary file + rename).
 pub fn save(path: &Path, bundle: &AgentBundle) -> Result<(), Error> {

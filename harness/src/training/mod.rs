@@ -1,6 +1,11 @@
 //! Training (§VI): Q-learning, the world model's Dirichlet counts and Bayesian RL all
 //! learn from the same episodes on the training map, driven by Q-learning's
-//! epsilon-greedy exploration.
+//! epsilon-greedy exploration. This file is the training loop; [`seed_agents`] trains one
+//! agent per training seed (in parallel, cached on disk) and [`agent_file`] reads and
+//! writes a trained agent.
+
+pub mod agent_file;
+pub mod seed_agents;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -15,9 +20,9 @@ use unforeseen_discretizer::Discretizer;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::{Action, Map};
 
+use crate::episodes::rewards::{red_light_cost, state_rewards, terminal_states};
 use crate::error::Error;
 use crate::progress::{NoProgress, Progress};
-use crate::rewards::{red_light_cost, state_rewards, terminal_states};
 use crate::seeds::episode_seed;
 
 /// Everything training needs besides the map.

@@ -10,9 +10,9 @@ use std::time::Instant;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_sim::Map;
 
-use crate::agent_file::check_compatible;
 use crate::error::Error;
 use crate::progress::{Message, Progress};
+use crate::training::agent_file::check_compatible;
 use crate::training::{TrainConfig, train_with_progress};
 
 /// Most training seeds one run accepts (each agent takes seconds to train).
@@ -132,7 +132,7 @@ fn load_cached(path: &Path, map: &Map, key: &str, progress: &dyn Progress) -> Op
     if !path.exists() {
         return None;
     }
-    let checked = crate::agent_file::load(path)
+    let checked = crate::training::agent_file::load(path)
         .map_err(|e| e.full_message())
         .and_then(|bundle| {
             if bundle.meta.get("cache_key").map(String::as_str) != Some(key) {
@@ -190,7 +190,7 @@ pub fn train_agents(
             bundle.meta.insert("cache_key".into(), key);
             let saved = match &path {
                 Some(p) => {
-                    crate::agent_file::save(p, &bundle)?;
+                    crate::training::agent_file::save(p, &bundle)?;
                     format!(" -> {}", p.display())
                 }
                 None => String::new(),

@@ -1,6 +1,6 @@
 //! Fairness of a candidate: a failure of a method counts only on a scenario a careful
 //! driver survives and a careless one does not (the two scripted witnesses of
-//! [`crate::survivability`], with its thresholds):
+//! [`crate::episodes::survivability`], with its thresholds):
 //!
 //! * **survivable**: brake-on-pedestrian succeeds in at least 99% of the K episodes;
 //! * **dangerous**: never-brake fails in at least 80% of them (succeeds in at most 20%).
@@ -12,7 +12,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::survivability::{DANGEROUS_MAX_SUCCESS, SURVIVABLE_MIN_SUCCESS};
+use crate::episodes::survivability::{DANGEROUS_MAX_SUCCESS, SURVIVABLE_MIN_SUCCESS};
 
 /// A method fails a candidate when its success rate is below this.
 pub const FAILURE_SUCCESS: f64 = 0.5;

@@ -55,14 +55,14 @@ use std::sync::Mutex;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::{Action, Map};
 
-use crate::agents::Agent;
-use crate::batch::{ResultLine, Shard};
+use crate::episodes::experiments::{evaluate_scripted, evaluate_under};
+use crate::episodes::methods::Method;
+use crate::episodes::metrics::Aggregate;
+use crate::episodes::protocol::{Protocol, covered};
 use crate::error::Error;
-use crate::experiments::{evaluate_scripted, evaluate_under};
-use crate::methods::Method;
-use crate::metrics::Aggregate;
 use crate::progress::{NoProgress, Progress};
-use crate::protocol::{Protocol, covered};
+use crate::runs::batch::{ResultLine, Shard};
+use crate::training::seed_agents::Agent;
 
 pub use fairness::Fairness;
 pub use output::Summary;
@@ -356,12 +356,6 @@ impl Evaluated {
             .filter(|l| l.role == Role::Method)
             .map(|l| l.result.success_rate)
             .collect()
-    }
-
-    /// The method's mean success over training seeds (None when rejected).
-    pub fn mean_success(&self) -> Option<f64> {
-        let s = self.method_success();
-        (!s.is_empty()).then(|| s.iter().sum::<f64>() / s.len() as f64)
     }
 
     /// The method's lowest success over training seeds (None when rejected): the agent
@@ -868,7 +862,7 @@ pub fn run_with(
     let head: String = std::iter::once(output::identity_line(&cfg.identity()))
         .chain(kept.values().flatten().map(|l| l.raw.clone()))
         .collect();
-    crate::report::write_atomic(&file, head.as_bytes())?;
+    crate::reports::files::write_atomic(&file, head.as_bytes())?;
     let sink = std::fs::OpenOptions::new()
         .append(true)
         .open(&file)
@@ -890,7 +884,7 @@ pub fn run_with(
     let text: String = std::iter::once(output::identity_line(&cfg.identity()))
         .chain(written.values().flatten().map(|l| l.raw.clone()))
         .collect();
-    crate::report::write_atomic(&file, text.as_bytes())?;
+    crate::reports::files::write_atomic(&file, text.as_bytes())?;
     output::write_all(cfg, out, &outcome)
 }
 

@@ -27,9 +27,9 @@ use super::fairness::Fairness;
 use super::minimise::Minimised;
 use super::space::{Domain, Value, map_ron};
 use super::{Evaluated, Outcome, Role, SearchConfig, SearchIdentity, Stage};
-use crate::batch::ResultLine;
 use crate::error::Error;
-use crate::plots::{plot_err, tick_label, write_svg};
+use crate::reports::figures::{plot_err, tick_label, write_svg};
+use crate::runs::batch::ResultLine;
 use crate::stats::Stat;
 
 /// The candidates file's name.
@@ -310,7 +310,7 @@ pub(super) fn write_all(cfg: &SearchConfig<'_>, out: &Path, outcome: &Outcome) -
         failures,
         rejected,
     };
-    crate::report::write_json(&out.join(SUMMARY), &summary)?;
+    crate::reports::files::write_json(&out.join(SUMMARY), &summary)?;
     Ok(summary)
 }
 
@@ -441,7 +441,7 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
     })?;
     text.push_str(&body);
     text.push('\n');
-    crate::report::write_atomic(&path, text.as_bytes())?;
+    crate::reports::files::write_atomic(&path, text.as_bytes())?;
     Ok(FailureReport {
         name: map.name.clone(),
         file: path,
