@@ -15,7 +15,7 @@ use unforeseen_agent::model::WorldModel;
 use unforeseen_agent::params::{GateMode, ModelPriors, QParams, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::q_learning::QLearning;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_agent::structure::{Factor, Parent, Structure};
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_harness::episodes::tick_recording::{TickTimes, jaywalk_family, record};

@@ -40,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut empty_reasoning = Vec::new();
     let mut per_episode = Vec::new();
     let mut drift = Vec::new();
-    let snapshot = |agent: &unforeseen_agent::scaled::ScaledAgent, episode: u64| {
+    let snapshot = |agent: &unforeseen_agent::scaled_agent::ScaledAgent, episode: u64| {
         let table: Vec<Vec<f64>> = agent
             .gate()
             .map(|g| {

@@ -23,7 +23,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_harness::episodes::tick_recording::{Recording, ReplayOutcome, TickTimes, jaywalk_family, record};
 use unforeseen_harness::training::agent_file;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};

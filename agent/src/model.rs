@@ -2,11 +2,11 @@
 //! factor CPTs with Dirichlet counts, the joint `B[u]` materialised from them,
 //! the observation model `A` with Dirichlet counts, preferences `C` and the state prior `D`.
 
-use crate::check;
 use crate::error::{AgentError, FieldError, ParamError};
 use crate::limits::{MAX_ACTIONS, MAX_STATES, MAX_VALUE};
 use crate::maths::{LN_FLOOR, ln, log_softmax};
 use crate::params::ModelPriors;
+use crate::stored_values;
 use crate::structure::{Parent, Structure};
 use crate::transition::{FactoredLogB, FactoredTransition};
 use nalgebra::DMatrix;
@@ -182,23 +182,26 @@ fn checked_matrix<'de, D: serde::Deserializer<'de>>(de: D) -> Result<DMatrix<f64
 /// terminal states in range.
 fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
     let n = r.structure.joint_size();
-    check::size(
+    stored_values::size(
         "structure",
         n,
         1,
         MAX_STATES,
         "joint states: the product of the factor sizes",
     )?;
-    check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
+    stored_values::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
     r.priors.check().map_err(|e| FieldError::from(e).within("priors"))?;
-    check::finite("priors.transition_concentration", &[r.priors.transition_concentration])
-        .and(check::finite("priors.a_concentration", &[r.priors.a_concentration]))
+    stored_values::finite("priors.transition_concentration", &[r.priors.transition_concentration])
+        .and(stored_values::finite(
+            "priors.a_concentration",
+            &[r.priors.a_concentration],
+        ))
         .map_err(|e| FieldError::new(e.path.trim_end_matches("[0]"), e.message))?;
     if let Some(d) = &r.priors.d {
-        check::len("priors.d", d.len(), n, "one prior probability per joint state")?;
+        stored_values::len("priors.d", d.len(), n, "one prior probability per joint state")?;
     }
     let factors = r.structure.factors();
-    check::len(
+    stored_values::len(
         "cpt",
         r.cpt.len(),
         factors.len(),
@@ -207,8 +210,8 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
     for (f, counts) in r.cpt.iter().enumerate() {
         let path = format!("cpt[{f}]");
         let configs = r.structure.n_configs(f, r.n_actions);
-        let want = check::product(&path, configs, factors[f].size)?;
-        check::len(
+        let want = stored_values::product(&path, configs, factors[f].size)?;
+        stored_values::len(
             &path,
             counts.len(),
             want,
@@ -217,7 +220,7 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
                 factors[f].size, factors[f].name
             ),
         )?;
-        check::counts(&path, counts)?;
+        stored_values::counts(&path, counts)?;
     }
     let (no, ns) = (r.a_counts.nrows(), r.a_counts.ncols());
     if ns != n || !(1..=MAX_STATES).contains(&no) {
@@ -241,13 +244,13 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
             ));
         }
     }
-    check::len(
+    stored_values::len(
         "c",
         r.c.len(),
         no,
         "one log preference per observation (rows of a_counts)",
     )?;
-    check::finite("c", &r.c)?;
+    stored_values::finite("c", &r.c)?;
     let m = r.c.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let lse = m + r.c.iter().map(|v| (v - m).exp()).sum::<f64>().ln();
     if lse.abs() > 1e-6 {
@@ -256,8 +259,8 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
             format!("is not a normalised log distribution: ln Σ exp(C) = {lse}, must be 0 (± 1e-6)"),
         ));
     }
-    check::len("d_counts", r.d_counts.len(), n, "one count per joint state")?;
-    check::counts("d_counts", &r.d_counts)?;
+    stored_values::len("d_counts", r.d_counts.len(), n, "one count per joint state")?;
+    stored_values::counts("d_counts", &r.d_counts)?;
     if r.d_counts.iter().sum::<f64>() <= 0.0 {
         return Err(FieldError::new(
             "d_counts",

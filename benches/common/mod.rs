@@ -4,7 +4,7 @@
 use std::time::Duration;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_sim::embedded;
 

@@ -70,6 +70,24 @@ impl Stat {
     }
 }
 
+/// The worst of a group of per-seed rows, each given as `(success rate, reward)`: the
+/// lowest success, ties broken by the lowest reward, then by the first. The one rule of
+/// "worst seed" in every summary over training seeds (the batch summary and `compare`'s
+/// table). None for no rows.
+pub fn worst_of(rows: impl IntoIterator<Item = (f64, f64)>) -> Option<usize> {
+    let mut worst: Option<(usize, (f64, f64))> = None;
+    for (i, (success, reward)) in rows.into_iter().enumerate() {
+        let worse = match worst {
+            None => true,
+            Some((_, (s, r))) => success < s || (success == s && reward < r),
+        };
+        if worse {
+            worst = Some((i, (success, reward)));
+        }
+    }
+    worst.map(|(i, _)| i)
+}
+
 /// t_{0.975, n-1} s / sqrt(n) for the values around their `mean`, or None when n < 2.
 fn half_width(values: &[f64], mean: f64) -> Option<f64> {
     let n = values.len();
@@ -88,6 +106,13 @@ mod tests {
 
     fn close(a: f64, b: f64, tol: f64) -> bool {
         (a - b).abs() <= tol
+    }
+
+    #[test]
+    fn the_worst_row_is_the_lowest_success_then_the_lowest_reward_then_the_first() {
+        assert_eq!(worst_of([]), None);
+        assert_eq!(worst_of([(1.0, 5.0), (0.5, 9.0), (0.5, 3.0), (0.5, 3.0)]), Some(2));
+        assert_eq!(worst_of([(0.2, 1.0), (0.2, 1.0)]), Some(0));
     }
 
     #[test]

@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_agent::habit::{PolicyHabit, TableHabit};
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_harness::episodes::methods::Method;
 
 use crate::agent::{PyAgent, decision_dict, scaled_params};

@@ -6,7 +6,7 @@ use serde::Serialize;
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_discretizer::{Discretizer, State};
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::{Action, Map};

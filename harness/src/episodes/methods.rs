@@ -4,7 +4,7 @@
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::{GateLearning, GateMode, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_sim::Map;
 
 use crate::episodes::reference::{BrakeOnPedestrian, NeverBrake};

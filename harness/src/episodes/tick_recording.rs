@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 use unforeseen_agent::controller::{Controller, Decision, Ending};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::Map;
 

@@ -399,19 +399,12 @@ fn summarize(
     }
 }
 
-/// The row with the lowest test success (ties: lowest test reward, then the first).
+/// The row with the lowest test success (ties: lowest test reward, then the first;
+/// [`crate::stats::worst_of`]).
 pub fn worst_seed(rows: &[MethodRow]) -> WorstSeed {
-    let worst = rows
-        .iter()
-        .reduce(|w, r| {
-            let key = |x: &MethodRow| (x.success_rate, x.test_reward);
-            if key(r).0 < key(w).0 || (key(r).0 == key(w).0 && key(r).1 < key(w).1) {
-                r
-            } else {
-                w
-            }
-        })
+    let i = crate::stats::worst_of(rows.iter().map(|r| (r.success_rate, r.test_reward)))
         .expect("a study has at least one agent");
+    let worst = &rows[i];
     WorstSeed {
         train_seed: worst.train_seed,
         success_rate: worst.success_rate,

@@ -183,14 +183,7 @@ fn summary_row(group: &[&ResultLine]) -> SummaryRow {
     let first = group[0];
     let stat = |f: fn(&ResultLine) -> f64| Stat::of(&group.iter().map(|l| f(l)).collect::<Vec<_>>());
     let worst = group
-        .iter()
-        .copied()
-        .reduce(|w, l| {
-            let worse =
-                l.success_rate < w.success_rate || (l.success_rate == w.success_rate && l.mean_reward < w.mean_reward);
-            if worse { l } else { w }
-        })
-        .expect("groups are not empty");
+        [crate::stats::worst_of(group.iter().map(|l| (l.success_rate, l.mean_reward))).expect("groups are not empty")];
     SummaryRow {
         scenario: first.scenario.clone(),
         stream: None,
