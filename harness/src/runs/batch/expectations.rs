@@ -1,10 +1,11 @@
 //! A map's expectations (`expect` in the map file) checked against a unit's figures.
 
+use serde::{Deserialize, Serialize};
+use unforeseen_sim::Map;
+
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::Protocol;
-use serde::{Deserialize, Serialize};
-use unforeseen_sim::Map;
 
 /// One checked expectation of a map.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -1,12 +1,13 @@
 //! The identity of a batch run ([`RunIdentity`]), the first line of its results file,
 //! and the identities of its agents (trained per seed, or from an agent file).
 
-use crate::episodes::methods::Method;
-use crate::episodes::protocol::Protocol;
-use crate::error::Error;
 use serde::{Deserialize, Serialize};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_sim::Map;
+
+use crate::episodes::methods::Method;
+use crate::episodes::protocol::Protocol;
+use crate::error::Error;
 
 use super::scenario::Scenario;
 use super::sweep::ParamSet;

@@ -25,8 +25,9 @@
 //! train only the agents the units still to run use ([`Plan::train_seeds_to_run`]), then
 //! [`run_plan`] runs it.
 //!
-//! One module per part: [`scenario`], [`sweep`], [`units`], [`expectations`], [`result_line`], [`plan`], [`identity`], [`run`], [`results_file`], [`summary`]; the items
-//! callers use are re-exported here.
+//! One module per part: [`scenario`], [`sweep`], [`units`], [`expectations`],
+//! [`result_line`], [`plan`], [`identity`], [`run`], [`results_file`] and [`summary`];
+//! the items callers use are re-exported here.
 
 pub mod expectations;
 pub mod identity;

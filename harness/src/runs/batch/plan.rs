@@ -2,13 +2,14 @@
 //! ([`BatchConfig`]) and its plan ([`Plan`]: the units, the shard, the identity and the
 //! lines `--resume` keeps).
 
+use std::collections::BTreeSet;
+use std::ops::Range;
+use std::path::Path;
+
 use crate::episodes::methods::Method;
 use crate::episodes::protocol::Protocol;
 use crate::error::Error;
 use crate::training::seed_agents::Agent;
-use std::collections::BTreeSet;
-use std::ops::Range;
-use std::path::Path;
 
 use super::identity::RunIdentity;
 use super::results_file::{KeptLine, resume_lines};

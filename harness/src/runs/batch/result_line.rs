@@ -1,8 +1,9 @@
 //! One result line of a batch (a JSON line of the results file), with the figures per
 //! map of a stream unit, and the key that identifies its unit for `--resume`.
 
-use crate::episodes::protocol::Protocol;
 use serde::{Deserialize, Serialize};
+
+use crate::episodes::protocol::Protocol;
 
 use super::expectations::Check;
 

@@ -1,9 +1,10 @@
 //! Reading a results file back: its identity and lines, the lines `--resume` keeps, and
 //! the checks that each kept line is a line of this run with figures in range.
 
-use crate::error::Error;
 use std::collections::BTreeSet;
 use std::path::Path;
+
+use crate::error::Error;
 
 use super::identity::{IdentityLine, RunIdentity};
 use super::result_line::ResultLine;

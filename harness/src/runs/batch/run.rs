@@ -1,17 +1,18 @@
 //! Running a batch: one unit ([`run_unit`]) and a whole plan, in parallel, streaming
 //! each finished unit to the results file as one JSON line.
 
+use rayon::prelude::*;
+use std::io::Write;
+use std::path::Path;
+use std::sync::Mutex;
+use unforeseen_sim::Action;
+
 use crate::episodes::experiments::evaluate_under;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::runner::EpisodeResult;
 use crate::error::Error;
 use crate::progress::{NoProgress, Progress};
 use crate::runs::stream::{evaluate_stream, per_map};
-use rayon::prelude::*;
-use std::io::Write;
-use std::path::Path;
-use std::sync::Mutex;
-use unforeseen_sim::Action;
 
 use super::expectations::check_expectations;
 use super::plan::{BatchConfig, Plan};

@@ -1,10 +1,11 @@
 //! The scenarios of a batch: a map or a deployment stream, loaded from files, folders
 //! or embedded names, with their names checked unique.
 
-use crate::error::Error;
-use crate::runs::stream::Stream;
 use std::path::{Path, PathBuf};
 use unforeseen_sim::Map;
+
+use crate::error::Error;
+use crate::runs::stream::Stream;
 
 /// A scenario of the suite: a map or a deployment stream, and where it came from.
 #[derive(Debug, Clone)]

@@ -2,10 +2,11 @@
 //! interval, range and worst seed, the expectations checked on the mean, and how each
 //! map of a stream fares under the two protocols.
 
-use crate::episodes::protocol::Protocol;
-use crate::stats::Stat;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+use crate::episodes::protocol::Protocol;
+use crate::stats::Stat;
 
 use super::expectations::{Check, holds};
 use super::result_line::ResultLine;

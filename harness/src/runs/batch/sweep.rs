@@ -1,10 +1,11 @@
 //! Parameter sweeps: `--set key=v1,v2` options expanded into the cross product of
 //! named parameter sets ([`ParamSet`]), checked against the scaled agent's parameters.
 
-use crate::error::Error;
 use serde::{Deserialize, Serialize};
 use unforeseen_agent::param_table;
 use unforeseen_agent::params::ScaledParams;
+
+use crate::error::Error;
 
 /// One named set of parameter overrides of a sweep (`[]` = the defaults).
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
