@@ -9,7 +9,7 @@
 //! Module map (named after the paper): [`maths`], [`params`] (and [`param_table`], the scaled agent's parameters by name), [`structure`], [`model`], [`transition`] (factored `B`),
 //! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`handback`] (the safe hand-back, beyond the paper), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
-//! [`habit`] (`π_o` as an interface), [`scaled`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
+//! [`habit`] (`π_o` as an interface), [`scaled_agent`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
 //!
 //! ```
 //! use unforeseen_agent::{controller::Controller, model::WorldModel, params::*,

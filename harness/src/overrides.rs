@@ -1,5 +1,5 @@
 //! `--set KEY=VALUE` overrides of the scaled agent's parameters, used by the commands
-//! and by sweeps ([`crate::runs::batch::sweep`]). Keys and values go through the agent's one
+//! and by sweeps ([`crate::runs::batch::sweep()`]). Keys and values go through the agent's one
 //! table of parameters ([`unforeseen_agent::param_table`]): every field of
 //! [`ScaledParams`] is a key (flat, e.g. `epsilon`, or dotted, e.g. `gate.epsilon`). A bad
 //! key or value is an [`Error::Flag`] naming the flag and what is allowed (an enum's

@@ -9,7 +9,7 @@
 //! interval, range and worst seed, and checks the maps' expectations on the mean.
 //!
 //! A scenario is a map or a deployment stream ([`ScenarioKind`], [`load_stream_scenario`]):
-//! a stream's unit runs its episodes over the stream's maps ([`evaluate_stream`]) and its
+//! a stream's unit runs its episodes over the stream's maps ([`evaluate_stream`](crate::runs::stream::evaluate_stream)) and its
 //! line is a line like a map's (the figures over the whole stream) with the figures per
 //! map within the stream added ([`ResultLine::per_map`]); the summary follows the stream's
 //! row with one row per map, and [`stream_learning`] compares each map's figures under
@@ -25,8 +25,8 @@
 //! train only the agents the units still to run use ([`Plan::train_seeds_to_run`]), then
 //! [`run_plan`] runs it.
 //!
-//! One module per part: [`scenario`], [`sweep`], [`units`], [`expectations`],
-//! [`result_line`], [`plan`], [`identity`], [`run`], [`results_file`] and [`summary`];
+//! One module per part: [`scenario`], [`sweep`](mod@sweep), [`units`](mod@units), [`expectations`],
+//! [`result_line`], [`plan`], [`identity`], [`run`](mod@run), [`results_file`] and [`summary`];
 //! the items callers use are re-exported here.
 
 pub mod expectations;

@@ -41,7 +41,7 @@ pub struct BatchConfig<'a> {
     /// Optional shard.
     pub shard: Option<Shard>,
     /// What determines the agents, for the run's identity: an agent file's content hash
-    /// ([`agent_file_identity`]) or the training recipe ([`trained_agents_identity`]).
+    /// ([`agent_file_identity`](super::agent_file_identity)) or the training recipe ([`trained_agents_identity`](super::trained_agents_identity)).
     /// Two runs with the same text here run the same agents.
     pub agents_identity: String,
 }

@@ -23,7 +23,7 @@ pub enum ScenarioKind {
     Map(Box<Map>),
     /// A deployment stream ([`crate::runs::stream`]): each episode on the map the stream's order
     /// gives it; the unit's line adds the figures per map within the stream
-    /// ([`ResultLine::per_map`]).
+    /// ([`ResultLine::per_map`](super::ResultLine::per_map)).
     Stream(Stream),
 }
 

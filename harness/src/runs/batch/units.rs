@@ -40,7 +40,7 @@ pub struct Unit {
 }
 
 impl Unit {
-    /// The unit's identity, as its result line's [`ResultLine::key`] gives it.
+    /// The unit's identity, as its result line's [`ResultLine::key`](super::ResultLine::key) gives it.
     pub fn key(&self, scenarios: &[Scenario]) -> UnitKey {
         (
             scenarios[self.scenario].name().to_string(),
