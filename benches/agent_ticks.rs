@@ -1,5 +1,5 @@
 //! Micro-benchmarks of the scaled agent's ticks: one reasoning tick per
-//! horizon `H`, the reasoning ticks of real episodes replayed (`unforeseen::tick_replay`), a feed-forward
+//! horizon `H`, the reasoning ticks of real episodes replayed (`unforeseen_harness::episodes::tick_recording`), a feed-forward
 //! tick, the end-of-episode test-time learning update, and the reasoning tick as the
 //! joint state space grows.
 //!
@@ -10,15 +10,15 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
-use unforeseen::tick_replay::{TickTimes, jaywalk_family, record};
 use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_agent::model::WorldModel;
 use unforeseen_agent::params::{GateMode, ModelPriors, QParams, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::q_learning::QLearning;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_agent::structure::{Factor, Parent, Structure};
 use unforeseen_env::{Env, EnvConfig};
+use unforeseen_harness::episodes::tick_recording::{TickTimes, jaywalk_family, record};
 use unforeseen_sim::embedded;
 
 mod common;
@@ -70,7 +70,7 @@ const REPLAY_EPISODES: u64 = 10;
 
 /// `reasoning_tick_replay/H`: the reasoning ticks the scaled agent (default parameters,
 /// horizon H) really meets in zero-shot evaluation episodes on the jaywalk family of
-/// maps (`unforeseen::tick_replay`: 10 episodes per map, `eval`'s seeds for seed 7), replayed
+/// maps (`unforeseen_harness::episodes::tick_recording`: 10 episodes per map, `eval`'s seeds for seed 7), replayed
 /// one episode after the other on one agent; only the reasoning ticks are timed, each
 /// alone (VMP over its real window, the EFE tree with the reuse of the previous tick's
 /// subtrees, scaling). One iteration is one reasoning tick; criterion's figure is the

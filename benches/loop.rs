@@ -7,14 +7,14 @@
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
-use unforeseen::experiments::eval_seeds;
-use unforeseen::methods::Method;
-use unforeseen::runner::run_episode;
-use unforeseen::training::train;
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_env::{Env, EnvConfig};
+use unforeseen_harness::episodes::experiments::eval_seeds;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::runner::run_episode;
+use unforeseen_harness::training::train;
 use unforeseen_sim::{Action, World, embedded};
 
 mod common;
@@ -86,7 +86,7 @@ fn episode(c: &mut Criterion, bundle: &AgentBundle) {
     let mut env = Env::new(&map, EnvConfig::default()).expect("env");
     let params = ScaledParams::default();
     let seeds = eval_seeds(7, &map, Method::Scaled, 0);
-    let mut probe = Method::Scaled.controller(bundle, &params).expect("controller");
+    let mut probe = Method::Scaled.controller(bundle, &params, &map).expect("controller");
     let (r, _) = run_episode(&mut env, probe.as_mut(), seeds, false).expect("episode");
     eprintln!(
         "episode: {} ticks, {} reasoning, return {:.1}, success {}",
@@ -94,7 +94,7 @@ fn episode(c: &mut Criterion, bundle: &AgentBundle) {
     );
     c.bench_function("episode", |b| {
         b.iter_batched(
-            || Method::Scaled.controller(bundle, &params).expect("controller"),
+            || Method::Scaled.controller(bundle, &params, &map).expect("controller"),
             |mut ctl| run_episode(&mut env, ctl.as_mut(), seeds, false).expect("episode"),
             BatchSize::SmallInput,
         )

@@ -13,19 +13,19 @@
 
 use std::path::Path;
 
-use unforeseen::experiments::eval_seeds;
-use unforeseen::methods::{Method, scaled_agent};
-use unforeseen::runner::run_episode;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_env::{Env, EnvConfig};
+use unforeseen_harness::episodes::experiments::eval_seeds;
+use unforeseen_harness::episodes::methods::{Method, scaled_agent};
+use unforeseen_harness::episodes::runner::run_episode;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
         return Err("usage: handback_audit AGENT.ron MAP [EPISODES] [key=value ...]".into());
     }
-    let bundle = unforeseen::agent_file::load(Path::new(&args[1]))?;
-    let map = unforeseen::maps::load(&args[2])?;
+    let bundle = unforeseen_harness::training::agent_file::load(Path::new(&args[1]))?;
+    let map = unforeseen_harness::maps::load(&args[2])?;
     let episodes: u64 = args.get(3).map_or(Ok(200), |s| s.parse())?;
     let mut params = ScaledParams::default();
     for kv in args.iter().skip(4) {
@@ -40,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut empty_reasoning = Vec::new();
     let mut per_episode = Vec::new();
     let mut drift = Vec::new();
-    let snapshot = |agent: &unforeseen_agent::scaled::ScaledAgent, episode: u64| {
+    let snapshot = |agent: &unforeseen_agent::scaled_agent::ScaledAgent, episode: u64| {
         let table: Vec<Vec<f64>> = agent
             .gate()
             .map(|g| {

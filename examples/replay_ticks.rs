@@ -1,5 +1,5 @@
 //! Records the scaled agent's reasoning ticks on the jaywalk family of maps and replays
-//! them (see `unforeseen::tick_replay`): prints the digest of every replayed decision (equal
+//! them (see `unforeseen_harness::episodes::tick_recording`): prints the digest of every replayed decision (equal
 //! digests = bit-identical results) and the distribution of the ticks' wall-clock times.
 //! Built for profiles and instruction counts, which need a short run without criterion:
 //!
@@ -22,11 +22,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use unforeseen::agent_file;
-use unforeseen::tick_replay::{Recording, ReplayOutcome, TickTimes, jaywalk_family, record};
-use unforeseen::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
+use unforeseen_harness::episodes::tick_recording::{Recording, ReplayOutcome, TickTimes, jaywalk_family, record};
+use unforeseen_harness::training::agent_file;
+use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_sim::embedded;
 
 /// One replay of the whole recording (a named function, for callgrind's `--toggle-collect`).
@@ -74,7 +74,7 @@ fn main() -> anyhow::Result<()> {
     };
     let mut base = ScaledParams::default();
     base.planning.horizon = horizon;
-    let params = unforeseen::overrides::apply(base, &sets)?;
+    let params = unforeseen_harness::overrides::apply(base, &sets)?;
     let maps = jaywalk_family()?;
     let started = Instant::now();
     let rec = record(&bundle, &params, &maps, episodes, seed)?;
@@ -142,7 +142,7 @@ fn main() -> anyhow::Result<()> {
             fastest.feedforward()
         );
         if let Some(path) = &json {
-            let summary = |t: unforeseen::tick_replay::TimeSummary| serde_json::json!({"n": t.n, "mean_us": t.mean, "p10_us": t.p10, "median_us": t.p50, "p90_us": t.p90});
+            let summary = |t: unforeseen_harness::episodes::tick_recording::TimeSummary| serde_json::json!({"n": t.n, "mean_us": t.mean, "p10_us": t.p10, "median_us": t.p50, "p90_us": t.p90});
             let v = serde_json::json!({
                 "horizon": horizon,
                 "passes": passes,

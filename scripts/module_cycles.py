@@ -5,7 +5,7 @@ when a's code (comments stripped) names `crate::b...` (also inside `use crate::{
 groups) or `super::b...`. Reports strongly connected components with more than one file."""
 import os, re, sys
 root = sys.argv[1]
-crates = {'unforeseen': 'src', 'sim': 'sim/src', 'agent': 'agent/src', 'discretizer': 'discretizer/src', 'env': 'env/src'}
+crates = {'unforeseen': 'src', 'harness': 'harness/src', 'sim': 'sim/src', 'agent': 'agent/src', 'discretizer': 'discretizer/src', 'env': 'env/src'}
 for extra in sys.argv[2:]:
     crates[extra] = extra + '/src'
 def strip(text):

@@ -5,7 +5,7 @@ use unforeseen_agent::controller::Controller;
 use unforeseen_agent::model::WorldModel;
 use unforeseen_agent::params::{ModelPriors, QParams, ReasoningMode, ScaledParams};
 use unforeseen_agent::q_learning::QLearning;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_agent::structure::Structure;
 
 fn main() {

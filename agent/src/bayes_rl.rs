@@ -3,13 +3,13 @@
 //! tick on the posterior-mean MDP (value iteration warm-started from the last values,
 //! or finite-horizon lookahead). Terminal transitions lead to an absorbing state of value 0.
 
-use crate::check;
 use crate::controller::{Controller, Decision, Ending, one_hot};
 use crate::error::{AgentError, FieldError, ParamError};
 use crate::limits::{MAX_ACTIONS, MAX_STATES};
 use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{BayesModel, BayesRlParams, ModelPriors, Planner};
+use crate::stored_values;
 use serde::{Deserialize, Serialize};
 
 /// Model-based Bayesian RL. Reading one (serde) checks every stored value (see
@@ -59,13 +59,13 @@ impl TryFrom<BayesRlRepr> for BayesRl {
     /// planning diverges); a factored model exactly when the parameters ask for one, of
     /// the same sizes.
     fn try_from(r: BayesRlRepr) -> Result<Self, FieldError> {
-        check::state_action_sizes(r.n_states, r.n_actions)?;
+        stored_values::state_action_sizes(r.n_states, r.n_actions)?;
         r.params.check().map_err(|e| FieldError::from(e).within("params"))?;
         for (name, x) in [
             ("params.prior_concentration", r.params.prior_concentration),
             ("params.reward_prior", r.params.reward_prior),
         ] {
-            if !check::bounded(x) {
+            if !stored_values::bounded(x) {
                 return Err(FieldError::new(
                     name,
                     format!("is {x}; must be at most {:e} in size", crate::limits::MAX_VALUE),
@@ -75,14 +75,14 @@ impl TryFrom<BayesRlRepr> for BayesRl {
         let (n, na) = (r.n_states, r.n_actions);
         let sa = n * na;
         let why = format!("n_states x n_actions = {n} x {na}");
-        check::len("counts", r.counts.len(), sa * n, &format!("{why} x n_states"))?;
-        check::len("terminal", r.terminal.len(), sa, &why)?;
-        check::len("visits", r.visits.len(), sa, &why)?;
-        check::len("reward_sum", r.reward_sum.len(), sa, &why)?;
-        check::counts("counts", &r.counts)?;
-        check::counts("terminal", &r.terminal)?;
-        check::counts("visits", &r.visits)?;
-        check::finite("reward_sum", &r.reward_sum)?;
+        stored_values::len("counts", r.counts.len(), sa * n, &format!("{why} x n_states"))?;
+        stored_values::len("terminal", r.terminal.len(), sa, &why)?;
+        stored_values::len("visits", r.visits.len(), sa, &why)?;
+        stored_values::len("reward_sum", r.reward_sum.len(), sa, &why)?;
+        stored_values::counts("counts", &r.counts)?;
+        stored_values::counts("terminal", &r.terminal)?;
+        stored_values::counts("visits", &r.visits)?;
+        stored_values::finite("reward_sum", &r.reward_sum)?;
         for i in 0..sa {
             let seen = r.terminal[i] + r.counts[i * n..(i + 1) * n].iter().sum::<f64>();
             if (r.visits[i] - seen).abs() > 1e-9 * r.visits[i].max(1.0) {

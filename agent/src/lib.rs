@@ -9,11 +9,11 @@
 //! Module map (named after the paper): [`maths`], [`params`] (and [`param_table`], the scaled agent's parameters by name), [`structure`], [`model`], [`transition`] (factored `B`),
 //! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`handback`] (the safe hand-back, beyond the paper), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
-//! [`habit`] (`π_o` as an interface), [`scaled`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
+//! [`habit`] (`π_o` as an interface), [`scaled_agent`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
 //!
 //! ```
 //! use unforeseen_agent::{controller::Controller, model::WorldModel, params::*,
-//!     q_learning::QLearning, scaled::ScaledAgent, structure::Structure};
+//!     q_learning::QLearning, scaled_agent::ScaledAgent, structure::Structure};
 //! let st = Structure::paper_default([4, 4, 2, 2]).unwrap();
 //! let mut w = WorldModel::new(st.clone(), 3, &ModelPriors::default()).unwrap();
 //! w.observe_transition(st.encode(&[3, 1, 1, 0]), 0, st.encode(&[2, 1, 1, 0]));
@@ -25,7 +25,6 @@
 //! assert!(d.action < 3);
 //! ```
 pub mod bayes_rl;
-mod check;
 pub mod controller;
 pub mod error;
 #[cfg(test)]
@@ -44,8 +43,9 @@ pub mod perception;
 pub mod persist;
 pub mod planning;
 pub mod q_learning;
-pub mod scaled;
+pub mod scaled_agent;
 pub mod scaling;
+mod stored_values;
 pub mod structure;
 pub mod surprise;
 pub mod transition;

@@ -292,11 +292,6 @@ pub fn argmax(x: &[f64]) -> usize {
     best
 }
 
-/// Nats to bits (reporting only: nats inside, bits when reported; docs/ARCHITECTURE.md §4.1).
-pub fn nats_to_bits(x: f64) -> f64 {
-    x / std::f64::consts::LN_2
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,11 +2,11 @@
 //! factor CPTs with Dirichlet counts, the joint `B[u]` materialised from them,
 //! the observation model `A` with Dirichlet counts, preferences `C` and the state prior `D`.
 
-use crate::check;
 use crate::error::{AgentError, FieldError, ParamError};
 use crate::limits::{MAX_ACTIONS, MAX_STATES, MAX_VALUE};
 use crate::maths::{LN_FLOOR, ln, log_softmax};
 use crate::params::ModelPriors;
+use crate::stored_values;
 use crate::structure::{Parent, Structure};
 use crate::transition::{FactoredLogB, FactoredTransition};
 use nalgebra::DMatrix;
@@ -237,23 +237,26 @@ fn checked_matrix<'de, D: serde::Deserializer<'de>>(de: D) -> Result<DMatrix<f64
 /// terminal states in range.
 fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
     let n = r.structure.joint_size();
-    check::size(
+    stored_values::size(
         "structure",
         n,
         1,
         MAX_STATES,
         "joint states: the product of the factor sizes",
     )?;
-    check::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
+    stored_values::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
     r.priors.check().map_err(|e| FieldError::from(e).within("priors"))?;
-    check::finite("priors.transition_concentration", &[r.priors.transition_concentration])
-        .and(check::finite("priors.a_concentration", &[r.priors.a_concentration]))
+    stored_values::finite("priors.transition_concentration", &[r.priors.transition_concentration])
+        .and(stored_values::finite(
+            "priors.a_concentration",
+            &[r.priors.a_concentration],
+        ))
         .map_err(|e| FieldError::new(e.path.trim_end_matches("[0]"), e.message))?;
     if let Some(d) = &r.priors.d {
-        check::len("priors.d", d.len(), n, "one prior probability per joint state")?;
+        stored_values::len("priors.d", d.len(), n, "one prior probability per joint state")?;
     }
     let factors = r.structure.factors();
-    check::len(
+    stored_values::len(
         "cpt",
         r.cpt.len(),
         factors.len(),
@@ -262,8 +265,8 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
     for (f, counts) in r.cpt.iter().enumerate() {
         let path = format!("cpt[{f}]");
         let configs = r.structure.n_configs(f, r.n_actions);
-        let want = check::product(&path, configs, factors[f].size)?;
-        check::len(
+        let want = stored_values::product(&path, configs, factors[f].size)?;
+        stored_values::len(
             &path,
             counts.len(),
             want,
@@ -272,7 +275,7 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
                 factors[f].size, factors[f].name
             ),
         )?;
-        check::counts(&path, counts)?;
+        stored_values::counts(&path, counts)?;
     }
     let (no, ns) = (r.a_counts.nrows(), r.a_counts.ncols());
     if ns != n || !(1..=MAX_STATES).contains(&no) {
@@ -296,13 +299,13 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
             ));
         }
     }
-    check::len(
+    stored_values::len(
         "c",
         r.c.len(),
         no,
         "one log preference per observation (rows of a_counts)",
     )?;
-    check::finite("c", &r.c)?;
+    stored_values::finite("c", &r.c)?;
     let m = r.c.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let lse = m + r.c.iter().map(|v| (v - m).exp()).sum::<f64>().ln();
     if lse.abs() > 1e-6 {
@@ -311,8 +314,8 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
             format!("is not a normalised log distribution: ln Σ exp(C) = {lse}, must be 0 (± 1e-6)"),
         ));
     }
-    check::len("d_counts", r.d_counts.len(), n, "one count per joint state")?;
-    check::counts("d_counts", &r.d_counts)?;
+    stored_values::len("d_counts", r.d_counts.len(), n, "one count per joint state")?;
+    stored_values::counts("d_counts", &r.d_counts)?;
     if r.d_counts.iter().sum::<f64>() <= 0.0 {
         return Err(FieldError::new(
             "d_counts",
@@ -350,9 +353,9 @@ fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
 /// A crash model fits `n` states and `n_actions` actions, with probabilities in [0, 1] and
 /// finite preferences.
 fn check_crash(c: &CrashModel, n: usize, n_actions: usize) -> Result<(), FieldError> {
-    check::len("crash.hazard", c.hazard.len(), n_actions, "one row per action")?;
+    stored_values::len("crash.hazard", c.hazard.len(), n_actions, "one row per action")?;
     for (u, h) in c.hazard.iter().enumerate() {
-        check::len(&format!("crash.hazard[{u}]"), h.len(), n, "one probability per state")?;
+        stored_values::len(&format!("crash.hazard[{u}]"), h.len(), n, "one probability per state")?;
         if let Some(s) = h.iter().position(|p| !(0.0..=1.0).contains(p)) {
             return Err(FieldError::new(
                 format!("crash.hazard[{u}][{s}]"),

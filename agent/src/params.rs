@@ -3,7 +3,7 @@
 //! for the scaled agent, `check()` returns the validated [`CheckedScaledParams`]).
 //!
 //! Every constructor that takes parameters ([`crate::model::WorldModel::new`],
-//! [`crate::scaled::ScaledAgent::new`], [`crate::bayes_rl::BayesRl::new`],
+//! [`crate::scaled_agent::ScaledAgent::new`], [`crate::bayes_rl::BayesRl::new`],
 //! [`crate::q_learning::QLearning::new`]) calls `check()` and returns the error.
 //! Defaults follow the paper's §VI where it states them. The scaled agent's parameters
 //! are read and set by name through [`crate::param_table`].
@@ -251,7 +251,7 @@ pub enum CrashPlanning {
     Hazard,
 }
 
-/// Hyperparameters of the paper's agent ([`crate::scaled::ScaledAgent`]), grouped by the
+/// Hyperparameters of the paper's agent ([`crate::scaled_agent::ScaledAgent`]), grouped by the
 /// paper's concepts. Every parameter has a key (the name in the table below; the
 /// dotted `group.key` is accepted too) by which it is read and set
 /// ([`ScaledParams::get`], [`ScaledParams::set_str`], [`ScaledParams::set_value`],
@@ -296,7 +296,7 @@ pub enum CrashPlanning {
 /// without spaces, `+` between names, no name twice, the watched factor not among the
 /// pooled ones) by `check`; that they name factors of the model (the watched factor, and
 /// next-time parents of it) only where a model is known, by
-/// [`CheckedScaledParams::check_factors`], which [`crate::scaled::ScaledAgent::new`] calls.
+/// [`CheckedScaledParams::check_factors`], which [`crate::scaled_agent::ScaledAgent::new`] calls.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ScaledParams {

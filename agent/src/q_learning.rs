@@ -1,11 +1,11 @@
 //! Tabular Q-learning, the base learner and first baseline (§VI): ε-greedy training,
 //! Q initialised with a bias toward speeding up (the paper's velocity preference).
 
-use crate::check;
 use crate::controller::{Controller, Decision, one_hot};
 use crate::error::{AgentError, FieldError, ParamError};
 use crate::maths::argmax;
 use crate::params::QParams;
+use crate::stored_values;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
@@ -37,7 +37,7 @@ impl TryFrom<QLearningRepr> for QLearning {
     /// Sizes in range, parameters valid, `epsilon` in [0, 1], a table of exactly
     /// `n_states * n_actions` finite values.
     fn try_from(r: QLearningRepr) -> Result<Self, FieldError> {
-        check::state_action_sizes(r.n_states, r.n_actions)?;
+        stored_values::state_action_sizes(r.n_states, r.n_actions)?;
         r.params.check().map_err(|e| FieldError::from(e).within("params"))?;
         if let Some(b) = r.params.bias_action.filter(|b| *b >= r.n_actions) {
             return Err(FieldError::new(
@@ -45,7 +45,7 @@ impl TryFrom<QLearningRepr> for QLearning {
                 format!("is {b}; must be below n_actions = {}", r.n_actions),
             ));
         }
-        if !check::bounded(r.params.bias) {
+        if !stored_values::bounded(r.params.bias) {
             return Err(FieldError::new(
                 "params.bias",
                 format!(
@@ -61,14 +61,14 @@ impl TryFrom<QLearningRepr> for QLearning {
                 format!("is {}; must be in [0, 1]", r.epsilon),
             ));
         }
-        let want = check::product("table", r.n_states, r.n_actions)?;
-        check::len(
+        let want = stored_values::product("table", r.n_states, r.n_actions)?;
+        stored_values::len(
             "table",
             r.table.len(),
             want,
             &format!("n_states x n_actions = {} x {}", r.n_states, r.n_actions),
         )?;
-        check::finite("table", &r.table)?;
+        stored_values::finite("table", &r.table)?;
         Ok(QLearning {
             n_states: r.n_states,
             n_actions: r.n_actions,
@@ -171,11 +171,6 @@ impl QLearning {
     /// `ε <- max(ε_min, ε · decay)`; call once per training episode.
     pub fn decay_epsilon(&mut self) {
         self.epsilon = (self.epsilon * self.params.epsilon_decay).max(self.params.epsilon_min);
-    }
-
-    /// Set the exploration rate directly (e.g. a custom schedule).
-    pub fn set_epsilon(&mut self, epsilon: f64) {
-        self.epsilon = epsilon.clamp(0.0, 1.0);
     }
 }
 

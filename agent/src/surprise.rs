@@ -33,12 +33,6 @@ pub fn theta(surprise: f64, omega: f64) -> f64 {
     1.0 - (-omega * surprise).exp()
 }
 
-/// The reasoning trigger `θ_t > ε` (§II: perception/planning engaged only above threshold).
-#[inline]
-pub fn reasoning_triggered(theta: f64, epsilon: f64) -> bool {
-    theta > epsilon
-}
-
 /// One exact Bayes filtering step `q_t ∝ A[o_t,:] ∘ ŝ_t` (the feed-forward perception of
 /// §II's footnote; equals VMP with window 1). Returns the evidence `Σ_s A[o_t,s] ŝ[s]`.
 /// If the evidence is 0, `q_t ∝ A[o_t,:]` (the observation alone).

@@ -2,10 +2,10 @@
 //! configuration.
 
 use std::time::Duration;
-use unforeseen::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
+use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_sim::embedded;
 
 /// Training configuration with the benches' seed 7.

@@ -259,19 +259,6 @@ impl Env {
         })
     }
 
-    /// An env of the map file at `name_or_path` if such a file exists, else of the
-    /// embedded map of that name (`"jaywalk"`, `"intersection.ron"`, ...).
-    pub fn load(name_or_path: &str, config: EnvConfig) -> Result<Env, EnvError> {
-        let path = std::path::Path::new(name_or_path);
-        let map = if path.exists() {
-            Map::load(path)
-        } else {
-            unforeseen_sim::embedded::load(name_or_path.strip_suffix(".ron").unwrap_or(name_or_path))
-        }
-        .map_err(|e| EnvError::Map(e.to_string()))?;
-        Env::new(&map, config)
-    }
-
     /// The map.
     pub fn map(&self) -> &Map {
         &self.map

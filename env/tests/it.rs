@@ -283,27 +283,6 @@ fn refused_calls_leave_the_env_unchanged() {
     ));
 }
 
-#[test]
-fn an_env_loads_a_map_by_embedded_name_or_by_file() {
-    let by_name = Env::load("jaywalk", EnvConfig::default()).unwrap();
-    assert_eq!(by_name.map(), &map("jaywalk"));
-    assert_eq!(
-        Env::load("jaywalk.ron", EnvConfig::default()).unwrap().map(),
-        &map("jaywalk")
-    );
-    let dir = std::env::temp_dir().join(format!("unforeseen-env-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("broken.ron");
-    std::fs::write(&file, "Map(name: \"broken\", road: (goal_x: -1.0))").unwrap();
-    let err = Env::load(file.to_str().unwrap(), EnvConfig::default())
-        .unwrap_err()
-        .to_string();
-    assert!(err.contains("broken.ron") && err.contains("goal_x"), "{err}");
-    let missing = Env::load("no_such_map", EnvConfig::default()).unwrap_err().to_string();
-    assert!(missing.contains("no_such_map"), "{missing}");
-    std::fs::remove_dir_all(&dir).unwrap();
-}
-
 proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 

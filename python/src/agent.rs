@@ -1,19 +1,21 @@
-//! The agents from Python: training and agent files ([`unforeseen::training`],
-//! [`unforeseen::agent_file`]), a controller of every method the command line has
-//! ([`unforeseen::methods::Method`]) with parameters through `--set`'s path
-//! ([`unforeseen::overrides`]), and the library's evaluation ([`unforeseen::experiments`]).
+//! The agents from Python: training and agent files ([`unforeseen_harness::training`],
+//! [`unforeseen_harness::training::agent_file`]), a controller of every method the command line has
+//! ([`unforeseen_harness::episodes::methods::Method`]) with parameters through `--set`'s path
+//! ([`unforeseen_harness::overrides`]), and the library's evaluation ([`unforeseen_harness::episodes::experiments`]).
 
 use std::path::PathBuf;
 use std::sync::Mutex;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
-use unforeseen::methods::Method;
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
 use unforeseen_agent::controller::{Controller, Decision, Ending};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
+use unforeseen_harness::episodes::experiments::evaluate_map;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::limits::check_episodes;
+use unforeseen_harness::progress::NoProgress;
 
 use crate::errors;
 
@@ -73,13 +75,13 @@ pub fn scaled_params(params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParam
             // Text goes the way `--set KEY=TEXT` does (the same parsing and messages);
             // numbers and bools as typed values.
             if let Ok(text) = v.extract::<String>() {
-                unforeseen::overrides::set_one(&mut p, &key, &text).map_err(errors::to_py)?;
+                unforeseen_harness::overrides::set_one(&mut p, &key, &text).map_err(errors::to_py)?;
             } else {
-                unforeseen::overrides::set_value(&mut p, &key, json_value(&key, &v)?).map_err(errors::to_py)?;
+                unforeseen_harness::overrides::set_value(&mut p, &key, json_value(&key, &v)?).map_err(errors::to_py)?;
             }
         }
     }
-    unforeseen::overrides::apply(p, &[]).map_err(errors::to_py)
+    unforeseen_harness::overrides::apply(p, &[]).map_err(errors::to_py)
 }
 
 /// A trained agent (an agent file's content).
@@ -93,7 +95,7 @@ pub struct PyAgent {
 impl PyAgent {
     /// Writes the agent file (atomically), as `unforeseen train --out` does.
     fn save(&self, path: PathBuf) -> PyResult<()> {
-        unforeseen::agent_file::save(&path, &self.bundle).map_err(errors::to_py)
+        unforeseen_harness::training::agent_file::save(&path, &self.bundle).map_err(errors::to_py)
     }
 
     /// What the file records: map, episodes, seed, ... (strings).
@@ -114,13 +116,16 @@ impl PyAgent {
         self.bundle.world_model.structure().sizes()
     }
 
-    /// A fresh controller of `method` (any name of `unforeseen eval --method`), with the
-    /// scaled agent's parameters as keywords (`epsilon=0.3, horizon=4`: the keys of `--set`).
-    #[pyo3(signature = (method = "scaled", **params))]
-    fn controller(&self, method: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<PyController> {
+    /// A fresh controller of `method` (any name of `unforeseen eval --method`) for
+    /// episodes on `map` (the scripted `brake-on-pedestrian` follows its red-light rule),
+    /// with the scaled agent's parameters as keywords (`epsilon=0.3, horizon=4`: the keys
+    /// of `--set`).
+    #[pyo3(signature = (method = "scaled", map = "jaywalk", **params))]
+    fn controller(&self, method: &str, map: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<PyController> {
         let m = self::method(method)?;
         let p = scaled_params(params)?;
-        let c = m.controller(&self.bundle, &p).map_err(errors::to_py)?;
+        let map = crate::maps::load(map, None)?;
+        let c = m.controller(&self.bundle, &p, &map).map_err(errors::to_py)?;
         Ok(PyController::new(c, self.factor_sizes(), m))
     }
 
@@ -140,16 +145,11 @@ impl PyAgent {
 #[pyfunction]
 #[pyo3(signature = (map = "intersection", episodes = 6000, seed = 7))]
 fn train(py: Python<'_>, map: &str, episodes: u64, seed: u64) -> PyResult<PyAgent> {
-    if !(1..=unforeseen::cli::MAX_EPISODES).contains(&episodes) {
-        return Err(errors::value(format!(
-            "episodes {episodes}: expected 1..={}",
-            unforeseen::cli::MAX_EPISODES
-        )));
-    }
+    check_episodes("episodes", episodes).map_err(errors::to_py)?;
     let map = crate::maps::load(map, None)?;
-    let cfg = unforeseen::training::TrainConfig::new(episodes, seed);
+    let cfg = unforeseen_harness::training::TrainConfig::new(episodes, seed);
     let (bundle, log) = py
-        .detach(|| unforeseen::training::train(&map, &cfg))
+        .detach(|| unforeseen_harness::training::train(&map, &cfg))
         .map_err(errors::to_py)?;
     Ok(PyAgent {
         bundle,
@@ -161,7 +161,7 @@ fn train(py: Python<'_>, map: &str, episodes: u64, seed: u64) -> PyResult<PyAgen
 /// loading and saving them in the agent cache `cache` (`None`: no cache) as
 /// `--train-seeds` does, so a notebook and the command line share agents.
 #[pyfunction]
-#[pyo3(signature = (seeds, map = "intersection", episodes = 6000, cache = Some(PathBuf::from(unforeseen::agents::DEFAULT_CACHE)), timeout_as = "truncation"))]
+#[pyo3(signature = (seeds, map = "intersection", episodes = 6000, cache = Some(PathBuf::from(unforeseen_harness::training::seed_agents::DEFAULT_CACHE)), timeout_as = "truncation"))]
 fn train_agents(
     py: Python<'_>,
     seeds: Vec<u64>,
@@ -170,12 +170,7 @@ fn train_agents(
     cache: Option<PathBuf>,
     timeout_as: &str,
 ) -> PyResult<Vec<PyAgent>> {
-    if !(1..=unforeseen::cli::MAX_EPISODES).contains(&episodes) {
-        return Err(errors::value(format!(
-            "episodes {episodes}: expected 1..={}",
-            unforeseen::cli::MAX_EPISODES
-        )));
-    }
+    check_episodes("episodes", episodes).map_err(errors::to_py)?;
     if seeds.is_empty() {
         return Err(errors::value("seeds: give at least one training seed"));
     }
@@ -183,12 +178,14 @@ fn train_agents(
         .parse()
         .map_err(|e: String| errors::value(format!("timeout_as: {e}")))?;
     let map = crate::maps::load(map, None)?;
-    let cfg = unforeseen::training::TrainConfig {
+    let cfg = unforeseen_harness::training::TrainConfig {
         timeout_as,
-        ..unforeseen::training::TrainConfig::new(episodes, 0)
+        ..unforeseen_harness::training::TrainConfig::new(episodes, 0)
     };
     let agents = py
-        .detach(|| unforeseen::agents::train_agents(&map, &seeds, &cfg, cache.as_deref(), &NoProgress))
+        .detach(|| {
+            unforeseen_harness::training::seed_agents::train_agents(&map, &seeds, &cfg, cache.as_deref(), &NoProgress)
+        })
         .map_err(errors::to_py)?;
     Ok(agents
         .into_iter()
@@ -202,15 +199,15 @@ fn train_agents(
 /// Loads and checks an agent file (errors name the file, the field and the fix).
 #[pyfunction]
 fn load_agent(path: PathBuf) -> PyResult<PyAgent> {
-    let bundle = unforeseen::agent_file::load(&path).map_err(errors::to_py)?;
+    let bundle = unforeseen_harness::training::agent_file::load(&path).map_err(errors::to_py)?;
     Ok(PyAgent {
         bundle,
         returns: Vec::new(),
     })
 }
 
-/// A scripted reference (`brake-on-pedestrian`, `never-brake`) for `map`'s
-/// observations: it needs no agent.
+/// A scripted reference (`brake-on-pedestrian`, `never-brake`) for episodes on `map`
+/// (its observations, and its red-light rule): it needs no agent.
 #[pyfunction]
 #[pyo3(signature = (method, map = "jaywalk"))]
 fn scripted_controller(method: &str, map: &str) -> PyResult<PyController> {
@@ -220,11 +217,14 @@ fn scripted_controller(method: &str, map: &str) -> PyResult<PyController> {
         .map_err(errors::to_py)?
         .factor_sizes()
         .to_vec();
-    let c = m.scripted_controller(&sizes).map_err(errors::to_py)?.ok_or_else(|| {
-        errors::value(format!(
-            "{method} needs a trained agent: use agent.controller('{method}')"
-        ))
-    })?;
+    let c = m
+        .scripted_controller(&sizes, &map)
+        .map_err(errors::to_py)?
+        .ok_or_else(|| {
+            errors::value(format!(
+                "{method} needs a trained agent: use agent.controller('{method}')"
+            ))
+        })?;
     Ok(PyController::new(c, sizes, m))
 }
 
@@ -354,16 +354,16 @@ impl PyController {
 }
 
 /// `(world, controller)` seeds of evaluation episode `episode` of `method` on `map`, as
-/// `unforeseen eval` uses them ([`unforeseen::experiments::eval_seeds`]).
+/// `unforeseen eval` uses them ([`unforeseen_harness::episodes::experiments::eval_seeds`]).
 #[pyfunction]
 fn eval_seeds(seed: u64, map: &str, method: &str, episode: u64) -> PyResult<(u64, u64)> {
     let map = crate::maps::load(map, None)?;
-    let s = unforeseen::experiments::eval_seeds(seed, &map, self::method(method)?, episode);
+    let s = unforeseen_harness::episodes::experiments::eval_seeds(seed, &map, self::method(method)?, episode);
     Ok((s.world, s.controller))
 }
 
-/// `unforeseen eval` in the library, with the GIL released: JSON text of
-/// `{method, map, protocol, computed_under, seed, aggregate, episodes}` (eval.json's fields).
+/// `unforeseen eval` in the library, with the GIL released: eval.json's JSON text, built by
+/// the one builder the command line uses ([`evaluate_map`]).
 #[pyfunction]
 #[pyo3(signature = (map, method, episodes, seed = 7, agent = None, protocol = "zero-shot", **params))]
 #[allow(clippy::too_many_arguments)]
@@ -381,38 +381,25 @@ fn evaluate_json(
     let proto = self::protocol(protocol)?;
     let p = scaled_params(params)?;
     let map = crate::maps::load(map, None)?;
-    if !(1..=unforeseen::cli::MAX_EPISODES).contains(&episodes) {
-        return Err(errors::value(format!(
-            "episodes {episodes}: expected 1..={}",
-            unforeseen::cli::MAX_EPISODES
-        )));
+    check_episodes("episodes", episodes).map_err(errors::to_py)?;
+    if !m.is_scripted() && agent.is_none() {
+        return Err(errors::value(format!("{method} needs a trained agent: pass agent=...")));
     }
-    let bar = NoProgress;
-    let results = match (m.is_scripted(), agent) {
-        (true, _) => py.detach(|| unforeseen::experiments::evaluate_scripted(&map, m, episodes, seed, &bar)),
-        (false, Some(a)) => {
-            py.detach(|| unforeseen::experiments::evaluate_under(proto, &map, &a.bundle, &p, m, episodes, seed, &bar))
-        }
-        (false, None) => return Err(errors::value(format!("{method} needs a trained agent: pass agent=..."))),
-    }
-    .map_err(errors::to_py)?;
-    let agg = unforeseen::metrics::Aggregate::of(&results);
-    let computed = if m.is_scripted() {
-        Protocol::ZeroShot
-    } else {
-        proto.effective(m, &p)
-    };
-    serde_json::to_string(&serde_json::json!({
-        "method": m,
-        "map": map.name,
-        "protocol": proto,
-        "computed_under": computed,
-        "seed": seed,
-        "reward": map.reward,
-        "aggregate": agg,
-        "episodes": results,
-    }))
-    .map_err(errors::to_py)
+    let report = py
+        .detach(|| {
+            evaluate_map(
+                &map,
+                m,
+                proto,
+                agent.map(|a| &a.bundle),
+                &p,
+                episodes,
+                seed,
+                &NoProgress,
+            )
+        })
+        .map_err(errors::to_py)?;
+    serde_json::to_string(&report.document().map_err(errors::to_py)?).map_err(errors::to_py)
 }
 
 /// Registers the classes and functions.

@@ -1,20 +1,19 @@
 //! `compare` and `batch` from Python, through the library functions the command line
-//! runs ([`unforeseen::study::run_study`], [`unforeseen::batch::run`]), returned as the
-//! JSON data their files hold (the caller `json.loads` it). Kept small: the library's
-//! signatures are being refactored, and this is the only glue that touches them.
+//! runs ([`unforeseen_harness::runs::compare::run_study`], [`unforeseen_harness::runs::batch::run`]), returned as the
+//! JSON data their files hold (the caller `json.loads` it), built by the same library
+//! functions as the command line's files.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
-use unforeseen::progress::NoProgress;
+use unforeseen_harness::progress::NoProgress;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList};
-use unforeseen::agents::Agent;
-use unforeseen::batch::{BatchConfig, Scenario};
-use unforeseen::cli::compare::CompareReport;
-use unforeseen::methods::Method;
-use unforeseen::protocol::Protocol;
-use unforeseen::study::{RewardPair, StudySetup};
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::runs::batch::{BatchConfig, Scenario};
+use unforeseen_harness::runs::compare::{CompareReport, StudySetup};
+use unforeseen_harness::training::seed_agents::Agent;
 
 use crate::agent::{PyAgent, method, protocol, scaled_params};
 use crate::errors;
@@ -37,8 +36,8 @@ fn protocols(names: Vec<String>) -> PyResult<Vec<Protocol>> {
     names.iter().map(|n| protocol(n)).collect()
 }
 
-/// `unforeseen compare`: compare.json's data as JSON text (`columns` is null; the
-/// command line fills it with prose).
+/// `unforeseen compare`: compare.json's data as JSON text, built by the one builder the
+/// command line uses ([`CompareReport::new`]).
 #[pyfunction]
 #[pyo3(signature = (agents, train_map = "intersection", test_map = "jaywalk", episodes = 100, seed = 7, protocols = vec!["zero-shot".to_string(), "continual".to_string()], ablations = false, **params))]
 #[allow(clippy::too_many_arguments)]
@@ -72,35 +71,9 @@ fn compare_json(
         seed,
     };
     let tables = py
-        .detach(|| unforeseen::study::run_study(&setup, &agents, &NoProgress))
+        .detach(|| unforeseen_harness::runs::compare::run_study(&setup, &agents, &NoProgress))
         .map_err(errors::to_py)?;
-    let report = CompareReport {
-        schema: 2,
-        protocols: protocols.clone(),
-        tables,
-        columns: serde_json::Value::Null,
-        paper: Method::PAPER
-            .iter()
-            .filter_map(|m| {
-                m.paper().map(|f| {
-                    serde_json::json!({"method": m.name(), "train_reward": f.train_reward, "test_reward": f.test_reward,
-                        "success_rate": f.success_rate, "collision_rate": null,
-                        "inference_rate_relative_to_bayes_rl": f.inference_rate})
-                })
-            })
-            .collect(),
-        train_map: train.name.clone(),
-        test_map: test.name.clone(),
-        reward: RewardPair::of(&train, &test),
-        seed,
-        train_seeds: agents.iter().map(|a| a.train_seed).collect(),
-        agent_file: None,
-        agent_cache: None,
-        train_episodes: agents.first().and_then(|a| a.train_episodes),
-        episodes,
-        action_selection: format!("{:?}", p.scaling.action_selection),
-        scaled_params: serde_json::to_value(&p).map_err(errors::to_py)?,
-    };
+    let report = CompareReport::new(&setup, &agents, tables, None, None).map_err(errors::to_py)?;
     serde_json::to_string(&report).map_err(errors::to_py)
 }
 
@@ -163,13 +136,13 @@ fn batch_json(
             sets.push(format!("{key}={joined}"));
         }
     }
-    let params = unforeseen::batch::sweep(&sets).map_err(errors::to_py)?;
+    let params = unforeseen_harness::runs::batch::sweep(&sets).map_err(errors::to_py)?;
     let axis: Vec<Option<u64>> = agents.iter().map(|a| a.train_seed).collect();
     let identity = format!(
         "python agents {}",
         agents
             .iter()
-            .map(|a| unforeseen::seeds::content_hash(a.bundle.to_ron_string().as_bytes()))
+            .map(|a| unforeseen_harness::seeds::content_hash(a.bundle.to_ron_string().as_bytes()))
             .collect::<Vec<_>>()
             .join(",")
     );
@@ -191,10 +164,10 @@ fn batch_json(
         std::process::id(),
         RUN.fetch_add(1, Ordering::Relaxed)
     ));
-    let lines = py.detach(|| unforeseen::batch::run(&cfg, &out, false, &NoProgress));
+    let lines = py.detach(|| unforeseen_harness::runs::batch::run(&cfg, &out, false, &NoProgress));
     let _ = std::fs::remove_file(&out);
     let lines = lines.map_err(errors::to_py)?;
-    let summary = unforeseen::batch::summarize(&lines);
+    let summary = unforeseen_harness::runs::batch::summarize(&lines);
     serde_json::to_string(&serde_json::json!({"lines": lines, "summary": summary})).map_err(errors::to_py)
 }
 

@@ -1,6 +1,6 @@
-//! A failure search (`unforeseen search`, `unforeseen::search`) with its candidates
+//! A failure search (`unforeseen search`, `unforeseen_harness::runs::search`) with its candidates
 //! evaluated by a distributed driver (`unforeseen.distributed.run_search`): the driver
-//! runs the stages here ([`drive_search`], `unforeseen::search::run_with`) and hands
+//! runs the stages here ([`drive_search`], `unforeseen_harness::runs::search::run_with`) and hands
 //! each stage's candidates to a Python callable, which runs them as tasks anywhere
 //! ([`evaluate_search_candidates`], with the GIL released). The stage logic and the
 //! outputs stay in the library, so they equal one machine's.
@@ -17,14 +17,14 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use rayon::prelude::*;
 use serde::Deserialize;
-use unforeseen::agents::Agent;
-use unforeseen::batch::{agent_file_identity, trained_agents_identity};
-use unforeseen::error::Error;
-use unforeseen::methods::Method;
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
-use unforeseen::search::{self, CandidateWire, Evaluator, SearchConfig, Space};
-use unforeseen::training::DEFAULT_TRAIN_MAP;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::error::Error;
+use unforeseen_harness::progress::NoProgress;
+use unforeseen_harness::runs::batch::{agent_file_identity, trained_agents_identity};
+use unforeseen_harness::runs::search::{self, CandidateWire, Evaluator, SearchConfig, Space};
+use unforeseen_harness::training::DEFAULT_TRAIN_MAP;
+use unforeseen_harness::training::seed_agents::Agent;
 
 use crate::agent::method;
 use crate::errors;
@@ -66,10 +66,10 @@ impl Built {
         check_episodes("train_episodes", spec.train_episodes)?;
         let method = method(&spec.method)?;
         let protocol = protocol(&spec.protocol)?;
-        let base = unforeseen::maps::load(&spec.map).map_err(errors::to_py)?;
+        let base = unforeseen_harness::maps::load(&spec.map).map_err(errors::to_py)?;
         let space = Space::load(&spec.space, &base).map_err(errors::to_py)?;
         let parsed: Vec<Agent> = agents.iter().map(|(_, t)| parse_agent(t)).collect::<PyResult<_>>()?;
-        let train_map = || unforeseen::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py);
+        let train_map = || unforeseen_harness::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py);
         let (agents, axis, identity) = if method.is_scripted() {
             (Vec::new(), vec![None], "none (a scripted method)".to_string())
         } else if from_file {
@@ -131,7 +131,7 @@ fn check_search(spec: &str) -> PyResult<bool> {
     check_episodes("episodes", spec.episodes)?;
     check_episodes("train_episodes", spec.train_episodes)?;
     protocol(&spec.protocol)?;
-    let base = unforeseen::maps::load(&spec.map).map_err(errors::to_py)?;
+    let base = unforeseen_harness::maps::load(&spec.map).map_err(errors::to_py)?;
     Space::load(&spec.space, &base).map_err(errors::to_py)?;
     Ok(method(&spec.method)?.is_scripted())
 }
@@ -149,11 +149,11 @@ fn protocol(name: &str) -> PyResult<Protocol> {
 /// An agent file's text as the search reads it (`--agent FILE`), for the object store.
 #[pyfunction]
 fn search_agent_text<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyBytes>> {
-    let bundle = unforeseen::agent_file::load(&path).map_err(errors::to_py)?;
+    let bundle = unforeseen_harness::training::agent_file::load(&path).map_err(errors::to_py)?;
     Ok(PyBytes::new(py, bundle.to_ron_string().as_bytes()))
 }
 
-/// Evaluates the candidates (JSON texts of `unforeseen::search::CandidateWire`) of the
+/// Evaluates the candidates (JSON texts of `unforeseen_harness::runs::search::CandidateWire`) of the
 /// search `spec` with its agents, on `threads` threads with the GIL released; returns
 /// each candidate's lines of `candidates.jsonl`, in the order given. Raises `ValueError`
 /// for input that cannot run here (a space or map that differs, a missing agent).

@@ -2,7 +2,7 @@
 //! plan a run on the driver ([`plan_batch`], the command line's `batch` planning), train
 //! one agent per training seed wherever a task runs ([`train_agent`]), run a block of
 //! units anywhere with the GIL released ([`run_units`]), and join the lines into the
-//! results file and summary on the driver ([`finish_batch`], [`unforeseen::merge`]).
+//! results file and summary on the driver ([`finish_batch`], [`unforeseen_harness::runs::merge`]).
 //!
 //! A plan's `spec` (JSON) is all a task needs besides the agents: the scenarios (as
 //! given, and where a node finds them), methods, parameter sets, protocols, training
@@ -17,16 +17,16 @@ use std::sync::Mutex;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use serde_json::{Value, json};
-use unforeseen::agents::Agent;
-use unforeseen::batch::{
+use unforeseen_agent::persist::AgentBundle;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::progress::NoProgress;
+use unforeseen_harness::runs::batch::{
     BatchConfig, DEFAULT_METHODS, RunIdentity, Scenario, agent_file_identity, checked_sweep, load_scenarios, run_unit,
     trained_agents_identity,
 };
-use unforeseen::methods::Method;
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
-use unforeseen::training::{DEFAULT_TRAIN_MAP, TrainConfig};
-use unforeseen_agent::persist::AgentBundle;
+use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::{DEFAULT_TRAIN_MAP, TrainConfig};
 
 use crate::agent::method;
 use crate::errors;
@@ -43,14 +43,8 @@ fn protocols_of(choice: &str) -> PyResult<Vec<Protocol>> {
 }
 
 pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
-    if (1..=unforeseen::cli::MAX_EPISODES).contains(&n) {
-        Ok(())
-    } else {
-        Err(errors::value(format!(
-            "{what} {n}: expected 1..={}",
-            unforeseen::cli::MAX_EPISODES
-        )))
-    }
+    unforeseen_harness::limits::check_episodes(what, n).map_err(errors::to_py)?;
+    Ok(())
 }
 
 /// Where a node finds a scenario: an embedded map's name, or the map file's absolute path
@@ -90,7 +84,7 @@ fn check_out(out: &Path, force: bool, resume: bool) -> PyResult<()> {
 /// positions still to run) with `todo_seeds` (each one's training seed),
 /// `train_seeds_to_run`, and `agent` (the agent file's text with `agent`, else null).
 #[pyfunction]
-#[pyo3(signature = (maps, out, episodes = 100, seed = 7, methods = None, protocol = "both", sets = Vec::new(), train_seeds = None, train_episodes = unforeseen::training::DEFAULT_TRAIN_EPISODES, agent = None, resume = false, force = false))]
+#[pyo3(signature = (maps, out, episodes = 100, seed = 7, methods = None, protocol = "both", sets = Vec::new(), train_seeds = None, train_episodes = unforeseen_harness::training::DEFAULT_TRAIN_EPISODES, agent = None, resume = false, force = false))]
 #[allow(clippy::too_many_arguments)]
 fn plan_batch(
     maps: Vec<PathBuf>,
@@ -116,7 +110,7 @@ fn plan_batch(
     };
     let params = checked_sweep(&sets).map_err(errors::to_py)?;
     let protocols = protocols_of(protocol)?;
-    let train_map = unforeseen::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py)?;
+    let train_map = unforeseen_harness::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py)?;
     let (axis, agents_identity, agent_text) = match (&train_seeds, &agent) {
         (Some(_), Some(_)) => {
             return Err(errors::value(
@@ -132,7 +126,7 @@ fn plan_batch(
             (axis, id, None)
         }
         (None, Some(path)) => {
-            let bundle = unforeseen::agent_file::load(path).map_err(errors::to_py)?;
+            let bundle = unforeseen_harness::training::agent_file::load(path).map_err(errors::to_py)?;
             let a = Agent::from_bundle(bundle.clone());
             (
                 vec![a.train_seed],
@@ -193,12 +187,18 @@ fn plan_batch(
 #[pyfunction]
 fn train_agent<'py>(py: Python<'py>, seed: u64, episodes: u64) -> PyResult<Bound<'py, PyBytes>> {
     check_episodes("train_episodes", episodes)?;
-    let map = unforeseen::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py)?;
+    let map = unforeseen_harness::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py)?;
     let text = py
         .detach(|| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
             pool.install(|| {
-                unforeseen::agents::train_agents(&map, &[seed], &TrainConfig::new(episodes, 0), None, &NoProgress)
+                unforeseen_harness::training::seed_agents::train_agents(
+                    &map,
+                    &[seed],
+                    &TrainConfig::new(episodes, 0),
+                    None,
+                    &NoProgress,
+                )
             })
             .map(|mut a| a.remove(0).bundle.to_ron_string())
         })
@@ -214,7 +214,7 @@ static PARSED: Mutex<Option<HashMap<String, Agent>>> = Mutex::new(None);
 const MAX_PARSED: usize = 16;
 
 pub(crate) fn parse_agent(text: &[u8]) -> PyResult<Agent> {
-    let key = unforeseen::seeds::content_hash(text);
+    let key = unforeseen_harness::seeds::content_hash(text);
     let mut parsed = PARSED.lock().unwrap_or_else(|e| e.into_inner());
     let map = parsed.get_or_insert_with(HashMap::new);
     if let Some(a) = map.get(&key) {
@@ -259,9 +259,9 @@ fn run_units(
     let mut scenarios = Vec::new();
     for (source, place) in &located {
         let map = if source.starts_with("embedded:") {
-            unforeseen::maps::load(place).map_err(errors::to_py)?
+            unforeseen_harness::maps::load(place).map_err(errors::to_py)?
         } else {
-            unforeseen::maps::load_file(Path::new(place)).map_err(errors::to_py)?
+            unforeseen_harness::maps::load_file(Path::new(place)).map_err(errors::to_py)?
         };
         scenarios.push(Scenario::of_map(map, source.clone()));
     }
@@ -326,7 +326,7 @@ fn run_units(
                     s.push('\n');
                     Ok(s)
                 })
-                .collect::<Result<Vec<String>, unforeseen::error::Error>>()
+                .collect::<Result<Vec<String>, unforeseen_harness::error::Error>>()
         })
     });
     lines.map_err(errors::to_py)
@@ -334,7 +334,7 @@ fn run_units(
 
 /// Joins the results file `out` a driver wrote (the plan's `head`, then the new lines in
 /// the order they finished) into the file one machine writes: every unit once, in
-/// canonical order, and its summary beside it, both atomically ([`unforeseen::merge`]).
+/// canonical order, and its summary beside it, both atomically ([`unforeseen_harness::runs::merge`]).
 /// Returns JSON text: `lines` (the result lines), `summary` (its path), `checked`,
 /// `failed` and `failures` (one message per expectation failed on the mean over seeds).
 #[pyfunction]
@@ -342,9 +342,9 @@ fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<String> {
     let parts = [out.clone()];
     let report = py
         .detach(|| {
-            let merged = unforeseen::merge::merge(&parts)?;
-            let report = unforeseen::merge::write_merged(&merged, &out)?;
-            Ok::<_, unforeseen::error::Error>((merged, report))
+            let merged = unforeseen_harness::runs::merge::merge(&parts)?;
+            let report = unforeseen_harness::runs::merge::write_merged(&merged, &out)?;
+            Ok::<_, unforeseen_harness::error::Error>((merged, report))
         })
         .map_err(errors::to_py)?;
     let (merged, report) = report;

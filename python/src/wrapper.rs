@@ -3,7 +3,7 @@
 //! agent, with `π_o` from a table of per-state probabilities ([`TableHabit`], the
 //! Q-table's by default) or from an external policy's probabilities each tick
 //! ([`PolicyHabit`]; [`unforeseen_agent::habit`] documents how learning corrects it).
-//! Also the batch summary of a results file ([`unforeseen::batch::summarize`]), so that
+//! Also the batch summary of a results file ([`unforeseen_harness::runs::batch::summarize`]), so that
 //! lines written from Python are read the way `unforeseen batch` reads its own.
 
 use std::path::PathBuf;
@@ -14,7 +14,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_agent::habit::{PolicyHabit, TableHabit};
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
+use unforeseen_harness::episodes::methods::Method;
 
 use crate::agent::{PyAgent, decision_dict, scaled_params};
 use crate::errors;
@@ -46,6 +47,7 @@ pub struct PyScaledHabitAgent {
     inner: Mutex<Wrapped>,
     sizes: Vec<usize>,
     external: bool,
+    learns: bool,
 }
 
 impl PyScaledHabitAgent {
@@ -69,6 +71,7 @@ impl PyScaledHabitAgent {
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         let p = scaled_params(params)?;
+        let learns = Method::Scaled.learns_across_episodes(&p);
         let checked = p.check().map_err(|e| errors::value(e.to_string()))?;
         let model = agent.bundle.world_model.clone();
         let (n, na) = (model.n_states(), model.n_actions());
@@ -97,6 +100,7 @@ impl PyScaledHabitAgent {
             inner: Mutex::new(inner),
             sizes: agent.bundle.world_model.structure().sizes(),
             external,
+            learns,
         })
     }
 
@@ -104,6 +108,14 @@ impl PyScaledHabitAgent {
     #[getter]
     fn external(&self) -> bool {
         self.external
+    }
+
+    /// Whether test-time learning carries over between episodes, as the library decides
+    /// it for the scaled agent with these parameters
+    /// ([`Method::learns_across_episodes`]: the key `learning`).
+    #[getter]
+    fn learns(&self) -> bool {
+        self.learns
     }
 
     /// Starts an episode: clears beliefs and the habit's per-tick inputs, seeds sampling.
@@ -205,9 +217,9 @@ fn q_table_habit<'py>(
 #[pyfunction]
 fn summarize_json(py: Python<'_>, path: PathBuf) -> PyResult<String> {
     let lines = py
-        .detach(|| unforeseen::batch::read_lines(&path))
+        .detach(|| unforeseen_harness::runs::batch::read_lines(&path))
         .map_err(errors::to_py)?;
-    serde_json::to_string(&unforeseen::batch::summarize(&lines)).map_err(errors::to_py)
+    serde_json::to_string(&unforeseen_harness::runs::batch::summarize(&lines)).map_err(errors::to_py)
 }
 
 /// Registers the classes and functions.

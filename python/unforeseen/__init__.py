@@ -123,7 +123,9 @@ def rollout(
     """The same evaluation as :func:`evaluate_builtin`, driven from Python: a loop over
     :class:`UnforeseenEnv` and a :class:`Controller`, with the per-episode seeds of
     ``unforeseen eval`` (:func:`eval_seeds`). Under ``zero-shot`` every episode gets a
-    fresh controller; under ``continual`` one controller learns across episodes.
+    fresh controller; under ``continual`` one controller learns across episodes. The
+    controller is built for ``map``, as the library builds it (the scripted
+    ``brake-on-pedestrian`` follows the map's red-light rule).
     Returns per episode ``ret``, ``success``, ``collision``, ``timeout``, ``ticks``,
     ``reasoning_ticks`` and ``jaywalk_surprise`` (the fields of eval.json's episodes
     that do not measure time)."""
@@ -132,7 +134,7 @@ def rollout(
     def make() -> Controller:
         if agent is None:
             return scripted_controller(method, map)
-        return agent.controller(method, **params)
+        return agent.controller(method, map, **params)
 
     controller = make()
     results = []

@@ -134,9 +134,11 @@ class Agent:
     def train_returns(self) -> list[float]: ...
     @property
     def factor_sizes(self) -> list[int]: ...
-    def controller(self, method: str = "scaled", **params: Any) -> Controller:
+    def controller(self, method: str = "scaled", map: str = "jaywalk", **params: Any) -> Controller:
         """A fresh controller of ``method`` (``q-learning``, ``bayes-rl``, ``scaled``, the
-        ablations, ``brake-on-pedestrian``, ``never-brake``); ``params`` are ``--set`` keys."""
+        ablations, ``brake-on-pedestrian``, ``never-brake``) for episodes on ``map`` (the
+        scripted ``brake-on-pedestrian`` follows its red-light rule); ``params`` are
+        ``--set`` keys."""
 
 @final
 class Controller:
@@ -189,6 +191,8 @@ class ScaledHabitAgent:
     def __init__(self, agent: Agent, habit_table: npt.NDArray[np.float64] | None = None, **params: Any) -> None: ...
     @property
     def external(self) -> bool: ...
+    @property
+    def learns(self) -> bool: ...
     def begin_episode(self, seed: int) -> None: ...
     def act(
         self, observed: int | Sequence[int], probs: npt.NDArray[np.float64] | None = None

@@ -92,9 +92,10 @@ class ScaledWrapper:
             raise ValueError(f"observation {self.observation!r}: expected 'discrete' or 'kinematic'")
         inner = getattr(habit, "method", None)
         self.method = method or (f"scaled+{inner}" if inner else "scaled-wrapper")
-        #: Whether test-time learning carries over between episodes (``learning_enabled``).
-        self.learns = bool(params.get("learning_enabled", True))
         self._inner = self._build()
+        #: Whether test-time learning carries over between episodes (the parameter
+        #: ``learning``), as the Rust library reads the parameters.
+        self.learns = bool(self._inner.learns)
 
     def _build(self) -> Any:
         return _unforeseen.ScaledHabitAgent(self._agent, self._table, **self._params)

@@ -9,18 +9,18 @@ use super::ProtocolChoice;
 use super::progress::{self, Bars};
 use super::table::{cell, print_grid, seed_text};
 use super::train_seeds::TrainSeedArgs;
-use crate::agents::Agent;
-use crate::batch::{
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::survivability::{Witness, warnings};
+use unforeseen_harness::maps;
+use unforeseen_harness::reports::files::write_json;
+use unforeseen_harness::runs::batch::{
     BatchConfig, DEFAULT_METHODS, ResultLine, Scenario, ScenarioKind, Shard, SummaryRow, agent_file_identity,
     checked_sweep, load_scenarios, load_stream_scenario, run_plan, stream_learning, summarize, summary_path,
     trained_agents_identity,
 };
-use crate::maps;
-use crate::merge::summary_document;
-use crate::methods::Method;
-use crate::report::write_json;
-use crate::survivability::{Witness, warnings};
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
+use unforeseen_harness::runs::merge::summary_document;
+use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `batch`.
 #[derive(Debug, Clone, Args)]
@@ -29,7 +29,7 @@ pub struct BatchArgs {
     #[arg(value_name = "MAP|DIR")]
     pub maps: Vec<PathBuf>,
     /// A deployment stream (a RON file listing maps with weights or a sequence; see
-    /// `src/stream.rs` and `maps/streams/`) as the one scenario, instead of maps: each
+    /// `harness/src/runs/stream.rs` and `maps/streams/`) as the one scenario, instead of maps: each
     /// unit runs `--episodes` episodes over the stream's maps, and its line and the
     /// summary report per map within the stream.
     #[arg(long, value_name = "FILE", conflicts_with = "maps")]
@@ -304,10 +304,10 @@ fn check_out(args: &BatchArgs, scenarios: &[Scenario], summary: &std::path::Path
             use std::io::Read;
             f.take(16)
                 .read_to_end(&mut head)
-                .map_err(|e| crate::error::Error::io("read", &args.out, e))?;
+                .map_err(|e| unforeseen_harness::error::Error::io("read", &args.out, e))?;
         }
         if !head.is_empty() && !head.starts_with(b"{\"run\":") {
-            return Err(crate::error::Error::flag(
+            return Err(unforeseen_harness::error::Error::flag(
                 format!("--out {}", args.out.display()),
                 "exists and is not a batch's results file (its first line is not {\"run\": ...}); \
                  give another --out, or add --force to replace it",
@@ -325,17 +325,17 @@ fn lock_results(out: &std::path::Path) -> anyhow::Result<std::fs::File> {
     name.push(".lock");
     let path = std::path::PathBuf::from(name);
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| crate::error::Error::io("create folder", dir, e))?;
+        std::fs::create_dir_all(dir).map_err(|e| unforeseen_harness::error::Error::io("create folder", dir, e))?;
     }
     let file = std::fs::OpenOptions::new()
         .create(true)
         .truncate(false)
         .write(true)
         .open(&path)
-        .map_err(|e| crate::error::Error::io("open the lock file", &path, e))?;
+        .map_err(|e| unforeseen_harness::error::Error::io("open the lock file", &path, e))?;
     match file.try_lock() {
         Ok(()) => Ok(file),
-        Err(std::fs::TryLockError::WouldBlock) => Err(crate::error::Error::flag(
+        Err(std::fs::TryLockError::WouldBlock) => Err(unforeseen_harness::error::Error::flag(
             format!("--out {}", out.display()),
             format!(
                 "another batch is writing this results file now (it holds {}); wait for it to finish, or give another --out",
@@ -343,7 +343,7 @@ fn lock_results(out: &std::path::Path) -> anyhow::Result<std::fs::File> {
             ),
         )
         .into()),
-        Err(std::fs::TryLockError::Error(e)) => Err(crate::error::Error::io("lock", &path, e).into()),
+        Err(std::fs::TryLockError::Error(e)) => Err(unforeseen_harness::error::Error::io("lock", &path, e).into()),
     }
 }
 

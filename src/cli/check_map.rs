@@ -1,11 +1,11 @@
 //! `unforeseen check-map`: validate map files, summarize them, and warn when a map with
-//! pedestrians is not a fair unforeseen test ([`crate::survivability`]).
+//! pedestrians is not a fair unforeseen test ([`unforeseen_harness::episodes::survivability`]).
 
 use clap::Args;
 use std::path::PathBuf;
 
-use crate::error::Error;
-use crate::survivability;
+use unforeseen_harness::episodes::survivability;
+use unforeseen_harness::error::Error;
 
 /// Arguments of `check-map`.
 #[derive(Debug, Clone, Args)]
@@ -28,7 +28,7 @@ pub struct CheckMapArgs {
 pub fn run(args: CheckMapArgs) -> anyhow::Result<()> {
     let mut bad = 0;
     for file in &args.files {
-        match crate::maps::load_file(file) {
+        match unforeseen_harness::maps::load_file(file) {
             Ok(map) => {
                 let disc = unforeseen_discretizer::Discretizer::new(&map)?;
                 let edges: Vec<String> = disc.distance_edges().iter().map(|e| format!("{e:.3}")).collect();

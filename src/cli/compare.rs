@@ -10,14 +10,15 @@ use super::ProtocolChoice;
 use super::table::{cell, print_grid, range_cell, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
-use crate::agents::Agent;
-use crate::methods::{Method, PaperFigures};
-use crate::plots::{BarPanel, BarRow, bar_key, grouped_bars};
-use crate::protocol::Protocol;
-use crate::report::{Csv, num, write_json};
-use crate::study::{METRICS, MethodSummary, ProtocolTable, RewardPair, StudySetup, run_study};
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
-use crate::{maps, rewards};
+use unforeseen_harness::episodes::methods::{Method, PaperFigures};
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::rewards;
+use unforeseen_harness::maps;
+use unforeseen_harness::reports::figures::{BarPanel, BarRow, bar_key, grouped_bars};
+use unforeseen_harness::reports::files::{Csv, num, write_json};
+use unforeseen_harness::runs::compare::{CompareReport, METRICS, MethodSummary, ProtocolTable, StudySetup, run_study};
+use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `compare`.
 #[derive(Debug, Clone, Args)]
@@ -66,9 +67,9 @@ impl Default for CompareArgs {
             out: PathBuf::from("out/compare"),
             seeds: TrainSeedArgs {
                 train_seeds: None,
-                cache: crate::agents::DEFAULT_CACHE.into(),
+                cache: unforeseen_harness::training::seed_agents::DEFAULT_CACHE.into(),
                 no_cache: false,
-                timeout_as: crate::training::TimeoutAs::Truncation,
+                timeout_as: unforeseen_harness::training::TimeoutAs::Truncation,
             },
             agent: AgentArgs {
                 agent: None,
@@ -78,46 +79,6 @@ impl Default for CompareArgs {
             },
         }
     }
-}
-
-/// The whole `compare.json` (schema 2: one table per protocol, each row summarized over
-/// training seeds with its per-seed rows kept).
-#[derive(Debug, serde::Serialize)]
-pub struct CompareReport {
-    /// Schema version of this file.
-    pub schema: u32,
-    /// The protocols, in table order.
-    pub protocols: Vec<Protocol>,
-    /// One table per protocol.
-    pub tables: Vec<ProtocolTable>,
-    /// What each column measures and on which map (train reward on the training map,
-    /// every other column on the test map).
-    pub columns: serde_json::Value,
-    /// The paper's values for the same columns (§VI, zero-shot; null where the paper
-    /// gives none, as for the collision rate).
-    pub paper: Vec<serde_json::Value>,
-    /// Training map name.
-    pub train_map: String,
-    /// Test map name.
-    pub test_map: String,
-    /// The reward settings of both maps (`train_map`, `test_map`).
-    pub reward: RewardPair,
-    /// Evaluation seed (episode seeds derive from it, the same for every agent).
-    pub seed: u64,
-    /// Training seeds of the agents (null for an agent file that does not say).
-    pub train_seeds: Vec<Option<u64>>,
-    /// Agent file given with --agent, if any.
-    pub agent_file: Option<String>,
-    /// Agent cache folder used by --train-seeds, if any.
-    pub agent_cache: Option<String>,
-    /// Training episodes per agent (null when unknown).
-    pub train_episodes: Option<u64>,
-    /// Evaluation episodes per method, map and agent.
-    pub episodes: u64,
-    /// How actions are chosen from the policy in evaluation.
-    pub action_selection: String,
-    /// The scaled agent's parameters.
-    pub scaled_params: serde_json::Value,
 }
 
 /// Runs `compare`.
@@ -157,35 +118,17 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         print_table(table, &train_map, &test_map);
     }
 
-    let report = CompareReport {
-        schema: 2,
-        protocols,
-        paper: Method::PAPER
-            .iter()
-            .filter_map(|m| m.paper().map(|p| serde_json::json!({"method": m.name(), "train_reward": p.train_reward, "test_reward": p.test_reward, "success_rate": p.success_rate, "collision_rate": null, "red_light_rate": null, "inference_rate_relative_to_bayes_rl": p.inference_rate})))
-            .collect(),
-        columns: columns(&train_map.name, &test_map.name, args.episodes),
-        train_map: train_map.name.clone(),
-        test_map: test_map.name.clone(),
-        reward: RewardPair::of(&train_map, &test_map),
-        seed: args.agent.seed,
-        train_seeds: agents.iter().map(|a| a.train_seed).collect(),
-        agent_file: args.agent.agent.as_ref().map(|p| p.display().to_string()),
-        agent_cache: (args.seeds.train_seeds.is_some())
-            .then(|| args.seeds.cache_dir().map(|p| p.display().to_string()))
-            .flatten(),
-        train_episodes: agents.first().and_then(|a| a.train_episodes),
-        episodes: args.episodes,
-        action_selection: format!("{:?}", params.scaling.action_selection),
-        scaled_params: serde_json::to_value(&params)?,
-        tables,
-    };
+    let agent_cache = (args.seeds.train_seeds.is_some())
+        .then(|| args.seeds.cache_dir().map(|p| p.display().to_string()))
+        .flatten();
+    let agent_file = args.agent.agent.as_ref().map(|p| p.display().to_string());
+    let report = CompareReport::new(&setup, &agents, tables, agent_file, agent_cache)?;
     let dir = &args.out;
     let files = ["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"];
     warn_replacing(dir, &files);
     super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     // All four or none: a failed write (a full disk) leaves the previous run's set.
-    crate::report::all_or_none(|| -> anyhow::Result<()> {
+    unforeseen_harness::reports::files::all_or_none(|| -> anyhow::Result<()> {
         write_json(&dir.join("compare.json"), &report)?;
         let maps = (report.train_map.as_str(), report.test_map.as_str());
         summary_csv(&report.tables, maps).write(&dir.join("compare.csv"))?;
@@ -198,20 +141,6 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         dir.display()
     );
     Ok(())
-}
-
-/// What each column of the table measures, on which map and over how many episodes.
-fn columns(train_map: &str, test_map: &str, episodes: u64) -> serde_json::Value {
-    let on_test = |what: &str| format!("{what} on the test map '{test_map}', {episodes} episodes per method and agent");
-    serde_json::json!({
-        "train_reward": format!("mean return on the training map '{train_map}' after training, {episodes} episodes per method and agent"),
-        "test_reward": on_test("mean return"),
-        "success_rate": on_test("share of episodes reaching the destination without a collision"),
-        "collision_rate": format!("{}; the paper gives no value", on_test("share of episodes that hit a pedestrian")),
-        "red_light_rate": format!("{}; not in the paper", on_test("red-light violations per episode: the car's front entering the crosswalk on red (at most one per episode)")),
-        "inference_rate": on_test("share of decision ticks that ran planning"),
-        "reasoning_us_per_tick": on_test("wall-clock µs per tick inside the controller"),
-    })
 }
 
 /// The paper's figures for a method, if it reports them.

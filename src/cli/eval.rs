@@ -5,13 +5,12 @@ use std::path::PathBuf;
 
 use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
-use crate::experiments::{evaluate_scripted, evaluate_under};
-use crate::maps;
-use crate::methods::Method;
-use crate::metrics::Aggregate;
-use crate::progress::Progress;
-use crate::protocol::Protocol;
-use crate::report::write_json;
+use unforeseen_harness::episodes::experiments::evaluate_map;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::maps;
+use unforeseen_harness::progress::Progress;
+use unforeseen_harness::reports::files::write_json;
 
 /// Arguments of `eval`.
 #[derive(Debug, Clone, Args)]
@@ -36,7 +35,7 @@ pub struct EvalArgs {
     #[arg(long, value_name = "DIR", default_value = "out/eval")]
     pub out: PathBuf,
     /// A deployment stream (a RON file listing maps with weights or a sequence; see
-    /// `src/stream.rs` and `maps/streams/`): run the episodes over its maps instead of
+    /// `harness/src/runs/stream.rs` and `maps/streams/`): run the episodes over its maps instead of
     /// `--map`, and report per map within the stream.
     #[arg(long, value_name = "FILE", conflicts_with = "map")]
     pub stream: Option<PathBuf>,
@@ -60,29 +59,25 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         args.method, map.name, args.protocol, args.episodes
     );
     // The scripted references need no agent: they decode the map's own observations.
-    let (results, train_seed) = if args.method.is_scripted() {
-        progress::phase(args.agent.quiet, &evaluating);
-        bars.phase(&label, args.episodes);
-        let results = evaluate_scripted(&map, args.method, args.episodes, args.agent.seed, &bars)?;
-        (results, None)
+    let bundle = if args.method.is_scripted() {
+        None
     } else {
-        let bundle = args.agent.bundle()?;
-        progress::phase(args.agent.quiet, &evaluating);
-        bars.phase(&label, args.episodes);
-        let results = evaluate_under(
-            args.protocol,
-            &map,
-            &bundle,
-            &params,
-            args.method,
-            args.episodes,
-            args.agent.seed,
-            &bars,
-        )?;
-        (results, bundle.meta.get("seed").cloned())
+        Some(args.agent.bundle()?)
     };
+    progress::phase(args.agent.quiet, &evaluating);
+    bars.phase(&label, args.episodes);
+    let report = evaluate_map(
+        &map,
+        args.method,
+        args.protocol,
+        bundle.as_ref(),
+        &params,
+        args.episodes,
+        args.agent.seed,
+        &bars,
+    )?;
     bars.finish();
-    let agg = Aggregate::of(&results);
+    let agg = &report.aggregate;
     outln!(
         "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, red lights {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
         args.method,
@@ -103,20 +98,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         args.agent.quiet,
         format_args!("writing {}", dir.join("eval.json").display()),
     );
-    write_json(
-        &dir.join("eval.json"),
-        &serde_json::json!({
-            "method": args.method,
-            "map": map.name,
-            "protocol": args.protocol,
-            "computed_under": args.protocol.effective(args.method, &params),
-            "seed": args.agent.seed,
-            "train_seed": train_seed,
-            "reward": map.reward,
-            "aggregate": agg,
-            "episodes": results,
-        }),
-    )?;
+    write_json(&dir.join("eval.json"), &report.document()?)?;
     outln!("wrote {}/eval.json", dir.display());
     Ok(())
 }
@@ -132,7 +114,7 @@ fn protocol_note(method: Method, protocol: Protocol, params: &unforeseen_agent::
 
 /// `eval --stream FILE`: the episodes over the stream's maps, one row per map.
 fn run_stream(args: &EvalArgs, file: &std::path::Path) -> anyhow::Result<()> {
-    use crate::stream::{Stream, evaluate_stream, per_map};
+    use unforeseen_harness::runs::stream::{Stream, evaluate_stream, per_map};
     let stream = Stream::load(file)?;
     args.agent
         .check_out_dir(&args.out, &["eval.json"], &[&file.display().to_string()])?;

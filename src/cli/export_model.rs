@@ -10,8 +10,8 @@ use std::path::PathBuf;
 use unforeseen_agent::inspect::InspectModel;
 
 use super::AgentArgs;
-use crate::error::Error;
-use crate::report::write_json;
+use unforeseen_harness::error::Error;
+use unforeseen_harness::reports::files::write_json;
 
 /// Arguments of `export-model`.
 #[derive(Debug, Clone, Args)]

@@ -4,7 +4,7 @@
 use clap::Args;
 use std::path::PathBuf;
 
-use crate::error::Error;
+use unforeseen_harness::error::Error;
 
 /// Arguments of `inspect`.
 #[derive(Debug, Clone, Args)]

@@ -1,16 +1,16 @@
 //! `unforeseen learn`: test-time learning curves over repeated encounters (paper Fig. 9),
-//! on one map or over a deployment stream (`--stream`, [`crate::stream::learn_stream`]).
+//! on one map or over a deployment stream (`--stream`, [`unforeseen_harness::runs::stream::learn_stream`]).
 
 use clap::Args;
 use plotters::style::{BLUE, RED, RGBColor};
 use std::path::PathBuf;
 
 use super::{AgentArgs, warn_replacing};
-use crate::experiments::{LearnPoint, learn};
-use crate::maps;
-use crate::plots::{Series, line_panels};
-use crate::report::{Csv, num, write_json};
-use crate::stream::{Stream, learn_stream};
+use unforeseen_harness::episodes::experiments::{LearnPoint, learn};
+use unforeseen_harness::maps;
+use unforeseen_harness::reports::figures::{Series, line_panels};
+use unforeseen_harness::reports::files::{Csv, num, write_json};
+use unforeseen_harness::runs::stream::{Stream, learn_stream};
 
 /// Arguments of `learn`.
 #[derive(Debug, Clone, Args)]
@@ -26,7 +26,7 @@ pub struct LearnArgs {
     #[arg(long, value_name = "DIR", default_value = "out/learn")]
     pub out: PathBuf,
     /// A deployment stream (a RON file listing maps with weights or a sequence; see
-    /// `src/stream.rs` and `maps/streams/`): learn across its maps instead of `--map`;
+    /// `harness/src/runs/stream.rs` and `maps/streams/`): learn across its maps instead of `--map`;
     /// learn.csv's `map` column says which map each episode ran on, and the summary
     /// gives the figures per map.
     #[arg(long, value_name = "FILE", conflicts_with = "map")]
@@ -146,7 +146,7 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     warn_replacing(dir, &OUTPUTS);
     super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
     // All three or none: a failed write (a full disk) leaves the previous run's set.
-    crate::report::all_or_none(|| -> anyhow::Result<()> {
+    unforeseen_harness::reports::files::all_or_none(|| -> anyhow::Result<()> {
         csv.write(&dir.join("learn.csv"))?;
         write_json(&dir.join("learn.json"), &points)?;
         let x = |f: &dyn Fn(&LearnPoint) -> Option<f64>| -> Vec<(f64, f64)> {

@@ -1,11 +1,11 @@
 //! `unforeseen merge`: join the shard files of one batch run, produced anywhere, into the
-//! results file and summary one machine would have written ([`crate::merge`]).
+//! results file and summary one machine would have written ([`unforeseen_harness::runs::merge`]).
 
 use clap::Args;
 use std::path::PathBuf;
 
 use super::batch::{failures, print_summary};
-use crate::merge::{merge, write_merged};
+use unforeseen_harness::runs::merge::{merge, write_merged};
 
 /// Arguments of `merge`.
 #[derive(Debug, Clone, Args)]
@@ -24,7 +24,7 @@ pub struct MergeArgs {
 pub fn run(args: MergeArgs) -> anyhow::Result<()> {
     use super::outputs;
     outputs::file("--out", &args.out)?;
-    let summary = crate::batch::summary_path(&args.out);
+    let summary = unforeseen_harness::runs::batch::summary_path(&args.out);
     outputs::file("--out (its summary)", &summary)?;
     let inputs: Vec<(&str, &std::path::Path)> = args.parts.iter().map(|p| ("PART", p.as_path())).collect();
     outputs::not_an_input("--out", &args.out, &inputs)?;

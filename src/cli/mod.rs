@@ -1,7 +1,7 @@
 //! The command line (clap). Each command lives in its own file; progress bars and
 //! phase lines are drawn by [`progress`]. Library errors become messages here, and only
 //! here is the exit code decided ([`exit_code`]): 2 for input the user can fix (maps,
-//! agent files, results files, flags: [`crate::error::Error::is_user_input`] and the map
+//! agent files, results files, flags: [`unforeseen_harness::error::Error::is_user_input`] and the map
 //! errors), 1 for any other failure.
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
@@ -9,11 +9,12 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
+use unforeseen_harness::limits::MAX_EPISODES;
 
-use crate::methods::Method;
-use crate::progress::Progress;
-use crate::protocol::Protocol;
-use crate::training::{DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::progress::Progress;
+use unforeseen_harness::training::{DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
 
 /// `println!` that never panics or stops the program when stdout's reader has gone (a
 /// closed pipe, `| head`): what is printed is a report of the work, and a closed report
@@ -155,22 +156,14 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
 }
 
 /// The exit code for an error (a library error, or an [`anyhow::Error`] as `&*err`): 2
-/// when it or anything in its chain of causes is input the user can fix, 1 otherwise.
+/// when it or anything in its chain of causes is input the user can fix
+/// ([`unforeseen_harness::user_input::in_chain`]), 1 otherwise.
 pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
-    let mut cause = Some(err);
-    while let Some(e) = cause {
-        let bad_input = e
-            .downcast_ref::<crate::error::Error>()
-            .is_some_and(crate::error::Error::is_user_input)
-            || e.is::<crate::maps::MapLookupError>()
-            || e.is::<crate::error::StreamError>()
-            || e.is::<unforeseen_sim::MapError>();
-        if bad_input {
-            return 2;
-        }
-        cause = e.source();
+    if unforeseen_harness::user_input::in_chain(err) {
+        2
+    } else {
+        1
     }
-    1
 }
 
 /// Parses a method by name (`--method`), listing every name with its summary.
@@ -215,9 +208,9 @@ pub struct AgentArgs {
     /// embedded training map (`intersection`) with the default episodes and `--seed`.
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
-    /// Scaled-agent parameter overrides (help text: [`crate::overrides::help`], the keys
+    /// Scaled-agent parameter overrides (help text: [`unforeseen_harness::overrides::help`], the keys
     /// derived from the parameter table).
-    #[arg(long = "set", value_name = "KEY=VALUE", help = crate::overrides::help())]
+    #[arg(long = "set", value_name = "KEY=VALUE", help = unforeseen_harness::overrides::help())]
     pub set: Vec<String>,
     /// Run seed: the evaluation episodes and, without `--agent`, the training run derive from it.
     #[arg(long, default_value_t = 7)]
@@ -230,7 +223,7 @@ pub struct AgentArgs {
 impl AgentArgs {
     /// Loads the agent file, or trains one on the embedded training map.
     pub fn bundle(&self) -> anyhow::Result<AgentBundle> {
-        self.bundle_trained_on(DEFAULT_TRAIN_MAP, crate::training::DEFAULT_TRAIN_EPISODES)
+        self.bundle_trained_on(DEFAULT_TRAIN_MAP, unforeseen_harness::training::DEFAULT_TRAIN_EPISODES)
     }
 
     /// Loads the agent file, or trains one on `map` (file or embedded name).
@@ -262,10 +255,6 @@ impl AgentArgs {
     }
 }
 
-/// Most episodes one flag may ask for: a million takes about an hour per method and map
-/// here, and each episode keeps a result in memory; run more as shards or seeds.
-pub const MAX_EPISODES: u64 = 1_000_000;
-
 /// Parses an episode count that may be 0 (`check-map --survivability-episodes`, where 0
 /// turns the check off): a whole number in 0..=MAX_EPISODES.
 pub fn episodes_or_none(s: &str) -> Result<u64, String> {
@@ -291,7 +280,7 @@ pub fn cap_rayon_threads() {
 }
 
 /// Parses `--timeout-as`.
-pub fn timeout_as(s: &str) -> Result<crate::training::TimeoutAs, String> {
+pub fn timeout_as(s: &str) -> Result<unforeseen_harness::training::TimeoutAs, String> {
     s.parse()
 }
 
@@ -322,9 +311,9 @@ pub fn load_or_train(
     quiet: bool,
 ) -> anyhow::Result<AgentBundle> {
     match agent {
-        Some(path) => Ok(crate::agent_file::load(path)?),
+        Some(path) => Ok(unforeseen_harness::training::agent_file::load(path)?),
         None => {
-            let map = crate::maps::load(map)?;
+            let map = unforeseen_harness::maps::load(map)?;
             progress::phase(
                 quiet,
                 format_args!("training {episodes} episodes on '{}' (seed {seed})", map.name),

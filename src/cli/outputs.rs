@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::Error;
+use unforeseen_harness::error::Error;
 
 /// The same file: both exist and resolve (links followed) to one path.
 fn same_file(a: &Path, b: &Path) -> bool {

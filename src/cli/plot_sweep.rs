@@ -6,9 +6,9 @@ use plotters::style::RGBColor;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use crate::batch::{ResultLine, read_results};
-use crate::error::Error;
-use crate::plots::{Series, line_panels};
+use unforeseen_harness::error::Error;
+use unforeseen_harness::reports::figures::{Series, line_panels};
+use unforeseen_harness::runs::batch::{ResultLine, read_results};
 
 /// Arguments of `plot-sweep`.
 #[derive(Debug, Clone, Args)]
@@ -25,7 +25,7 @@ pub struct PlotSweepArgs {
 type SeriesData = (String, RGBColor, Vec<(f64, f64)>);
 
 /// Reads an x value off a result line.
-type XOf = Box<dyn Fn(&crate::batch::ResultLine) -> Option<f64>>;
+type XOf = Box<dyn Fn(&unforeseen_harness::runs::batch::ResultLine) -> Option<f64>>;
 
 /// Distinct colours, readable on white (Paul Tol's "bright" and "muted" schemes), in turn.
 const COLORS: [RGBColor; 12] = [
@@ -134,7 +134,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
     ));
     // Against one swept key, each setting of the other swept keys is its own series (a
     // line through points that differ in another parameter would zigzag).
-    let others = |l: &crate::batch::ResultLine, x_key: &Option<String>| -> String {
+    let others = |l: &unforeseen_harness::runs::batch::ResultLine, x_key: &Option<String>| -> String {
         let Some(x_key) = x_key else { return String::new() };
         l.params
             .iter()
@@ -164,7 +164,7 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
         for (figure, y_of) in [
             (
                 "success rate",
-                (|l: &crate::batch::ResultLine| l.success_rate) as fn(&_) -> f64,
+                (|l: &unforeseen_harness::runs::batch::ResultLine| l.success_rate) as fn(&_) -> f64,
             ),
             ("mean reward", |l| l.mean_reward),
             ("inference rate", |l| l.inference_rate),

@@ -9,7 +9,7 @@ use std::io::IsTerminal;
 use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
-use crate::progress::{Message, Progress};
+use unforeseen_harness::progress::{Message, Progress};
 
 /// When the clock of the phase lines started.
 static START: OnceLock<Instant> = OnceLock::new();

@@ -1,18 +1,18 @@
 //! `unforeseen search`: search a space of map variations for the fair scenarios where a
-//! method fails (`crate::search`).
+//! method fails (`unforeseen_harness::runs::search`).
 
 use clap::Args;
 use std::path::PathBuf;
 
 use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
-use crate::agents::Agent;
-use crate::batch::{Shard, agent_file_identity, trained_agents_identity};
-use crate::maps;
-use crate::methods::Method;
-use crate::protocol::Protocol;
-use crate::search::{self, SearchConfig, Space, Summary};
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::maps;
+use unforeseen_harness::runs::batch::{Shard, agent_file_identity, trained_agents_identity};
+use unforeseen_harness::runs::search::{self, SearchConfig, Space, Summary};
+use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `search`.
 #[derive(Debug, Clone, Args)]
@@ -78,7 +78,7 @@ pub struct SearchArgs {
 /// Runs `search`.
 pub fn run(args: SearchArgs) -> anyhow::Result<()> {
     if !(1..=super::MAX_JOBS).contains(&args.jobs) {
-        return Err(crate::error::Error::flag("--jobs", "expected 1 to 256 worker threads").into());
+        return Err(unforeseen_harness::error::Error::flag("--jobs", "expected 1 to 256 worker threads").into());
     }
     let base = maps::load(&args.map)?;
     let space = Space::load(&args.space, &base)?;

@@ -1,7 +1,7 @@
 //! Printed tables: summarized figures as cells and aligned columns.
 
-use crate::report::num;
-use crate::stats::Stat;
+use unforeseen_harness::reports::files::num;
+use unforeseen_harness::stats::Stat;
 
 /// A summarized figure as a cell: `mean` with one value, `mean ± half-width` of the 95%
 /// interval with more; as a percentage when `percent`.

@@ -4,13 +4,13 @@ use clap::Args;
 use std::path::PathBuf;
 
 use super::{AgentArgs, warn_replacing};
-use crate::experiments::trace;
-use crate::maps;
-use crate::methods::Method;
-use crate::plots::{filmstrip, theta_trace};
-use crate::protocol::Protocol;
-use crate::replay::replay_html;
-use crate::report::{Csv, num, write_atomic};
+use unforeseen_harness::episodes::experiments::trace;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::maps;
+use unforeseen_harness::reports::figures::{filmstrip, theta_trace};
+use unforeseen_harness::reports::files::{Csv, num, write_atomic};
+use unforeseen_harness::reports::replay_page::replay_html;
 
 /// Arguments of `trace`.
 #[derive(Debug, Clone, Args)]

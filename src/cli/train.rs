@@ -4,9 +4,11 @@ use clap::Args;
 use std::path::PathBuf;
 
 use super::progress::{self, Bars};
-use crate::maps;
-use crate::progress::Progress;
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs, TrainConfig, train_with_progress};
+use unforeseen_harness::maps;
+use unforeseen_harness::progress::Progress;
+use unforeseen_harness::training::{
+    DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs, TrainConfig, train_with_progress,
+};
 
 /// Arguments of `train`.
 #[derive(Debug, Clone, Args)]
@@ -62,7 +64,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     };
     progress::phase(args.quiet, format_args!("writing {}", args.out.display()));
     super::warn_replacing_file(&args.out);
-    crate::agent_file::save(&args.out, &bundle)?;
+    unforeseen_harness::training::agent_file::save(&args.out, &bundle)?;
     outln!(
         "trained on '{}' for {} episodes in {:.1} s (mean return of the last {} with exploration: {mean:.2}); wrote {}",
         map.name,

@@ -5,8 +5,8 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 
 use super::progress::{self, Bars};
-use crate::agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
-use crate::training::{TimeoutAs, TrainConfig};
+use unforeseen_harness::training::seed_agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
+use unforeseen_harness::training::{TimeoutAs, TrainConfig};
 
 /// Options of a training-seed study.
 #[derive(Debug, Clone, Args)]
@@ -41,7 +41,7 @@ impl TrainSeedArgs {
     /// One agent per seed of `seeds`, trained on `train_map` for `episodes` episodes in
     /// parallel (or loaded from the cache).
     pub fn train(&self, seeds: &[u64], train_map: &str, episodes: u64, quiet: bool) -> anyhow::Result<Vec<Agent>> {
-        let map = crate::maps::load(train_map)?;
+        let map = unforeseen_harness::maps::load(train_map)?;
         progress::phase(
             quiet,
             format_args!(

@@ -6,11 +6,13 @@ use crate::common;
 
 use std::path::Path;
 use std::sync::OnceLock;
-use unforeseen::agents::Agent;
-use unforeseen::batch::{BatchConfig, ParamSet, ResultLine, Scenario, Shard, load_scenarios, read_lines, run, sweep};
-use unforeseen::methods::Method;
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::progress::NoProgress;
+use unforeseen_harness::runs::batch::{
+    BatchConfig, ParamSet, ResultLine, Scenario, Shard, load_scenarios, read_lines, run, sweep,
+};
+use unforeseen_harness::training::seed_agents::Agent;
 
 fn scenarios() -> Vec<Scenario> {
     let names = ["jaywalk".to_string(), "intersection".to_string()];
@@ -233,7 +235,7 @@ fn expectations_pass_and_fail_as_declared() {
 fn the_cli_fails_when_an_expectation_fails_and_names_it() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("agent.ron");
-    unforeseen::agent_file::save(&agent, common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, common::bundle()).unwrap();
     let jay = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps").join("jaywalk.ron");
     let map = dir.path().join("impossible.ron");
     std::fs::write(

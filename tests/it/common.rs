@@ -3,8 +3,8 @@
 #![allow(dead_code)]
 
 use std::sync::OnceLock;
-use unforeseen::training::{TrainConfig, train};
 use unforeseen_agent::persist::AgentBundle;
+use unforeseen_harness::training::{TrainConfig, train};
 
 /// Training episodes for tests: enough for Q-learning to learn to drive to the goal,
 /// small enough to keep `cargo test` fast.
@@ -21,7 +21,7 @@ pub fn small_config(seed: u64) -> TrainConfig {
 pub fn bundle() -> &'static AgentBundle {
     static BUNDLE: OnceLock<AgentBundle> = OnceLock::new();
     BUNDLE.get_or_init(|| {
-        let map = unforeseen::maps::load("intersection").expect("embedded map");
+        let map = unforeseen_harness::maps::load("intersection").expect("embedded map");
         train(&map, &small_config(7)).expect("training").0
     })
 }

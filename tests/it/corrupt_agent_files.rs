@@ -13,7 +13,7 @@ use crate::common;
 
 use std::path::Path;
 use std::process::Command;
-use unforeseen::error::Error;
+use unforeseen_harness::error::Error;
 
 /// `text` with the list opened at the line found by following `path` (each entry the
 /// start of a line, searched from the previous match) replaced by `f(items)`. Pretty
@@ -269,12 +269,12 @@ fn corpus() -> Vec<Case> {
 fn every_damaged_agent_file_is_refused_naming_the_field() {
     let valid = common::tiny_agent_text();
     let path = Path::new("agent.ron");
-    unforeseen::agent_file::parse(path, valid).expect("the undamaged agent loads");
+    unforeseen_harness::training::agent_file::parse(path, valid).expect("the undamaged agent loads");
     let cases = corpus();
     assert!(cases.len() >= 35);
     for c in &cases {
         assert_ne!(c.text, valid, "{}: the edit changed nothing", c.name);
-        let err = unforeseen::agent_file::parse(path, &c.text).expect_err(c.name);
+        let err = unforeseen_harness::training::agent_file::parse(path, &c.text).expect_err(c.name);
         let message = format!("{err:#}");
         assert_eq!(unforeseen::cli::exit_code(&err), 2, "{}: {message}", c.name);
         assert!(matches!(err, Error::AgentFile { .. }), "{}: {message}", c.name);

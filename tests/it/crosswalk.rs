@@ -4,16 +4,16 @@
 //! crash-risk states.
 
 use crate::common::bundle;
-use unforeseen::methods::Method;
-use unforeseen::rewards::crash_model;
 use unforeseen_agent::params::{CrashPlanning, ScaledParams};
 use unforeseen_discretizer::{Discretizer, State};
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::rewards::crash_model;
 
 /// Hazards of the default map by hand: speed bins [0, 1.5), [1.5, 4.5), [4.5, 7.5),
 /// [7.5, 9] have middles 0.75, 3, 6, 8.25 m/s; one tick at top speed covers 9 m.
 #[test]
 fn hazards_by_hand() {
-    let map = unforeseen::maps::load("intersection").unwrap();
+    let map = unforeseen_harness::maps::load("intersection").unwrap();
     let disc = Discretizer::new(&map).unwrap();
     let crash = crash_model(&map, &disc, 1.0);
     let s = |d, v, p| disc.encode(State { d, v, l: 1, p });
@@ -47,13 +47,13 @@ fn hazards_by_hand() {
 /// the planner dashes; with the crash model it brakes.
 #[test]
 fn the_crash_model_brakes_where_the_crash_states_dash() {
-    let map = unforeseen::maps::load("intersection").unwrap();
+    let map = unforeseen_harness::maps::load("intersection").unwrap();
     let disc = Discretizer::new(&map).unwrap();
     let o = disc.encode(State { d: 1, v: 2, l: 1, p: 1 });
     let act = |crash_model| {
         let mut params = ScaledParams::default();
         params.planning.crash_model = crash_model;
-        let mut agent = Method::ScaledAlways.controller(bundle(), &params).unwrap();
+        let mut agent = Method::ScaledAlways.controller(bundle(), &params, &map).unwrap();
         agent.act(o)
     };
     let hazard = act(CrashPlanning::Hazard);

@@ -4,17 +4,17 @@
 
 use crate::common;
 
-use unforeseen::experiments::{evaluate, learn, trace};
-use unforeseen::methods::Method;
-use unforeseen::metrics::Aggregate;
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_harness::episodes::experiments::{evaluate, learn, trace};
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::metrics::Aggregate;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::progress::NoProgress;
 
 #[test]
 fn scaled_avoids_the_jaywalker_that_q_learning_hits() {
     let bundle = common::bundle();
-    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let params = ScaledParams::default();
 
     let (q, q_ticks) = trace(bundle, &params, Method::QLearning, &jaywalk, 11, Protocol::ZeroShot, 0).unwrap();
@@ -58,11 +58,11 @@ fn scaled_avoids_the_jaywalker_that_q_learning_hits() {
 #[test]
 fn test_time_learning_makes_the_jaywalk_familiar_without_a_crash() {
     let bundle = common::bundle();
-    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let points = learn(bundle, &ScaledParams::default(), &jaywalk, 30, 3, &NoProgress).unwrap();
     let (first, last) = (&points[0], points.last().unwrap());
     assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
-    let surprise = |p: &unforeseen::experiments::LearnPoint| p.event_surprise_bits.unwrap();
+    let surprise = |p: &unforeseen_harness::episodes::experiments::LearnPoint| p.event_surprise_bits.unwrap();
     assert!(surprise(last) < 0.5 * surprise(first), "surprise {first:?} -> {last:?}");
     assert!(last.p_pedestrian_green_d2.unwrap() > first.p_pedestrian_green_d2.unwrap() + 0.3);
     assert!(last.p_slow_down > first.p_slow_down, "habit {first:?} -> {last:?}");
@@ -75,10 +75,10 @@ fn test_time_learning_makes_the_jaywalk_familiar_without_a_crash() {
 #[test]
 fn over_a_few_episodes_scaled_beats_q_learning_on_the_jaywalk() {
     let bundle = common::bundle();
-    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let params = ScaledParams::default();
     let run = |m: Method| {
-        let mut c = m.controller(bundle, &params).unwrap();
+        let mut c = m.controller(bundle, &params, &jaywalk).unwrap();
         Aggregate::of(&evaluate(&jaywalk, c.as_mut(), m, 10, 5, &NoProgress).unwrap())
     };
     let q = run(Method::QLearning);
@@ -94,9 +94,9 @@ fn over_a_few_episodes_scaled_beats_q_learning_on_the_jaywalk() {
 #[test]
 fn a_traced_continual_episode_is_the_one_a_continual_run_meets() {
     let bundle = common::bundle();
-    let map = unforeseen::maps::load("stop_midway").unwrap();
+    let map = unforeseen_harness::maps::load("stop_midway").unwrap();
     let params = ScaledParams::default();
-    let mut agent = Method::Scaled.controller(bundle, &params).unwrap();
+    let mut agent = Method::Scaled.controller(bundle, &params, &map).unwrap();
     let run = evaluate(&map, agent.as_mut(), Method::Scaled, 4, 3, &NoProgress).unwrap();
     let (traced, ticks) = trace(bundle, &params, Method::Scaled, &map, 3, Protocol::Continual, 3).unwrap();
     let last = &run[3];
@@ -114,11 +114,13 @@ fn a_traced_continual_episode_is_the_one_a_continual_run_meets() {
 #[test]
 fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
     let bundle = common::bundle();
-    let map = unforeseen::maps::load("jaywalk_late").unwrap();
+    let map = unforeseen_harness::maps::load("jaywalk_late").unwrap();
     let reasoning = |params: &ScaledParams| {
         let points = learn(bundle, params, &map, 30, 3, &NoProgress).unwrap();
         assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
-        let ticks = |ps: &[unforeseen::experiments::LearnPoint]| ps.iter().map(|p| p.reasoning_ticks).sum::<u32>();
+        let ticks = |ps: &[unforeseen_harness::episodes::experiments::LearnPoint]| {
+            ps.iter().map(|p| p.reasoning_ticks).sum::<u32>()
+        };
         (ticks(&points[..5]), ticks(&points[25..]))
     };
     let (first, last) = reasoning(&ScaledParams::default());
@@ -142,9 +144,9 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
 #[test]
 fn scaled_waits_for_the_slow_walker() {
     let bundle = common::bundle();
-    let map = unforeseen::maps::load("slow_walker").unwrap();
+    let map = unforeseen_harness::maps::load("slow_walker").unwrap();
     let success = |params: &ScaledParams| {
-        let mut agent = Method::Scaled.controller(bundle, params).unwrap();
+        let mut agent = Method::Scaled.controller(bundle, params, &map).unwrap();
         Aggregate::of(&evaluate(&map, agent.as_mut(), Method::Scaled, 10, 7, &NoProgress).unwrap()).success_rate
     };
     assert_eq!(success(&ScaledParams::default()), 1.0);

@@ -3,11 +3,13 @@
 //! cut-off text (estimated from the SVG's `<text>` elements: `svg_text`). The figures
 //! the README's commands write are checked the same way in `readme`.
 
-use unforeseen::experiments::trace;
-use unforeseen::methods::Method;
-use unforeseen::plots::{BarPanel, BarRow, Series, bar_key, filmstrip, grouped_bars, line_panels, theta_trace};
-use unforeseen::protocol::Protocol;
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_harness::episodes::experiments::trace;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::reports::figures::{
+    BarPanel, BarRow, Series, bar_key, filmstrip, grouped_bars, line_panels, theta_trace,
+};
 
 use crate::common;
 use crate::svg_text::assert_text_fits;
@@ -124,7 +126,7 @@ fn grouped_bars_for_one_and_several_agents_fit() {
 #[test]
 fn filmstrips_of_real_episodes_fit() {
     let dir = tempfile::tempdir().unwrap();
-    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     for method in [Method::Scaled, Method::QLearning] {
         let (_, ticks) = trace(
             common::bundle(),

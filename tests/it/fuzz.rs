@@ -13,11 +13,11 @@ use crate::common;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
-use unforeseen::methods::Method;
-use unforeseen::runner::{EpisodeSeeds, run_episode};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_discretizer::Discretizer;
 use unforeseen_env::{Env, EnvConfig, ObservationForm};
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::runner::{EpisodeSeeds, run_episode};
 use unforeseen_sim::{Action, Map};
 
 fn cases() -> usize {
@@ -225,7 +225,7 @@ fn mutated_agent_files_are_refused_or_drive_the_car() {
     let (mut accepted, n) = (0, cases());
     for case in 0..n {
         let text = mutate(valid, &mut rng);
-        let bundle = match unforeseen::agent_file::parse(path, &text) {
+        let bundle = match unforeseen_harness::training::agent_file::parse(path, &text) {
             Ok(b) => b,
             Err(e) => {
                 assert_eq!(unforeseen::cli::exit_code(&e), 2, "case {case}: {e:#}");
@@ -234,7 +234,7 @@ fn mutated_agent_files_are_refused_or_drive_the_car() {
             }
         };
         accepted += 1;
-        if unforeseen::agent_file::check_compatible(&bundle, &map).is_err() {
+        if unforeseen_harness::training::agent_file::check_compatible(&bundle, &map).is_err() {
             continue;
         }
         for method in [
@@ -243,7 +243,7 @@ fn mutated_agent_files_are_refused_or_drive_the_car() {
             Method::BayesRlFactored,
             Method::Scaled,
         ] {
-            let Ok(mut controller) = method.controller(&bundle, &params) else {
+            let Ok(mut controller) = method.controller(&bundle, &params, &map) else {
                 continue;
             };
             // Two episodes on one controller: the second after test-time learning.

@@ -10,14 +10,14 @@
 
 use crate::common;
 use std::fmt::Write;
-use unforeseen::experiments::trace;
-use unforeseen::methods::Method;
-use unforeseen::protocol::Protocol;
-use unforeseen::runner::{EpisodeResult, Tick};
-use unforeseen::seeds::content_hash;
-use unforeseen::training::{TimeoutAs, train};
 use unforeseen_agent::params::{CrashPlanning, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
+use unforeseen_harness::episodes::experiments::trace;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::runner::{EpisodeResult, Tick};
+use unforeseen_harness::seeds::content_hash;
+use unforeseen_harness::training::{TimeoutAs, train};
 
 fn bits(x: f64) -> String {
     format!("{:016x}", x.to_bits())
@@ -126,8 +126,8 @@ fn digests(bundle: &AgentBundle) -> [String; 4] {
 fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
     [
         agent_digest(bundle),
-        episodes_digest(bundle, &unforeseen::maps::load("intersection").unwrap(), params),
-        episodes_digest(bundle, &unforeseen::maps::load("jaywalk").unwrap(), params),
+        episodes_digest(bundle, &unforeseen_harness::maps::load("intersection").unwrap(), params),
+        episodes_digest(bundle, &unforeseen_harness::maps::load("jaywalk").unwrap(), params),
         episodes_digest(bundle, &noisy_jaywalk(), params),
     ]
 }
@@ -146,7 +146,7 @@ fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
 /// recorded on that code.
 #[test]
 fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
-    let map = unforeseen::maps::load("intersection").unwrap();
+    let map = unforeseen_harness::maps::load("intersection").unwrap();
     let mut cfg = common::small_config(7);
     cfg.timeout_as = TimeoutAs::Termination;
     let (bundle, _) = train(&map, &cfg).unwrap();
@@ -158,7 +158,7 @@ fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
 /// settings differ where episodes time out: `timeouts_truncate_and_learners_bootstrap`).
 #[test]
 fn trained_agent_and_decisions_are_unchanged() {
-    let map = unforeseen::maps::load("intersection").unwrap();
+    let map = unforeseen_harness::maps::load("intersection").unwrap();
     let (_, log) = train(&map, &common::small_config(7)).unwrap();
     assert_eq!(log.timeouts, 0);
     assert_eq!(digests(common::bundle()), GOLDEN);

@@ -4,7 +4,7 @@
 
 use crate::common::{TINY_MAP, assert_exit, run_cli, tiny_agent_text};
 use std::path::{Path, PathBuf};
-use unforeseen::batch::{ResultLine, read_lines, summary_path};
+use unforeseen_harness::runs::batch::{ResultLine, read_lines, summary_path};
 
 struct Setup {
     dir: tempfile::TempDir,

@@ -5,11 +5,11 @@
 
 use crate::common;
 use serde_json::{Value, json};
-use unforeseen::batch::sweep;
-use unforeseen::overrides::{apply, keys, set_one, set_value};
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::param_table;
 use unforeseen_agent::params::{ScaledParams, ScalingMode};
+use unforeseen_harness::overrides::{apply, keys, set_one, set_value};
+use unforeseen_harness::runs::batch::sweep;
 
 /// A value other than the default for each key, as `--set` text and as JSON.
 fn other_value(key: &str) -> (String, Value) {
@@ -97,10 +97,14 @@ fn unknown_keys_and_bad_values_name_the_key_and_the_allowed_values() {
 fn factor_names_are_checked_against_the_model() {
     let bundle = common::bundle();
     let p = apply(ScaledParams::default(), &["gate_factor=x".into()]).unwrap();
-    let e = unforeseen::methods::scaled_agent(bundle, p).unwrap_err().to_string();
+    let e = unforeseen_harness::episodes::methods::scaled_agent(bundle, p)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("gate_factor") && e.contains("d, v, L, p"), "{e}");
     let p = apply(ScaledParams::default(), &["persistence_ignores=v".into()]).unwrap();
-    let e = unforeseen::methods::scaled_agent(bundle, p).unwrap_err().to_string();
+    let e = unforeseen_harness::episodes::methods::scaled_agent(bundle, p)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("persistence_ignores") && e.contains("next-time parents of `p`"),
         "{e}"
@@ -118,7 +122,7 @@ fn scaling_mode_closed_form_reaches_the_closed_form_and_acts() {
     .unwrap();
     assert_eq!(p.scaling.scaling_mode, ScalingMode::ClosedForm);
     let bundle = common::bundle();
-    let mut agent = unforeseen::methods::scaled_agent(bundle, p).unwrap();
+    let mut agent = unforeseen_harness::episodes::methods::scaled_agent(bundle, p).unwrap();
     let n = bundle.world_model.n_states();
     agent.begin_episode(3);
     let mut reasoned = 0;

@@ -4,12 +4,12 @@
 
 use crate::common;
 
-use unforeseen::experiments::{evaluate, evaluate_under};
-use unforeseen::methods::Method;
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
-use unforeseen::runner::EpisodeResult;
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_harness::episodes::experiments::{evaluate, evaluate_under};
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::runner::EpisodeResult;
+use unforeseen_harness::progress::NoProgress;
 
 /// Results without the wall-clock fields.
 fn untimed(results: Vec<EpisodeResult>) -> Vec<EpisodeResult> {
@@ -24,7 +24,7 @@ fn untimed(results: Vec<EpisodeResult>) -> Vec<EpisodeResult> {
 }
 
 fn zero_shot(method: Method, threads: usize) -> Vec<EpisodeResult> {
-    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let params = ScaledParams::default();
     let hidden = NoProgress;
@@ -45,12 +45,12 @@ fn zero_shot(method: Method, threads: usize) -> Vec<EpisodeResult> {
 
 #[test]
 fn methods_that_do_not_learn_across_episodes_give_the_same_results_under_both_protocols() {
-    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let params = ScaledParams::default();
     for method in [Method::QLearning, Method::ScaledNoLearning] {
         assert!(!method.learns_across_episodes(&params));
         // The real continual loop: one controller, episodes in order.
-        let mut controller = method.controller(common::bundle(), &params).unwrap();
+        let mut controller = method.controller(common::bundle(), &params, &jaywalk).unwrap();
         let continual = untimed(evaluate(&jaywalk, controller.as_mut(), method, 4, 5, &NoProgress).unwrap());
         assert_eq!(continual, zero_shot(method, 2), "{method}");
     }

@@ -3,12 +3,12 @@
 //! `max_red_light` expectation, and `batch --train-map`.
 
 use std::path::{Path, PathBuf};
-use unforeseen::batch::check_expectations;
-use unforeseen::methods::Method;
-use unforeseen::metrics::Aggregate;
-use unforeseen::protocol::Protocol;
-use unforeseen::rewards::{entered_bins, red_light_cost, state_rewards};
 use unforeseen_discretizer::{Discretizer, State};
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::metrics::Aggregate;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::rewards::{entered_bins, red_light_cost, state_rewards};
+use unforeseen_harness::runs::batch::check_expectations;
 
 use crate::common::{assert_exit, run_cli};
 
@@ -17,7 +17,7 @@ fn shipped(rel: &str) -> PathBuf {
 }
 
 fn load(rel: &str) -> unforeseen_sim::Map {
-    unforeseen::maps::load(shipped(rel).to_str().unwrap()).expect("shipped map")
+    unforeseen_harness::maps::load(shipped(rel).to_str().unwrap()).expect("shipped map")
 }
 
 #[test]
@@ -43,14 +43,14 @@ fn the_planner_pays_for_entering_the_crosswalk_on_red() {
     let bits = |m: &unforeseen_sim::Map| state_rewards(m, &disc).iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&map), bits(&free));
     // The trained agent carries it: its planning model has the rule, a rule-free one not.
-    let cfg = unforeseen::training::TrainConfig::new(5, 1);
-    let (agent, _) = unforeseen::training::train(&map, &cfg).unwrap();
+    let cfg = unforeseen_harness::training::TrainConfig::new(5, 1);
+    let (agent, _) = unforeseen_harness::training::train(&map, &cfg).unwrap();
     assert_eq!(agent.world_model.generative().transition_cost.as_ref(), Some(&rule));
     assert_eq!(
         agent.world_model.planning_generative().transition_cost.as_ref(),
         Some(&rule)
     );
-    let (free_agent, _) = unforeseen::training::train(&free, &cfg).unwrap();
+    let (free_agent, _) = unforeseen_harness::training::train(&free, &cfg).unwrap();
     assert!(free_agent.world_model.generative().transition_cost.is_none());
     // ...and keeps it through its file.
     let back = unforeseen_agent::persist::AgentBundle::from_ron_str(&agent.to_ron_string()).unwrap();
@@ -61,7 +61,7 @@ fn the_planner_pays_for_entering_the_crosswalk_on_red() {
 #[test]
 fn maps_without_the_rule_or_without_the_edge_keep_the_papers_preferences() {
     for name in ["intersection", "jaywalk", "stuck_green", "slow_walker"] {
-        let map = unforeseen::maps::load(name).unwrap();
+        let map = unforeseen_harness::maps::load(name).unwrap();
         let disc = Discretizer::new(&map).unwrap();
         let r = state_rewards(&map, &disc);
         // Only the goal and the crash risk, as in the paper (§VI).
@@ -73,7 +73,7 @@ fn maps_without_the_rule_or_without_the_edge_keep_the_papers_preferences() {
     }
     // The rule with the default bins: d = 1 holds 4 m before the crosswalk, so no state
     // says the car has entered, and R(s) stays the rule-free one bit for bit.
-    let mut map = unforeseen::maps::load("intersection").unwrap();
+    let mut map = unforeseen_harness::maps::load("intersection").unwrap();
     let disc = Discretizer::new(&map).unwrap();
     let free = state_rewards(&map, &disc);
     map.reward.red_light = -100.0;
@@ -94,7 +94,7 @@ fn max_red_light_bounds_the_violations_per_episode() {
         "Map(base: \"jaywalk\", expect: [(method: QLearning, max_red_light: 0.1, protocol: ZeroShot)])",
     )
     .unwrap();
-    let map = unforeseen::maps::load(good.to_str().unwrap()).unwrap();
+    let map = unforeseen_harness::maps::load(good.to_str().unwrap()).unwrap();
     assert_eq!(map.expect[0].max_red_light, Some(0.1));
     let agg = |rate| Aggregate {
         episodes: 10,
@@ -122,7 +122,9 @@ fn a_bad_max_red_light_names_the_file_the_place_and_the_fix() {
         "Map(base: \"jaywalk\",\n  expect: [\n    (method: Scaled, max_red_light: 1.5),\n  ])\n",
     )
     .unwrap();
-    let e = unforeseen::maps::load(range.to_str().unwrap()).unwrap_err().to_string();
+    let e = unforeseen_harness::maps::load(range.to_str().unwrap())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("range.ron"), "{e}");
     assert!(e.contains("expect[0].max_red_light: must be in [0, 1], got 1.5"), "{e}");
     assert!(e.contains("hint: a probability or a rate"), "{e}");
@@ -132,7 +134,9 @@ fn a_bad_max_red_light_names_the_file_the_place_and_the_fix() {
         "Map(base: \"jaywalk\",\n  expect: [\n    (method: Scaled, max_red_light: \"low\"),\n  ])\n",
     )
     .unwrap();
-    let e = unforeseen::maps::load(typed.to_str().unwrap()).unwrap_err().to_string();
+    let e = unforeseen_harness::maps::load(typed.to_str().unwrap())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("typed.ron:3:"), "the line of the field: {e}");
     let out = run_cli(&["check-map", "--survivability-episodes", "0", range.to_str().unwrap()]);
     assert_exit(&out, 2, &["range.ron", "expect[0].max_red_light", "hint:"]);

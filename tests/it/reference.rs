@@ -5,13 +5,13 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use unforeseen::experiments::evaluate;
-use unforeseen::methods::Method;
-use unforeseen::metrics::Aggregate;
-use unforeseen::progress::NoProgress;
-use unforeseen::survivability::witness;
-use unforeseen::training::{TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_harness::episodes::experiments::evaluate;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::metrics::Aggregate;
+use unforeseen_harness::episodes::survivability::witness;
+use unforeseen_harness::progress::NoProgress;
+use unforeseen_harness::training::{TrainConfig, train};
 
 const EPISODES: u64 = 20;
 
@@ -60,7 +60,7 @@ fn too_late(dir: &Path) -> PathBuf {
 
 #[test]
 fn brake_on_pedestrian_survives_the_jaywalker_and_never_brake_does_not() {
-    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let brake = witness(&jaywalk, Method::BrakeOnPedestrian, EPISODES, 7).unwrap();
     assert_eq!(brake.episodes, EPISODES);
     assert_eq!(brake.success_rate, 1.0, "{brake:?}");
@@ -72,14 +72,14 @@ fn brake_on_pedestrian_survives_the_jaywalker_and_never_brake_does_not() {
 #[test]
 fn the_method_factory_builds_the_references_from_an_agent_file_too() {
     // One training episode is enough: the references read only the model's factor sizes.
-    let intersection = unforeseen::maps::load("intersection").unwrap();
+    let intersection = unforeseen_harness::maps::load("intersection").unwrap();
     let cfg = TrainConfig::new(1, 7);
     let bundle = train(&intersection, &cfg).unwrap().0;
-    let jaywalk = unforeseen::maps::load("jaywalk").unwrap();
+    let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     for method in Method::REFERENCE {
         assert!(method.is_scripted() && !Method::PAPER.contains(&method));
         assert!(!method.learns_across_episodes(&ScaledParams::default()));
-        let mut controller = method.controller(&bundle, &ScaledParams::default()).unwrap();
+        let mut controller = method.controller(&bundle, &ScaledParams::default(), &jaywalk).unwrap();
         assert_eq!(controller.name(), method.name());
         let results = evaluate(&jaywalk, controller.as_mut(), method, EPISODES, 7, &NoProgress).unwrap();
         let agg = Aggregate::of(&results);
@@ -90,7 +90,12 @@ fn the_method_factory_builds_the_references_from_an_agent_file_too() {
             "{method}: same episodes, same result"
         );
     }
-    assert!(Method::QLearning.scripted_controller(&[4, 4, 2, 2]).unwrap().is_none());
+    assert!(
+        Method::QLearning
+            .scripted_controller(&[4, 4, 2, 2], &jaywalk)
+            .unwrap()
+            .is_none()
+    );
 }
 
 #[test]
@@ -134,10 +139,10 @@ fn check_map_warns_when_a_map_is_not_dangerous_or_not_survivable() {
 fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
     let dir = tempfile::tempdir().unwrap();
     let harmless = harmless(dir.path());
-    let intersection = unforeseen::maps::load("intersection").unwrap();
+    let intersection = unforeseen_harness::maps::load("intersection").unwrap();
     let cfg = TrainConfig::new(1, 7);
     let agent = dir.path().join("agent.ron");
-    unforeseen::agent_file::save(&agent, &train(&intersection, &cfg).unwrap().0).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, &train(&intersection, &cfg).unwrap().0).unwrap();
     let results = dir.path().join("r.jsonl");
     let out = unforeseen(&[
         "batch",
@@ -192,8 +197,8 @@ fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
 /// same map, `red_light: 0`) the witness ignores the light, as before.
 #[test]
 fn brake_on_pedestrian_stops_for_red_where_the_map_has_the_rule() {
-    use unforeseen::experiments::evaluate_scripted;
-    let mut map = unforeseen::maps::load(&shipped("red_light/red_on_approach.ron")).unwrap();
+    use unforeseen_harness::episodes::experiments::evaluate_scripted;
+    let mut map = unforeseen_harness::maps::load(&shipped("red_light/red_on_approach.ron")).unwrap();
     assert_eq!(map.reward.red_light, -100.0);
     let run = |map: &unforeseen_sim::Map, method| {
         Aggregate::of(&evaluate_scripted(map, method, EPISODES, 7, &NoProgress).unwrap())

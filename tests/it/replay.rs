@@ -18,7 +18,7 @@ fn embedded_episode(page: &str) -> serde_json::Value {
 fn trace_html_is_self_contained_and_carries_every_tick() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("agent.ron");
-    unforeseen::agent_file::save(&agent, common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, common::bundle()).unwrap();
     let html = dir.path().join("replay").join("episode.html");
     let out = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
         .args(["trace", "--map", "jaywalk", "--seed", "11", "-q", "--agent"])
@@ -101,19 +101,19 @@ fn trace_html_is_self_contained_and_carries_every_tick() {
 
 #[test]
 fn names_in_the_page_cannot_end_its_script() {
-    let map = unforeseen::maps::load("jaywalk").unwrap();
-    let (_, ticks) = unforeseen::experiments::trace(
+    let map = unforeseen_harness::maps::load("jaywalk").unwrap();
+    let (_, ticks) = unforeseen_harness::episodes::experiments::trace(
         common::bundle(),
         &Default::default(),
-        unforeseen::methods::Method::QLearning,
+        unforeseen_harness::episodes::methods::Method::QLearning,
         &map,
         3,
-        unforeseen::protocol::Protocol::ZeroShot,
+        unforeseen_harness::episodes::protocol::Protocol::ZeroShot,
         0,
     )
     .unwrap();
     let title = "a </script><script>alert(1)</script> & \"quoted\" title";
-    let page = unforeseen::replay::replay_html(title, "ended", &map, &ticks, 0.2).unwrap();
+    let page = unforeseen_harness::reports::replay_page::replay_html(title, "ended", &map, &ticks, 0.2).unwrap();
     assert_eq!(
         page.matches("</script>").count(),
         2,
@@ -133,7 +133,7 @@ fn names_in_the_page_cannot_end_its_script() {
 fn the_replay_marks_the_tick_that_ran_the_red_light() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("agent.ron");
-    unforeseen::agent_file::save(&agent, common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, common::bundle()).unwrap();
     let html = dir.path().join("episode.html");
     let map = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("maps/red_light/red_on_approach.ron");
     let out = Command::new(env!("CARGO_BIN_EXE_unforeseen"))

@@ -15,15 +15,15 @@
 
 use std::path::Path;
 use std::sync::OnceLock;
-use unforeseen::experiments::{eval_seeds, evaluate_under};
-use unforeseen::methods::{Method, scaled_agent};
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
-use unforeseen::runner::{EpisodeResult, run_episode};
-use unforeseen::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_env::{Env, EnvConfig};
+use unforeseen_harness::episodes::experiments::{eval_seeds, evaluate_under};
+use unforeseen_harness::episodes::methods::{Method, scaled_agent};
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::runner::{EpisodeResult, run_episode};
+use unforeseen_harness::progress::NoProgress;
+use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 
 use crate::common;
 
@@ -31,7 +31,7 @@ use crate::common;
 fn full_agent() -> &'static AgentBundle {
     static BUNDLE: OnceLock<AgentBundle> = OnceLock::new();
     BUNDLE.get_or_init(|| {
-        let map = unforeseen::maps::load("intersection").expect("embedded map");
+        let map = unforeseen_harness::maps::load("intersection").expect("embedded map");
         train(&map, &TrainConfig::new(DEFAULT_TRAIN_EPISODES, 7))
             .expect("training")
             .0
@@ -41,7 +41,7 @@ fn full_agent() -> &'static AgentBundle {
 const EPISODES: u64 = 40;
 
 fn crowd() -> unforeseen_sim::Map {
-    unforeseen::maps::load_file(Path::new("maps/crowd.ron")).expect("maps/crowd.ron")
+    unforeseen_harness::maps::load_file(Path::new("maps/crowd.ron")).expect("maps/crowd.ron")
 }
 
 fn run(bundle: &AgentBundle, method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<EpisodeResult> {
@@ -141,7 +141,7 @@ fn triggers_only_learning_made_go_to_a_safe_habit() {
 /// Reasoning ticks over 40 continual episodes on `map` (a file or an embedded name) whose
 /// true state has nobody on the crosswalk, with the parameters `settings` changed.
 fn empty_road_reasoning(map: &str, settings: &[(&str, &str)]) -> usize {
-    let map = unforeseen::maps::load(map).unwrap();
+    let map = unforeseen_harness::maps::load(map).unwrap();
     let episodes = continual_ticks_with(&map, settings, 40);
     episodes
         .iter()

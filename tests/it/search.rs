@@ -3,19 +3,19 @@
 //! are a few candidates of a few episodes, on a small space.
 
 use std::path::Path;
-use unforeseen::agents::Agent;
-use unforeseen::batch::Shard;
-use unforeseen::methods::Method;
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
-use unforeseen::search::{self, Fairness, SearchConfig, Space, Value, sobol_candidates};
-use unforeseen::survivability::witness;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::survivability::witness;
+use unforeseen_harness::progress::NoProgress;
+use unforeseen_harness::runs::batch::Shard;
+use unforeseen_harness::runs::search::{self, Fairness, SearchConfig, Space, Value, sobol_candidates};
+use unforeseen_harness::training::seed_agents::Agent;
 use unforeseen_sim::Map;
 
 use crate::common::{assert_exit, bundle, run_cli};
 
 fn jaywalk() -> Map {
-    unforeseen::maps::load("jaywalk").expect("embedded jaywalk")
+    unforeseen_harness::maps::load("jaywalk").expect("embedded jaywalk")
 }
 
 /// A small space: three parameters of the jaywalk.
@@ -202,8 +202,8 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
         );
         assert!(f.method_success.iter().all(|&(_, s)| s < 0.5), "{f:?}");
         // The written map is that scenario: re-run as batch would, it fails again.
-        let map = unforeseen::maps::load_file(&f.file).expect("a valid map file");
-        let results = unforeseen::experiments::evaluate_under(
+        let map = unforeseen_harness::maps::load_file(&f.file).expect("a valid map file");
+        let results = unforeseen_harness::episodes::experiments::evaluate_under(
             Protocol::ZeroShot,
             &map,
             bundle(),
@@ -214,7 +214,7 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
             &NoProgress,
         )
         .expect("runs");
-        let agg = unforeseen::metrics::Aggregate::of(&results);
+        let agg = unforeseen_harness::episodes::metrics::Aggregate::of(&results);
         assert_eq!(Some(agg.success_rate), f.method_success.first().map(|s| s.1));
         assert!(
             witness(&map, Method::BrakeOnPedestrian, 3, 5)

@@ -7,11 +7,13 @@ use crate::common::{self, assert_exit, run_cli};
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use unforeseen::agents::Agent;
-use unforeseen::batch::{BatchConfig, ParamSet, ResultLine, Shard, load_stream_scenario, read_lines, run};
-use unforeseen::methods::Method;
-use unforeseen::progress::NoProgress;
-use unforeseen::protocol::Protocol;
+use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::progress::NoProgress;
+use unforeseen_harness::runs::batch::{
+    BatchConfig, ParamSet, ResultLine, Shard, load_stream_scenario, read_lines, run,
+};
+use unforeseen_harness::training::seed_agents::Agent;
 
 /// A stream over two embedded maps in a fixed sequence (intersection, intersection,
 /// jaywalk, repeated), and the shared test agent's file, in `dir`.
@@ -23,7 +25,7 @@ fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
     )
     .unwrap();
     let agent = dir.join("agent.ron");
-    unforeseen::agent_file::save(&agent, common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, common::bundle()).unwrap();
     (stream, agent)
 }
 
@@ -190,7 +192,7 @@ fn stream_batches_do_not_depend_on_jobs_and_shard_merge_and_resume_to_the_whole(
             part
         })
         .collect();
-    let merged = unforeseen::merge::merge(&parts).unwrap();
+    let merged = unforeseen_harness::runs::merge::merge(&parts).unwrap();
     assert_eq!(without_timing(merged.results()), a);
 
     // A kill after the first line: --resume runs the rest and keeps that line's bytes.

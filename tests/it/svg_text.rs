@@ -1,7 +1,7 @@
 //! Where the text of an SVG figure lies, estimated from its `<text>` elements (position,
 //! anchor, font size, length, rotation), to check that no two texts overlap and that
 //! none is cut off at the figure's edge. The estimate is deliberately independent of
-//! the one the figures are laid out with (`unforeseen::plots::text_width`): glyph
+//! the one the figures are laid out with (`unforeseen_harness::reports::figures::text_width`): glyph
 //! widths here come in classes (narrow, digits, capitals, wide) of DejaVu Sans, the
 //! usual sans-serif.
 

@@ -10,7 +10,7 @@ use unforeseen_agent::model::WorldModel;
 use unforeseen_agent::params::{BayesModel, BayesRlParams, ModelPriors, Planner, QParams, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::{AgentBundle, FORMAT_VERSION};
 use unforeseen_agent::q_learning::QLearning;
-use unforeseen_agent::scaled::ScaledAgent;
+use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_agent::structure::Structure;
 
 /// A toy chain: v' = v + 1 under action 1 (speed up), d decreases with v'.

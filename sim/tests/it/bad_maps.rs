@@ -398,7 +398,7 @@ fn the_shipped_maps_are_within_the_limits() {
                 continue;
             }
             if path.is_dir() {
-                // maps/streams/ holds deployment streams (lists of maps, src/stream.rs), not maps.
+                // maps/streams/ holds deployment streams (lists of maps, harness/src/runs/stream.rs), not maps.
                 if !path.ends_with("streams") {
                     dirs.push(path);
                 }

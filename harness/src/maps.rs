@@ -1,0 +1,119 @@
+//! Finding a map: a file path, or the name of a map embedded in the binary
+//! (`intersection`, `jaywalk`, ...), so the default run needs no files at all. Every
+//! map loaded here has its expectations' names checked against this program's
+//! [`Method`]s and [`Protocol`]s ([`check_expectation_names`]).
+
+use std::path::Path;
+use unforeseen_sim::{Diagnostic, Map, MapError, embedded};
+
+use crate::episodes::methods::Method;
+use crate::episodes::protocol::Protocol;
+pub use crate::error::MapLookupError;
+
+/// Loads `arg` as a map file if such a path exists, else as an embedded map name
+/// (with or without `.ron`).
+pub fn load(arg: &str) -> Result<Map, MapLookupError> {
+    let path = Path::new(arg);
+    if path.exists() {
+        return Ok(load_file(path)?);
+    }
+    let name = arg.strip_suffix(".ron").unwrap_or(arg);
+    if embedded::names().contains(&name) {
+        let map = embedded::load(name)?;
+        check_expectation_names(&map, &format!("embedded:{name}"))?;
+        return Ok(map);
+    }
+    Err(MapLookupError::NotFound {
+        arg: arg.to_string(),
+        names: embedded::names().join(", "),
+    })
+}
+
+/// Loads a map file ([`Map::load`]) and checks its expectations' names
+/// ([`check_expectation_names`]).
+pub fn load_file(path: &Path) -> Result<Map, MapError> {
+    let map = Map::load(path)?;
+    check_expectation_names(&map, &path.display().to_string())?;
+    Ok(map)
+}
+
+/// Checks that every expectation of `map` names a method ([`Method::map_name`]) and, if
+/// it names one, a protocol ([`Protocol::map_name`]) of this program. `file` names the
+/// map in the diagnostics (one per bad name, with its field, e.g. `expect[2].method`,
+/// and the allowed names).
+pub fn check_expectation_names(map: &Map, file: &str) -> Result<(), MapError> {
+    let diagnostic = |path: String, what: &str, name: &str, allowed: Vec<&str>| Diagnostic {
+        file: file.to_string(),
+        position: None,
+        path,
+        message: format!("unknown {what} `{name}`"),
+        hint: Some(format!("expected one of: {}", allowed.join(", "))),
+    };
+    let mut problems = Vec::new();
+    for (i, e) in map.expect.iter().enumerate() {
+        if Method::from_map_name(&e.method).is_none() {
+            let allowed = Method::all().iter().map(|m| m.map_name()).collect();
+            problems.push(diagnostic(format!("expect[{i}].method"), "method", &e.method, allowed));
+        }
+        if let Some(p) = &e.protocol
+            && Protocol::from_map_name(p).is_none()
+        {
+            let allowed = Protocol::ALL.iter().map(|p| p.map_name()).collect();
+            problems.push(diagnostic(format!("expect[{i}].protocol"), "protocol", p, allowed));
+        }
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(MapError::new(problems))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Map {
+        Map::from_str_named("bad.ron", text, &|_| None).expect("the map parses")
+    }
+
+    #[test]
+    fn expectation_names_are_checked_against_methods_and_protocols() {
+        let map = parse("Map(expect: [(method: Scaled), (method: NeverBrake, protocol: Continual)])");
+        assert_eq!(check_expectation_names(&map, "bad.ron"), Ok(()));
+        let map = parse(
+            "Map(expect: [(method: Scaled), (method: Scald, min_success: 0.5), (method: QLearning, protocol: Continuous)])",
+        );
+        let err = check_expectation_names(&map, "bad.ron").unwrap_err();
+        let lines: Vec<String> = err.diagnostics().iter().map(ToString::to_string).collect();
+        assert_eq!(lines.len(), 2, "{lines:?}");
+        assert!(
+            lines[0].starts_with(
+                "bad.ron: expect[1].method: unknown method `Scald` (hint: expected one of: QLearning, BayesRl, Scaled,"
+            ),
+            "{}",
+            lines[0]
+        );
+        assert_eq!(
+            lines[1],
+            "bad.ron: expect[2].protocol: unknown protocol `Continuous` (hint: expected one of: ZeroShot, Continual)"
+        );
+    }
+
+    #[test]
+    fn every_method_and_protocol_has_a_map_name() {
+        for &m in Method::all() {
+            assert_eq!(Method::from_map_name(m.map_name()), Some(m));
+        }
+        for p in Protocol::ALL {
+            assert_eq!(Protocol::from_map_name(p.map_name()), Some(p));
+        }
+    }
+
+    #[test]
+    fn embedded_maps_name_known_methods_and_protocols() {
+        for name in embedded::names() {
+            load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+    }
+}

@@ -1,0 +1,84 @@
+//! `--set KEY=VALUE` overrides of the scaled agent's parameters, used by the commands
+//! and by sweeps ([`crate::runs::batch::sweep()`]). Keys and values go through the agent's one
+//! table of parameters ([`unforeseen_agent::param_table`]): every field of
+//! [`ScaledParams`] is a key (flat, e.g. `epsilon`, or dotted, e.g. `gate.epsilon`). A bad
+//! key or value is an [`Error::Flag`] naming the flag and what is allowed (an enum's
+//! values, a number's range and its reason).
+
+use unforeseen_agent::error::SetError;
+use unforeseen_agent::param_table;
+use unforeseen_agent::params::ScaledParams;
+
+use crate::error::Error;
+
+/// The keys `--set` accepts, sorted by group, then key (derived from [`ScaledParams`]'s fields).
+pub fn keys() -> Vec<&'static str> {
+    param_table::key_names()
+}
+
+/// The help text of `--set`: the keys, grouped, with their defaults.
+pub fn help() -> String {
+    let p = ScaledParams::default();
+    let mut groups: Vec<(String, Vec<String>)> = Vec::new();
+    for k in param_table::keys() {
+        let shown = match p.get(&k.name) {
+            Ok(serde_json::Value::String(s)) => format!("{}={s:?}", k.name),
+            Ok(v) => format!("{}={v}", k.name),
+            Err(_) => k.name.clone(),
+        };
+        match groups.iter_mut().find(|(g, _)| *g == k.group) {
+            Some((_, list)) => list.push(shown),
+            None => groups.push((k.group.clone(), vec![shown])),
+        }
+    }
+    let lines: Vec<String> = groups
+        .iter()
+        .map(|(g, list)| format!("{g}: {}", list.join(", ")))
+        .collect();
+    format!(
+        "Scaled-agent parameter overrides, e.g. `--set omega=0.3 --set horizon=2` or `--set gate.epsilon=0.1` \
+         (ranges: agent/src/params.rs). Keys and defaults by group: {}. Also `sample=true|false` \
+         (action_selection=sample|mode).",
+        lines.join("; ")
+    )
+}
+
+/// The [`Error::Flag`] of a `--set` that [`ScaledParams::set_str`] refused.
+pub fn flag_error(key: &str, value: &str, e: SetError) -> Error {
+    match e {
+        SetError::UnknownKey { .. } => Error::flag(format!("--set {key}"), e.to_string()),
+        SetError::BadValue { .. } => Error::flag(format!("--set {key}={value}"), e.to_string()),
+    }
+}
+
+/// Applies `KEY=VALUE` overrides in order, then checks the result (ranges and bounds
+/// of [`ScaledParams::check`]).
+pub fn apply(mut p: ScaledParams, sets: &[String]) -> Result<ScaledParams, Error> {
+    for set in sets {
+        let (key, value) = set.split_once('=').ok_or_else(|| {
+            Error::flag(
+                format!("--set {set}"),
+                format!(
+                    "expected KEY=VALUE, e.g. --set omega=0.425 (keys: {})",
+                    keys().join(", ")
+                ),
+            )
+        })?;
+        set_one(&mut p, key.trim(), value.trim())?;
+    }
+    p.check_ref()
+        .map_err(|e| Error::flag(format!("--set {}", e.name), e.to_string()))?;
+    Ok(p)
+}
+
+/// Sets one parameter by name (as [`ScaledParams::set_str`]).
+pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), Error> {
+    p.set_str(key, value).map_err(|e| flag_error(key, value, e))
+}
+
+/// Sets one parameter by name to a typed value (as [`ScaledParams::set_value`]; for
+/// keyword arguments of other front ends). The same path as [`set_one`].
+pub fn set_value(p: &mut ScaledParams, key: &str, value: serde_json::Value) -> Result<(), Error> {
+    let shown = value.to_string();
+    p.set_value(key, value).map_err(|e| flag_error(key, &shown, e))
+}

@@ -1,0 +1,52 @@
+//! Headless batch runs of scenario suites: every (scenario, method, parameter set,
+//! protocol, training seed) is a unit of work; units run in parallel (rayon) and each
+//! finished unit is streamed as one JSON line. Seeds derive from (seed, scenario, method,
+//! episode), never from thread order, so results are identical whatever the number of
+//! jobs; `--shard i/n` takes a contiguous slice of the canonical unit order, so shards
+//! concatenate into the file a single run writes. A method that does not learn across
+//! episodes is run once per (scenario, parameter set, seed), and its line covers every
+//! protocol asked. Over training seeds, [`summarize`] gives each figure's mean, 95%
+//! interval, range and worst seed, and checks the maps' expectations on the mean.
+//!
+//! A scenario is a map or a deployment stream ([`ScenarioKind`], [`load_stream_scenario`]):
+//! a stream's unit runs its episodes over the stream's maps ([`evaluate_stream`](crate::runs::stream::evaluate_stream)) and its
+//! line is a line like a map's (the figures over the whole stream) with the figures per
+//! map within the stream added ([`ResultLine::per_map`]); the summary follows the stream's
+//! row with one row per map, and [`stream_learning`] compares each map's figures under
+//! the two protocols.
+//!
+//! A results file starts with the [`RunIdentity`] of the run that wrote it (program
+//! version, agents, map contents, methods, parameter sets, protocols, training seeds,
+//! episodes, seed). `--resume` refuses a file of another run, saying what differs, and
+//! keeps the lines it reuses byte for byte.
+//!
+//! [`BatchConfig::plan`] computes once what a run does (its units, its shard of them, its
+//! identity and the lines `--resume` keeps) before any agent is needed, so a caller can
+//! train only the agents the units still to run use ([`Plan::train_seeds_to_run`]), then
+//! [`run_plan`] runs it.
+//!
+//! One module per part: [`scenario`], [`sweep`](mod@sweep), [`units`](mod@units), [`expectations`],
+//! [`result_line`], [`plan`], [`identity`], [`run`](mod@run), [`results_file`] and [`summary`];
+//! the items callers use are re-exported here.
+
+pub mod expectations;
+pub mod identity;
+pub mod plan;
+pub mod result_line;
+pub mod results_file;
+pub mod run;
+pub mod scenario;
+pub mod summary;
+pub mod sweep;
+pub mod units;
+
+pub use expectations::{Check, check_expectations};
+pub use identity::{RunIdentity, agent_file_identity, trained_agents_identity};
+pub use plan::{BatchConfig, Plan};
+pub use result_line::{MapFigures, ResultLine, UnitKey};
+pub use results_file::{KeptLine, MAX_FIGURE, ResultsFile, read_lines, read_results, resume_lines};
+pub use run::{run, run_plan, run_unit};
+pub use scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};
+pub use summary::{StreamLearning, SummaryCheck, SummaryRow, WorstLine, stream_learning, summarize, summary_path};
+pub use sweep::{MAX_PARAM_SETS, ParamSet, checked_sweep, sweep};
+pub use units::{DEFAULT_METHODS, Shard, Unit, units};

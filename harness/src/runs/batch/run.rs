@@ -1,0 +1,192 @@
+//! Running a batch: one unit ([`run_unit`]) and a whole plan, in parallel, streaming
+//! each finished unit to the results file as one JSON line.
+
+use rayon::prelude::*;
+use std::io::Write;
+use std::path::Path;
+use std::sync::Mutex;
+use unforeseen_sim::Action;
+
+use crate::episodes::experiments::evaluate_under;
+use crate::episodes::metrics::Aggregate;
+use crate::episodes::runner::EpisodeResult;
+use crate::error::Error;
+use crate::progress::{NoProgress, Progress};
+use crate::runs::stream::{evaluate_stream, per_map};
+
+use super::expectations::check_expectations;
+use super::plan::{BatchConfig, Plan};
+use super::result_line::{MapFigures, ResultLine};
+use super::results_file::KeptLine;
+use super::scenario::ScenarioKind;
+use super::units::Unit;
+
+/// Runs one unit: `episodes` episodes of its method on its scenario with its agent,
+/// under its protocol. A map: [`evaluate_under`] (zero-shot episodes in parallel, each
+/// from a fresh controller; continual ones in order on one controller). A stream:
+/// [`evaluate_stream`] (the same, over the stream's maps), and the line adds the figures
+/// per map within the stream ([`per_map`]).
+pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error> {
+    let scenario = &cfg.scenarios[unit.scenario];
+    let agent = cfg
+        .agents
+        .iter()
+        .find(|a| a.train_seed == unit.train_seed)
+        .ok_or(Error::MissingAgent {
+            train_seed: unit.train_seed,
+        })?;
+    let params = unit.params.scaled_params()?;
+    let actions = Action::ALL.len();
+    let tree: usize = (1..=params.planning.horizon).map(|k| actions.pow(k as u32)).sum();
+    // Reasoning compute: the inference rate times the prefix tree, for the planner by EFE.
+    let efe = |agg: &Aggregate| {
+        if unit.method.is_scaled() {
+            agg.inference_rate * tree as f64
+        } else {
+            0.0
+        }
+    };
+    let (agg, per_map_figures) = match &scenario.kind {
+        ScenarioKind::Map(map) => {
+            let results = evaluate_under(
+                unit.protocol,
+                map,
+                &agent.bundle,
+                &params,
+                unit.method,
+                cfg.episodes,
+                cfg.seed,
+                &NoProgress,
+            )?;
+            (Aggregate::of(&results), Vec::new())
+        }
+        ScenarioKind::Stream(stream) => {
+            let episodes = evaluate_stream(
+                stream,
+                Some(&agent.bundle),
+                &params,
+                unit.method,
+                unit.protocol,
+                cfg.episodes,
+                cfg.seed,
+                &NoProgress,
+            )?;
+            let results: Vec<EpisodeResult> = episodes.iter().map(|e| e.result.clone()).collect();
+            let figures = per_map(stream, &episodes)
+                .into_iter()
+                .map(|row| {
+                    let a = &row.aggregate;
+                    MapFigures {
+                        efe_matvecs_per_tick: efe(a),
+                        map: row.map,
+                        episodes: a.episodes as u64,
+                        mean_reward: a.mean_reward,
+                        success_rate: a.success_rate,
+                        collision_rate: a.collision_rate,
+                        timeout_rate: a.timeout_rate,
+                        red_light_rate: a.red_light_rate,
+                        inference_rate: a.inference_rate,
+                        mean_ticks: a.mean_ticks,
+                        timing_us_per_tick: a.us_per_tick,
+                    }
+                })
+                .collect();
+            (Aggregate::of(&results), figures)
+        }
+    };
+    // A map's expectations describe the methods at their default parameters on that map
+    // alone: the other points of a sweep, and streams, are reported, not gated.
+    let checks = match scenario.map() {
+        Some(map) if unit.params.0.is_empty() => check_expectations(map, unit.method, &unit.covers, &agg),
+        _ => Vec::new(),
+    };
+    Ok(ResultLine {
+        unit: unit.index,
+        scenario: scenario.name().to_string(),
+        source: scenario.source.clone(),
+        method: unit.method.name().into(),
+        param_set: unit.params.label(),
+        params: unit.params.0.clone(),
+        protocol: unit.protocol,
+        covers: unit.covers.clone(),
+        train_seed: unit.train_seed,
+        train_episodes: agent.train_episodes,
+        seed: cfg.seed,
+        episodes: cfg.episodes,
+        mean_reward: agg.mean_reward,
+        success_rate: agg.success_rate,
+        collision_rate: agg.collision_rate,
+        timeout_rate: agg.timeout_rate,
+        red_light_rate: agg.red_light_rate,
+        inference_rate: agg.inference_rate,
+        efe_matvecs_per_tick: efe(&agg),
+        mean_ticks: agg.mean_ticks,
+        checks,
+        timing_us_per_tick: agg.us_per_tick,
+        per_map: per_map_figures,
+    })
+}
+
+fn to_line(r: &ResultLine) -> String {
+    let mut s = serde_json::to_string(r).expect("result lines serialize");
+    s.push('\n');
+    s
+}
+
+/// Plans the batch ([`BatchConfig::plan`]) and runs it ([`run_plan`]).
+pub fn run(cfg: &BatchConfig<'_>, out: &Path, resume: bool, progress: &dyn Progress) -> Result<Vec<ResultLine>, Error> {
+    run_plan(cfg, &cfg.plan(out, resume)?, out, progress)
+}
+
+/// Runs a planned batch, streaming each finished unit to `out` after the run's identity
+/// and the lines the plan keeps, then rewrites `out` in canonical order (kept lines byte
+/// for byte). Returns all lines of the file in canonical order. One phase of `progress`
+/// (`batch units`, one step per unit).
+pub fn run_plan(
+    cfg: &BatchConfig<'_>,
+    plan: &Plan,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Vec<ResultLine>, Error> {
+    let identity = &plan.identity;
+    let todo = plan.todo();
+
+    // The identity and the kept lines, then the new lines as they finish.
+    let head: String = std::iter::once(identity.to_line())
+        .chain(plan.kept.iter().map(|l| l.raw.clone()))
+        .collect();
+    crate::reports::files::write_atomic(out, head.as_bytes())?;
+    let file = std::fs::OpenOptions::new()
+        .append(true)
+        .open(out)
+        .map_err(|e| Error::io("append to", out, e))?;
+    let sink = Mutex::new(file);
+    progress.phase("batch units", todo.len() as u64);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(cfg.jobs.max(1)).build()?;
+    let fresh: Vec<KeptLine> = pool.install(|| {
+        todo.par_iter()
+            .map(|u| {
+                let line = run_unit(cfg, u)?;
+                let raw = to_line(&line);
+                let mut f = sink.lock().expect("result file lock");
+                f.write_all(raw.as_bytes())
+                    .and_then(|()| f.flush())
+                    .map_err(|e| Error::io("write", out, e))?;
+                progress.advance(1);
+                Ok(KeptLine {
+                    line: 0,
+                    raw,
+                    parsed: line,
+                })
+            })
+            .collect::<Result<Vec<_>, Error>>()
+    })?;
+    progress.finish();
+    let mut lines: Vec<KeptLine> = plan.kept.iter().cloned().chain(fresh).collect();
+    lines.sort_by_key(|l| l.parsed.unit);
+    let text: String = std::iter::once(identity.to_line())
+        .chain(lines.iter().map(|l| l.raw.clone()))
+        .collect();
+    crate::reports::files::write_atomic(out, text.as_bytes())?;
+    Ok(lines.into_iter().map(|l| l.parsed).collect())
+}

@@ -1,0 +1,136 @@
+//! Agent files: a trained [`AgentBundle`] as RON, written atomically. Loading checks the
+//! whole file before anything uses it (the agent crate checks every stored value, see
+//! [`unforeseen_agent::persist`]; here, that it is an agent of this intersection: three
+//! actions and the factors `d, v, L, p`), and every failure is an [`Error::AgentFile`]
+//! naming the file, the field when there is one, and the fix.
+
+use std::io::Read;
+use std::path::Path;
+use unforeseen_agent::error::PersistError;
+use unforeseen_agent::persist::{AgentBundle, MAX_FILE_BYTES};
+use unforeseen_discretizer::Discretizer;
+use unforeseen_sim::{Action, Map};
+
+use crate::error::Error;
+use crate::reports::files::write_atomic;
+
+/// Saves `bundle` to `path` (temporary file + rename).
+pub fn save(path: &Path, bundle: &AgentBundle) -> Result<(), Error> {
+    let text = bundle.to_ron_string();
+    write_atomic(path, text.as_bytes())
+}
+
+fn retrain(path: &Path) -> String {
+    format!("retrain it with `unforeseen train --out {}`", path.display())
+}
+
+fn bad(path: &Path, field: Option<String>, problem: impl Into<String>, fix: String) -> Error {
+    Error::AgentFile {
+        path: path.to_path_buf(),
+        field,
+        problem: problem.into(),
+        fix,
+    }
+}
+
+/// Loads and checks an agent file; every failure is an [`Error::AgentFile`].
+pub fn load(path: &Path) -> Result<AgentBundle, Error> {
+    let create = format!("create one with `unforeseen train --out {}`", path.display());
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+        // Never suggest writing an agent over a device, a folder or a pipe.
+        let give = "give the agent file `unforeseen train --out FILE` wrote (a regular file)".to_string();
+        return Err(bad(path, None, "not a regular file", give));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_FILE_BYTES as u64 + 1).read_to_end(&mut bytes))
+        .map_err(|e| bad(path, None, format!("cannot read the agent file ({e})"), create.clone()))?;
+    if bytes.len() > MAX_FILE_BYTES {
+        return Err(bad(
+            path,
+            None,
+            format!("larger than any agent file (at most {} MiB)", MAX_FILE_BYTES >> 20),
+            "pass the file `unforeseen train` wrote".into(),
+        ));
+    }
+    let text = String::from_utf8(bytes).map_err(|_| bad(path, None, "not an agent file (not UTF-8 text)", create))?;
+    parse(path, &text)
+}
+
+/// Parses and checks the text of an agent file; `path` names it in errors.
+pub fn parse(path: &Path, text: &str) -> Result<AgentBundle, Error> {
+    let bundle = AgentBundle::from_ron_str(text).map_err(|e| match e {
+        PersistError::Invalid(f) => bad(
+            path,
+            Some(f.path),
+            f.message,
+            format!("the file is damaged or was edited: restore it, or {}", retrain(path)),
+        ),
+        other => bad(path, None, other.to_string(), retrain(path)),
+    })?;
+    check_intersection(&bundle).map_err(|(field, problem)| bad(path, Some(field), problem, retrain(path)))?;
+    Ok(bundle)
+}
+
+/// The bundle drives this program's car: the sim's actions, and the discretizer's
+/// factors `d, v, L, p` with L and p binary.
+fn check_intersection(bundle: &AgentBundle) -> Result<(), (String, String)> {
+    let na = Action::ALL.len();
+    let model = &bundle.world_model;
+    if model.n_actions() != na {
+        return Err((
+            "world_model.n_actions".into(),
+            format!("is {}; the car has {na} actions", model.n_actions()),
+        ));
+    }
+    let factors: Vec<(&str, usize)> = model
+        .structure()
+        .factors()
+        .iter()
+        .map(|f| (f.name.as_str(), f.size))
+        .collect();
+    let ok = matches!(
+        factors[..],
+        [("d", d), ("v", v), ("L", 2), ("p", 2)]
+            if d >= 2 && v >= 1
+    );
+    if !ok {
+        return Err((
+            "world_model.structure".into(),
+            format!(
+                "has factors {factors:?}; an agent of the intersection has d, v, L, p (in that order, L and p binary, d at least 2)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks that `bundle` can drive `map`: the world model's factor sizes are the ones the
+/// map's bins give (the same joint state space, factor by factor).
+pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> Result<(), Error> {
+    let disc = Discretizer::new(map)?;
+    let agent = bundle.world_model.structure().sizes();
+    let map_sizes = disc.factor_sizes();
+    if agent != map_sizes {
+        return Err(Error::Agent {
+            problem: format!(
+                "the agent was trained on factor sizes {agent:?} (d, v, L, p: {} discrete states) but map '{}' gives {map_sizes:?} ({} states)",
+                agent.iter().product::<usize>(),
+                map.name,
+                disc.n_states()
+            ),
+            fix: "its bins differ from the training map's: train an agent on a map with the same bins".into(),
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// The map validator bounds the bins by the same number of joint states as the agent
+    /// crate bounds its learners, so every valid map can be trained on.
+    #[test]
+    fn maps_and_agents_share_the_state_bound() {
+        assert_eq!(unforeseen_sim::MAX_JOINT_STATES, unforeseen_agent::limits::MAX_STATES);
+    }
+}
