@@ -18,7 +18,10 @@
 //! with the harmful states the episode-ending states the preferences rank below every
 //! other state (the crash-risk states: a pedestrian on the crosswalk while the car moves in
 //! a crosswalk bin). Since harmful states absorb, `risk(u)` is the probability of entering
-//! one within `H` ticks of holding `u`. If holding the habit's action `a_o` (the mode of
+//! one within `H` ticks of holding `u`. When the agent plans with a crash model
+//! (`crash_model = hazard`, docs/ARCHITECTURE.md §4.3) its hazard states are not harmful
+//! states, and `risk(u)` is the mass that crashes within `H` ticks instead. If holding the
+//! habit's action `a_o` (the mode of
 //! `π_o(·|q_t)`) is riskier than holding the safest action by more than `ρ`,
 //! `risk(a_o) - min_u risk(u) > ρ`, the agent reasons instead of handing back.
 //!
