@@ -6,7 +6,7 @@
 use unforeseen_agent::maths::log_softmax;
 use unforeseen_agent::model::{CrashModel, TransitionCost};
 use unforeseen_discretizer::Discretizer;
-use unforeseen_sim::Map;
+use unforeseen_sim::{Action, Map};
 
 /// One line naming a map's reward, for tables: its four numbers (and the red-light rule's,
 /// where the map has it), and whether it pays
@@ -110,16 +110,17 @@ pub fn crash_model(map: &Map, disc: &Discretizer, tau_c: f64) -> CrashModel {
         let hi = edges.get(bin).copied().unwrap_or(v.max_speed.max(lo));
         (lo + hi) / 2.0
     };
-    let distance = |speed: f64, u: usize| -> f64 {
+    let distance = |speed: f64, u: Action| -> f64 {
         match u {
-            1 => (speed + (speed + v.max_accel * dt).min(v.max_speed.max(speed))) / 2.0 * dt,
-            2 if speed <= v.max_brake * dt => speed * speed / (2.0 * v.max_brake),
-            2 => (2.0 * speed - v.max_brake * dt) / 2.0 * dt,
-            _ => speed * dt,
+            Action::SpeedUp => (speed + (speed + v.max_accel * dt).min(v.max_speed.max(speed))) / 2.0 * dt,
+            Action::SlowDown if speed <= v.max_brake * dt => speed * speed / (2.0 * v.max_brake),
+            Action::SlowDown => (2.0 * speed - v.max_brake * dt) / 2.0 * dt,
+            Action::Maintain => speed * dt,
         }
     };
     let full = v.max_speed * dt;
-    let hazard = (0..3)
+    let hazard = Action::ALL
+        .into_iter()
         .map(|u| {
             (0..disc.n_states())
                 .map(|s| {
