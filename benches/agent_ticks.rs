@@ -12,7 +12,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_agent::model::WorldModel;
-use unforeseen_agent::params::{GateMode, ModelPriors, QParams, ReasoningMode, ScaledParams};
+use unforeseen_agent::params::{CompetenceCheck, GateMode, ModelPriors, QParams, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::q_learning::QLearning;
 use unforeseen_agent::scaled_agent::ScaledAgent;
@@ -155,8 +155,10 @@ fn feedforward_tick(c: &mut Criterion, bundle: &AgentBundle) {
         }
         o = step.observation.index().expect("discrete");
     }
+    // The paper's feed-forward tick: no surprise reaches ε, and no competence check.
     let mut never = ScaledParams::default();
     never.gate.epsilon = 0.999;
+    never.gate.competence = CompetenceCheck::SurpriseOnly;
     let mut a = agent(bundle, never);
     a.begin_episode(0);
     let ff = chain.iter().map(|o| a.act(*o)).skip(1).filter(|d| !d.reasoned).count();

@@ -8,7 +8,7 @@ use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_mai
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 use unforeseen_agent::controller::Controller;
-use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::params::{CompetenceCheck, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_harness::episodes::experiments::eval_seeds;
@@ -92,13 +92,20 @@ fn episode(c: &mut Criterion, bundle: &AgentBundle) {
         "episode: {} ticks, {} reasoning, return {:.1}, success {}",
         r.ticks, r.reasoning_ticks, r.ret, r.success
     );
-    c.bench_function("episode", |b| {
-        b.iter_batched(
-            || Method::Scaled.controller(bundle, &params, &map).expect("controller"),
-            |mut ctl| run_episode(&mut env, ctl.as_mut(), seeds, false).expect("episode"),
-            BatchSize::SmallInput,
-        )
-    });
+    // Side by side: the default agent, and the paper's (the competence check off).
+    let mut paper = ScaledParams::default();
+    paper.gate.competence = CompetenceCheck::SurpriseOnly;
+    let mut g = c.benchmark_group("episode");
+    for (name, params) in [("default", &params), ("surprise_only", &paper)] {
+        g.bench_function(name, |b| {
+            b.iter_batched(
+                || Method::Scaled.controller(bundle, params, &map).expect("controller"),
+                |mut ctl| run_episode(&mut env, ctl.as_mut(), seeds, false).expect("episode"),
+                BatchSize::SmallInput,
+            )
+        });
+    }
+    g.finish();
 }
 
 /// `training_throughput`: `train` for 100 episodes on the intersection map

@@ -7,7 +7,7 @@
 //! implement [`controller::Controller`].
 //!
 //! Module map (named after the paper): [`maths`], [`params`] (and [`param_table`], the scaled agent's parameters by name), [`structure`], [`model`], [`transition`] (factored `B`),
-//! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`handback`] (the safe hand-back, beyond the paper), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
+//! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`handback`] (the safe hand-back, beyond the paper), [`competence`] (the competence check of the habit, beyond the paper), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
 //! [`habit`] (`π_o` as an interface), [`scaled_agent`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
 //!
@@ -25,6 +25,7 @@
 //! assert!(d.action < 3);
 //! ```
 pub mod bayes_rl;
+pub mod competence;
 pub mod controller;
 pub mod error;
 #[cfg(test)]

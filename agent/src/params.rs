@@ -220,6 +220,22 @@ pub enum HandBackRule {
     Theta,
 }
 
+/// Whether the world model checks the habit where the surprise gate leaves it in charge
+/// ([`crate::competence`]; docs/ARCHITECTURE.md §4.11). Beyond the paper, whose agent
+/// trusts the habit wherever nothing surprises it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CompetenceCheck {
+    /// The habit acts only where holding its action for `competence_horizon` ticks is
+    /// predicted (expected free energy, Prop. 1) at most `competence_regret` nats worse than
+    /// holding the best action, or where the best action is the riskier (by more than
+    /// `handback_risk`); otherwise the agent reasons.
+    #[default]
+    Regret,
+    /// Ablation (the paper's agent): reasoning only where the gate finds surprise.
+    SurpriseOnly,
+}
+
 /// Which model the EFE tree's first step from `q_t` goes through
 /// ([`crate::planning::EfeTree::evaluate`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -270,6 +286,9 @@ pub enum CrashPlanning {
 /// | `gate` | `handback` | `decline-learned` | `decline-learned`, `risk-checked`, `hand-back-checked`, `theta` | where test-time learning changed the trigger's verdict: a hand-back learning made goes to the habit only if the world model's crash-risk check passes, a reasoning tick learning alone made is declined (beyond the paper; `risk-checked` takes such a tick where the check finds the habit at risk, `hand-back-checked` takes every one, `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
 /// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
 /// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |
+/// | `gate` | `competence` | `regret` | `regret`, `surprise-only` | where the gate leaves the habit in charge, the world model scores holding its action against holding the best one, and the agent reasons where it is worse by more than `competence_regret` (beyond the paper; `surprise-only` is the paper's agent) ([`CompetenceCheck`]) |
+/// | `gate` | `competence_regret` | 10.0 | finite and >= 0 | nats of expected free energy by which holding the habit's action may be worse than holding the best action before the agent reasons |
+/// | `gate` | `competence_horizon` | 8 | 1..=40 | ticks each action is held by the competence check |
 /// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
 /// | `perception` | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
 /// | `perception` | `vmp_tol` | 1e-6 | finite and > 0 | VMP convergence threshold on max \|Δ q\| |
@@ -340,6 +359,12 @@ pub struct GateParams {
     pub handback_risk: f64,
     /// Ticks of the hand-back check's rollout of the habit.
     pub handback_horizon: usize,
+    /// Whether the world model checks the habit's action on the ticks the gate leaves to it.
+    pub competence: CompetenceCheck,
+    /// The largest regret (nats) of holding the habit's action at which it acts.
+    pub competence_regret: f64,
+    /// Ticks each action is held by the competence check.
+    pub competence_horizon: usize,
 }
 
 impl Default for GateParams {
@@ -355,6 +380,9 @@ impl Default for GateParams {
             handback: HandBackRule::DeclineLearned,
             handback_risk: 0.08,
             handback_horizon: 3,
+            competence: CompetenceCheck::Regret,
+            competence_regret: 10.0,
+            competence_horizon: 8,
         }
     }
 }
@@ -564,10 +592,13 @@ impl Bound {
 
 /// Largest planning horizon: the EFE tree evaluates `n_actions^H` policies per reasoning tick.
 pub const MAX_HORIZON: usize = 8;
+/// Largest horizon of the competence check: `n_actions × H_c` predictions per checked tick,
+/// the length of a default episode.
+pub const MAX_COMPETENCE_HORIZON: usize = 40;
 
 impl ScaledParams {
     /// Every numeric parameter's key, value and range (the table above).
-    pub fn bounds(&self) -> [(&'static str, f64, Bound); 18] {
+    pub fn bounds(&self) -> [(&'static str, f64, Bound); 20] {
         let (g, pe, pl, s, l) = (
             &self.gate,
             &self.perception,
@@ -587,6 +618,15 @@ impl ScaledParams {
                 count(
                     MAX_HORIZON,
                     "in 1..=8 (the hand-back check rolls the habit forward on the ticks it checks)",
+                ),
+            ),
+            ("competence_regret", g.competence_regret, Bound::NonNegative),
+            (
+                "competence_horizon",
+                g.competence_horizon as f64,
+                count(
+                    MAX_COMPETENCE_HORIZON,
+                    "in 1..=40 (the competence check holds each action this many ticks where the habit acts)",
                 ),
             ),
             (

@@ -150,14 +150,7 @@ pub struct EfeTree {
     horizon: usize,
     /// `bufs[k]` is the predicted state belief at depth k (bufs[0] = q_t).
     bufs: Vec<Vec<f64>>,
-    obuf: Vec<f64>,
-    scratch: Vec<f64>,
-    /// The belief masked to a [`crate::model::TransitionCost`]'s `from` states, and its
-    /// prediction.
-    masked: Vec<f64>,
-    masked_next: Vec<f64>,
-    /// The part of a belief that does not crash in the step ([`crate::model::CrashModel`]).
-    survive: Vec<f64>,
+    step: StepScratch,
     /// `crashed[k]`: the mass that crashed in the first k steps of the current branch.
     crashed: Vec<f64>,
     /// `q_t` of the last evaluation (the root), for [`EfeTree::evaluate_reusing`].
@@ -193,11 +186,7 @@ impl EfeTree {
             n_actions,
             horizon,
             bufs: vec![vec![0.0; n_states]; horizon + 1],
-            obuf: vec![0.0; n_obs],
-            scratch: vec![0.0; n_states],
-            masked: vec![0.0; n_states],
-            masked_next: vec![0.0; n_states],
-            survive: vec![0.0; n_states],
+            step: StepScratch::new(n_states, n_obs),
             crashed: vec![0.0; horizon + 1],
             memo_root: vec![0.0; n_states],
             memo_s: vec![0.0; internal * n_states],
@@ -274,34 +263,11 @@ impl EfeTree {
         let step_model = if depth == 0 { root } else { gm };
         for u in 0..self.n_actions {
             let (lo, hi) = self.bufs.split_at_mut(depth + 1);
-            // With a crash model the crashing part of the belief leaves the drive first.
-            let hit = match &gm.crash {
-                Some(cm) => {
-                    let hit = cm.split(u, &lo[depth], &mut self.survive);
-                    step_model.transition_into(u, &self.survive, &mut hi[0], &mut self.scratch);
-                    hit
-                }
-                None => {
-                    step_model.transition_into(u, &lo[depth], &mut hi[0], &mut self.scratch);
-                    0.0
-                }
-            };
-            self.crashed[depth + 1] = self.crashed[depth] + hit;
+            let (g, crashed) = self
+                .step
+                .step(gm, step_model, u, &lo[depth], &mut hi[0], g_acc, self.crashed[depth]);
+            self.crashed[depth + 1] = crashed;
             self.matvecs += 1;
-            let (r, a) = step_efe(gm, &self.bufs[depth + 1], &mut self.obuf);
-            let mut g = g_acc + r + a;
-            if let Some(cm) = &gm.crash {
-                g += cm.risk(self.crashed[depth + 1]);
-            }
-            if step_model.transition_cost.is_some() {
-                g += step_model.transition_cost_of(
-                    u,
-                    &self.bufs[depth],
-                    &mut self.masked,
-                    &mut self.masked_next,
-                    &mut self.scratch,
-                );
-            }
             let child = idx * self.n_actions + u;
             if depth + 1 == self.horizon {
                 self.g[child] = g;
@@ -330,6 +296,73 @@ impl EfeTree {
             }
             self.recurse(gm, root, depth + 1, g, child, reuse);
         }
+    }
+}
+
+/// Scratch of one step of a branch of the EFE tree ([`StepScratch::step`]), shared by the
+/// tree and the competence check's held policies ([`crate::competence`]).
+#[derive(Debug, Clone)]
+pub struct StepScratch {
+    obuf: Vec<f64>,
+    scratch: Vec<f64>,
+    /// The belief masked to a [`crate::model::TransitionCost`]'s `from` states, and its
+    /// prediction.
+    masked: Vec<f64>,
+    masked_next: Vec<f64>,
+    /// The part of a belief that does not crash in the step ([`crate::model::CrashModel`]).
+    survive: Vec<f64>,
+}
+
+impl StepScratch {
+    /// Scratch for `n_states` states and `n_obs` observations.
+    pub fn new(n_states: usize, n_obs: usize) -> StepScratch {
+        StepScratch {
+            obuf: vec![0.0; n_obs],
+            scratch: vec![0.0; n_states],
+            masked: vec![0.0; n_states],
+            masked_next: vec![0.0; n_states],
+            survive: vec![0.0; n_states],
+        }
+    }
+
+    /// One step of a policy (Prop. 1): from belief `from`, after `crashed` mass has
+    /// crashed on the branch so far, action `u` through `step_model`'s `B` into `to`.
+    /// Returns `G` accumulated to `g` with the step's risk and ambiguity under `gm`'s
+    /// preferences, its crash risk ([`crate::model::CrashModel`]) and its transition cost,
+    /// and the crashed mass after the step. With a crash model the crashing part of the
+    /// belief leaves the drive first.
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &mut self,
+        gm: &GenerativeModel,
+        step_model: &GenerativeModel,
+        u: usize,
+        from: &[f64],
+        to: &mut [f64],
+        g: f64,
+        crashed: f64,
+    ) -> (f64, f64) {
+        let hit = match &gm.crash {
+            Some(cm) => {
+                let hit = cm.split(u, from, &mut self.survive);
+                step_model.transition_into(u, &self.survive, to, &mut self.scratch);
+                hit
+            }
+            None => {
+                step_model.transition_into(u, from, to, &mut self.scratch);
+                0.0
+            }
+        };
+        let crashed = crashed + hit;
+        let (r, a) = step_efe(gm, to, &mut self.obuf);
+        let mut g = g + r + a;
+        if let Some(cm) = &gm.crash {
+            g += cm.risk(crashed);
+        }
+        if step_model.transition_cost.is_some() {
+            g += step_model.transition_cost_of(u, from, &mut self.masked, &mut self.masked_next, &mut self.scratch);
+        }
+        (g, crashed)
     }
 }
 

@@ -13,6 +13,7 @@
 //! the surprise itself, `Decision::theta` what the trigger compared with `ε`. Planning always
 //! predicts with the full transition model, which keeps the pedestrian's persistence.
 
+use crate::competence::Competence;
 use crate::controller::{Controller, Decision, Dist, Ending};
 use crate::error::AgentError;
 use crate::gate::StateGate;
@@ -22,8 +23,8 @@ use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{
-    ActionSelection, CheckedScaledParams, CrashPlanning, GateBaseline, GateLearning, GateMode, HandBackRule,
-    ReasoningMode, RootStep, ScaledParams, ScalingMode,
+    ActionSelection, CheckedScaledParams, CompetenceCheck, CrashPlanning, GateBaseline, GateLearning, GateMode,
+    HandBackRule, ReasoningMode, RootStep, ScaledParams, ScalingMode,
 };
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s_into};
@@ -72,6 +73,9 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     gate: Option<StateGate>,
     /// The crash-risk check of hand-backs that learning made ([`crate::handback`]).
     handback: HandBack,
+    /// The competence check of the habit where the gate leaves it in charge
+    /// ([`crate::competence`]).
+    competence: Competence,
     /// Whether test-time learning has changed the agent (an episode was learned from).
     learned: bool,
     rng: ChaCha8Rng,
@@ -92,6 +96,9 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     hist_reasoned: Vec<bool>,
     /// Whether each tick reasoned because the hand-back check refused the habit.
     hist_refused: Vec<bool>,
+    /// Whether each tick reasoned because the competence check found the habit's action
+    /// wanting.
+    hist_checked: Vec<bool>,
     /// Whether each tick's trigger fired only because of test-time learning and the habit
     /// acted, the check finding it safe.
     hist_declined: Vec<bool>,
@@ -234,6 +241,7 @@ impl<H: Habit> ScaledAgent<H> {
             hist_surprise: Vec::with_capacity(256),
             hist_reasoned: Vec::with_capacity(256),
             hist_refused: Vec::with_capacity(256),
+            hist_checked: Vec::with_capacity(256),
             hist_declined: Vec::with_capacity(256),
             final_obs: None,
             prev_one_hot: None,
@@ -245,6 +253,7 @@ impl<H: Habit> ScaledAgent<H> {
             habit,
             gate,
             handback,
+            competence: Competence::new(n, n_obs, na),
             learned: false,
         })
     }
@@ -294,6 +303,47 @@ impl<H: Habit> ScaledAgent<H> {
         }
         let th0 = self.trained_trigger_fires()?;
         self.habit_at_risk().then_some(th0)
+    }
+
+    /// The competence check ([`crate::competence`]), with the habit's policy in `self.pi`
+    /// and the gate's `θ` `th`: `Some(θ_c)` when holding the habit's action for
+    /// `competence_horizon` ticks is predicted to be worse than holding the best action by
+    /// more than `competence_regret` nats, and the best held action is not predicted to
+    /// crash more often than the habit's by more than `handback_risk` (the check trades no
+    /// safety for progress); the reasoning tick then scales with
+    /// `θ_c = max(θ, 1 - exp(-Ω regret))`, the regret read as the trigger reads surprise.
+    fn habit_wanting(&mut self, th: f64) -> Option<f64> {
+        if self.params.gate.competence == CompetenceCheck::SurpriseOnly {
+            return None;
+        }
+        let root = match self.params.planning.root_step {
+            RootStep::Learned => self.model.generative(),
+            RootStep::Absorbing => self.model.planning_generative(),
+        };
+        let plan = self.model.planning_generative();
+        let obs_certain = self.q_cur.iter().position(|&x| x == 1.0);
+        let habit = argmax(&self.pi);
+        let horizon = self.params.gate.competence_horizon;
+        let regret = self
+            .competence
+            .regret(plan, root, &self.q_cur, obs_certain, habit, horizon);
+        if regret <= self.params.gate.competence_regret {
+            return None;
+        }
+        // Never for a riskier action: where holding the preferred action is predicted to
+        // crash more often than holding the habit's, by more than ρ within the hand-back's
+        // horizon (crash_risk, as the hand-back checks), the habit keeps the tick.
+        let held = self.competence.held();
+        let best = (0..self.n_actions).fold(habit, |b, u| if held[u] < held[b] { u } else { b });
+        let mut hold = vec![0; self.n_states];
+        let risk_horizon = self.params.gate.handback_horizon;
+        let mut risk = |u: usize| {
+            hold.fill(u);
+            self.handback
+                .crash_risk(root, plan, &self.q_cur, u, &hold, risk_horizon)
+        };
+        let safer = risk(best) - risk(habit) <= self.params.gate.handback_risk;
+        safer.then(|| th.max(theta(regret, self.params.gate.omega)))
     }
 
     /// The check of a reasoning tick that learning made: on a tick whose learned trigger
@@ -348,6 +398,11 @@ impl<H: Habit> ScaledAgent<H> {
     /// check refused to hand the state to the habit ([`crate::handback`]).
     pub fn refused_history(&self) -> &[bool] {
         &self.hist_refused
+    }
+    /// Whether each tick of the current (or last) episode reasoned because the competence
+    /// check found the habit's action wanting ([`crate::competence`]).
+    pub fn checked_history(&self) -> &[bool] {
+        &self.hist_checked
     }
     /// Whether each tick of the current (or last) episode went to the habit although the
     /// learned trigger fired, because only test-time learning made it fire and the check
@@ -486,6 +541,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
         self.hist_surprise.clear();
         self.hist_reasoned.clear();
         self.hist_refused.clear();
+        self.hist_checked.clear();
         self.hist_declined.clear();
         self.final_obs = None;
         self.prev_one_hot = None;
@@ -534,6 +590,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
         let declined = reasoned && !always && self.decline_trigger(obs);
         reasoned &= !declined;
         let mut refused = false;
+        let mut checked = false;
         let mut scaling_iters = 0;
         if reasoned {
             scaling_iters = self.reason(obs, th);
@@ -546,6 +603,11 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             if let Some(th0) = self.refuse_handback() {
                 (reasoned, refused) = (true, true);
                 scaling_iters = self.reason(obs, th0);
+            } else if let Some(thc) = self.habit_wanting(th) {
+                // The competence check: reason where holding the habit's action is
+                // predicted to be worse than the best action by more than the bound.
+                (reasoned, checked) = (true, true);
+                scaling_iters = self.reason(obs, thc);
             }
         }
         let pi = std::mem::take(&mut self.pi);
@@ -559,6 +621,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
         self.hist_surprise.push(s);
         self.hist_reasoned.push(reasoned);
         self.hist_refused.push(refused);
+        self.hist_checked.push(checked);
         self.hist_declined.push(declined);
         Decision {
             action,
@@ -651,6 +714,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             gate.consolidate();
         }
         self.model.materialize();
+        self.competence.invalidate();
         self.learned = true;
     }
 }

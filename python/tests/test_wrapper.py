@@ -116,6 +116,26 @@ def test_an_external_habit_is_acted_on_and_corrected_by_learning(agent):
     assert w.habit_counts().sum() == 0
 
 
+def never_restarts(obs):
+    """A habit that maintains at a standstill and speeds up otherwise (the discrete
+    observation's speed bin is its second entry)."""
+    return np.array([1.0, 0.0, 0.0]) if obs[1] == 0 else np.array([0.0, 1.0, 0.0])
+
+
+@pytest.mark.parametrize("protocol", ["zero-shot", "continual"])
+def test_a_wrapped_habit_that_never_restarts_is_started_again(agent, protocol):
+    # Bare, this habit drives into the jaywalker; wrapped, the surprise gate brakes for
+    # them, and once they have crossed only the competence check sees that holding
+    # "maintain" at a standstill never arrives (issue 32: with the gate alone every
+    # episode timed out).
+    episodes = unforeseen.evaluate_policy(ScaledWrapper(habit=never_restarts, agent=agent), "jaywalk", 10, protocol)
+    assert sum(e["timeout"] for e in episodes) == 0, episodes
+    assert sum(e["success"] for e in episodes) == 10, episodes
+    # The paper's agent (the gate alone) is kept as the ablation, and stalls.
+    alone = ScaledWrapper(habit=never_restarts, agent=agent, competence="surprise-only")
+    assert sum(e["timeout"] for e in unforeseen.evaluate_policy(alone, "jaywalk", 3, protocol)) == 3
+
+
 def test_bad_habits_are_refused_with_the_reason(agent):
     env = UnforeseenEnv("jaywalk")
     obs, info = env.reset(options={"world_seed": 1})

@@ -446,6 +446,9 @@ pub struct Expectation {
     /// crosswalk on red) per episode, in [0, 1].
     #[serde(default)]
     pub max_red_light: Option<f64>,
+    /// Highest acceptable time-out rate (episodes that ran out of decision ticks), in [0, 1].
+    #[serde(default)]
+    pub max_timeout: Option<f64>,
     /// The evaluation protocol the bounds apply to, as written in the map (e.g.
     /// `"Continual"`); absent: every protocol the batch ran the method under.
     #[serde(
@@ -809,6 +812,7 @@ impl Map {
                 ("max_collision", x.max_collision),
                 ("max_inference_rate", x.max_inference_rate),
                 ("max_red_light", x.max_red_light),
+                ("max_timeout", x.max_timeout),
             ] {
                 if let Some(v) = val {
                     parts.push(format!("{label} {v}"));

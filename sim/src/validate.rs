@@ -578,6 +578,7 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
             ("max_collision", x.max_collision),
             ("max_inference_rate", x.max_inference_rate),
             ("max_red_light", x.max_red_light),
+            ("max_timeout", x.max_timeout),
         ] {
             if let Some(v) = val {
                 c.probability(&format!("{path}.{name}"), v, false);

@@ -142,6 +142,7 @@ fn expectations_pass_and_fail_as_declared() {
         max_collision: None,
         max_inference_rate: None,
         max_red_light: None,
+        max_timeout: None,
         protocol: None,
     };
     map.expect = vec![

@@ -10,7 +10,7 @@
 
 use crate::common;
 use std::fmt::Write;
-use unforeseen_agent::params::{CrashPlanning, ScaledParams};
+use unforeseen_agent::params::{CompetenceCheck, CrashPlanning, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::experiments::trace;
 use unforeseen_harness::episodes::methods::Method;
@@ -116,10 +116,19 @@ fn noisy_jaywalk() -> unforeseen_sim::Map {
     unforeseen_sim::Map::from_str_named("noisy_jaywalk.ron", text, &embedded).expect("valid map")
 }
 
+/// The scaled agent's default parameters with the competence check off
+/// (`competence = surprise-only`): the paper's agent, whose decisions these digests
+/// recorded before the check (docs/ARCHITECTURE.md §4.11).
+fn surprise_only() -> ScaledParams {
+    let mut params = ScaledParams::default();
+    params.gate.competence = CompetenceCheck::SurpriseOnly;
+    params
+}
+
 /// The agent's digest and its episodes' on the intersection, the jaywalk and the noisy
-/// jaywalk, with the scaled agent's default parameters.
+/// jaywalk, with [`surprise_only`]'s parameters.
 fn digests(bundle: &AgentBundle) -> [String; 4] {
-    digests_with(bundle, &ScaledParams::default())
+    digests_with(bundle, &surprise_only())
 }
 
 /// [`digests`] with the scaled agent's parameters `params`.
@@ -136,7 +145,7 @@ fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
 /// exactly as the code before it did: the digests recorded on that code.
 #[test]
 fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
-    let mut params = ScaledParams::default();
+    let mut params = surprise_only();
     params.set_str("handback", "theta").unwrap();
     assert_eq!(digests_with(common::bundle(), &params), GOLDEN_THETA_HANDBACK);
 }
@@ -155,7 +164,8 @@ fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
 
 /// The default training (time-outs truncate: the learners bootstrap through them). None of
 /// this agent's training episodes times out, so it is the agent of before too (the two
-/// settings differ where episodes time out: `timeouts_truncate_and_learners_bootstrap`).
+/// settings differ where episodes time out: `timeouts_truncate_and_learners_bootstrap`);
+/// without the competence check it decides as before.
 #[test]
 fn trained_agent_and_decisions_are_unchanged() {
     let map = unforeseen_harness::maps::load("intersection").unwrap();
@@ -169,9 +179,20 @@ fn trained_agent_and_decisions_are_unchanged() {
 /// when the option was added).
 #[test]
 fn the_crash_model_decisions_are_recorded() {
-    let mut params = ScaledParams::default();
+    let mut params = surprise_only();
     params.planning.crash_model = CrashPlanning::Hazard;
     assert_eq!(digests_with(common::bundle(), &params), GOLDEN_CRASH_MODEL);
+}
+
+/// The default agent, with the competence check (docs/ARCHITECTURE.md §4.11): the same
+/// agent tables; the episodes change where the check sends a tick to reasoning (digests
+/// recorded when the check was added).
+#[test]
+fn the_competence_check_decisions_are_recorded() {
+    assert_eq!(
+        digests_with(common::bundle(), &ScaledParams::default()),
+        GOLDEN_COMPETENCE
+    );
 }
 
 /// On a map whose episodes often time out (the tiny map: 12 ticks), the two settings
@@ -217,6 +238,15 @@ const GOLDEN_CRASH_MODEL: [&str; 4] = [
     "a82992ccf57b2219",
     "edd28553a6b36eb0",
     "69af290d4e23083f",
+];
+
+/// Digests of [`the_competence_check_decisions_are_recorded`].
+/// The jaywalk's episodes are those of before; the intersection's change.
+const GOLDEN_COMPETENCE: [&str; 4] = [
+    "10356990b4c98627",
+    "31a9127450a408ad",
+    "fd86969ccbedd97b",
+    "42645404ec0bad2e",
 ];
 
 /// Digests of [`the_theta_handback_ablation_reproduces_the_decisions_of_before`]: those of

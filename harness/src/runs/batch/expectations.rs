@@ -55,6 +55,7 @@ pub fn check_expectations(map: &Map, method: Method, covers: &[Protocol], agg: &
         add("collision_rate", "max", e.max_collision, agg.collision_rate);
         add("inference_rate", "max", e.max_inference_rate, agg.inference_rate);
         add("red_light_rate", "max", e.max_red_light, agg.red_light_rate);
+        add("timeout_rate", "max", e.max_timeout, agg.timeout_rate);
     }
     checks
 }

@@ -337,6 +337,7 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
             max_collision: None,
             max_inference_rate: None,
             max_red_light: None,
+            max_timeout: None,
             protocol: None,
         },
         unforeseen_sim::Expectation {
@@ -348,6 +349,7 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
             max_collision: None,
             max_inference_rate: None,
             max_red_light: None,
+            max_timeout: None,
             protocol: None,
         },
     ];
