@@ -149,10 +149,14 @@ def evaluate(
     method: str | None = None,
     seed: int = 7,
     train_episodes: int | None = None,
+    force: bool = False,
 ) -> list[dict[str, Any]]:
     """Evaluates a policy per training seed on every map under every protocol and
-    returns the batch result lines (dicts); with ``out``, appends them to that JSON Lines
-    file (one line per unit as it finishes).
+    returns the batch result lines (dicts); with ``out``, writes them to that JSON Lines
+    file (one line per unit as it finishes), replacing what it held. ``out`` is checked
+    first as ``unforeseen batch --out`` is: a ``ValueError`` if it is one of the map
+    files, if it holds something other than batch results (unless ``force``), or if
+    another run is writing it.
 
     ``policy``: a policy, a mapping ``train_seed -> policy`` or a callable
     ``train_seed -> policy`` (the policy trained with that seed). ``seeds``: the training
@@ -179,7 +183,11 @@ def evaluate(
 
     lines = []
     unit = 0
-    fh = open(out, "a", encoding="utf-8") if out is not None else None
+    guard = None
+    if out is not None:
+        files = [m for m in maps if os.path.exists(m)]
+        guard = _unforeseen.ResultsGuard(os.fspath(out), files, force=force)
+    fh = open(out, "w", encoding="utf-8") if out is not None else None
     try:
         for m in maps:
             for s in seeds:
@@ -201,11 +209,15 @@ def evaluate(
     finally:
         if fh is not None:
             fh.close()
+        if guard is not None:
+            guard.release()
     return lines
 
 
 def summarize(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     """The batch summary over training seeds of a results file (``results.summary.json``'s
     rows: means with 95% intervals and the worst seed), computed by the Rust code
-    ``unforeseen batch`` uses."""
+    ``unforeseen batch`` uses. A path that is not a file is a ``ValueError``."""
+    if not os.path.isfile(path):
+        raise ValueError(f"{os.fspath(path)}: not a results file (no such file); give the file `evaluate` or `batch` wrote")
     return json.loads(_unforeseen.summarize_json(os.fspath(path)))
