@@ -5,7 +5,6 @@
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
-use unforeseen_harness::progress::NoProgress;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList};
@@ -71,9 +70,9 @@ fn compare_json(
         episodes,
         seed,
     };
-    let tables = py
-        .detach(|| unforeseen_harness::runs::compare::run_study(&setup, &agents, &NoProgress))
-        .map_err(errors::to_py)?;
+    let tables = crate::interrupt::interruptible(py, |progress| {
+        unforeseen_harness::runs::compare::run_study(&setup, &agents, progress)
+    })?;
     let report = CompareReport::new(&setup, &agents, tables, None, None).map_err(errors::to_py)?;
     serde_json::to_string(&report).map_err(errors::to_py)
 }
@@ -166,9 +165,11 @@ fn batch_json(
         std::process::id(),
         RUN.fetch_add(1, Ordering::Relaxed)
     ));
-    let lines = py.detach(|| unforeseen_harness::runs::batch::run(&cfg, &out, false, &NoProgress));
+    let lines = crate::interrupt::interruptible(py, |progress| {
+        unforeseen_harness::runs::batch::run(&cfg, &out, false, progress)
+    });
     let _ = std::fs::remove_file(&out);
-    let lines = lines.map_err(errors::to_py)?;
+    let lines = lines?;
     let summary = unforeseen_harness::runs::batch::summarize(&lines);
     serde_json::to_string(&serde_json::json!({"lines": lines, "summary": summary})).map_err(errors::to_py)
 }

@@ -317,8 +317,10 @@ pub fn write_merged(merged: &Merged, out: &Path) -> Result<MergeReport, Error> {
     let rows = summarize(&merged.results());
     let summary = summary_path(out);
     let doc = summary_document(out, None, &merged.identity, &rows);
-    crate::reports::files::write_atomic(out, text.as_bytes())?;
-    crate::reports::files::write_json(&summary, &doc)?;
+    crate::reports::files::all_or_none(|| {
+        crate::reports::files::write_atomic(out, text.as_bytes())?;
+        crate::reports::files::write_json(&summary, &doc)
+    })?;
     Ok(MergeReport {
         out: out.to_path_buf(),
         summary,

@@ -304,7 +304,7 @@ pub fn evaluate_stream(
      -> Result<StreamEpisode, crate::error::Error> {
         let map = &stream.maps[m].0;
         let result = run_episode(env, controller, eval_seeds(seed, map, method, k as u64), false)?.0;
-        progress.advance(1);
+        crate::progress::step(progress)?;
         Ok(StreamEpisode {
             episode: k as u64,
             map: map.name.clone(),

@@ -570,7 +570,7 @@ impl Runner<'_, '_> {
         }
         self.written.lock().expect("lines lock").insert(candidate.index, raws);
         if advance {
-            self.progress.advance(1);
+            crate::progress::step(self.progress)?;
         }
         Ok(Evaluated { candidate, lines })
     }
@@ -941,8 +941,11 @@ pub fn run_with(
     let text: String = std::iter::once(output::identity_line(&cfg.identity()))
         .chain(written.values().flatten().map(|l| l.raw.clone()))
         .collect();
-    crate::reports::files::write_atomic(&file, text.as_bytes())?;
-    output::write_all(cfg, out, &outcome)
+    // The candidates, failure maps, summary and figure appear together or not at all.
+    crate::reports::files::all_or_none(|| {
+        crate::reports::files::write_atomic(&file, text.as_bytes())?;
+        output::write_all(cfg, out, &outcome)
+    })
 }
 
 /// The stages (see the module doc).
