@@ -52,7 +52,7 @@ def test_evaluate_twice_into_one_file_replaces_it(tmp_path):
     for _ in range(2):
         unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out)
     assert len(out.read_text().splitlines()) == 1
-    assert [r["n"] for r in unforeseen.summarize(out)] == [1]
+    assert [len(r["train_seeds"]) for r in unforeseen.summarize(out)] == [1]
 
 
 def test_summarize_a_missing_file_is_an_error(tmp_path):
@@ -98,3 +98,40 @@ def test_an_endless_observation_is_refused(agent):
     c = agent.controller("scaled")
     with pytest.raises(ValueError, match="factors"):
         c.act(itertools.count())
+
+
+INTERRUPTED = """
+import os, signal, sys, threading, time
+import unforeseen
+which = sys.argv[1]
+agent = unforeseen.train("intersection", episodes=20, seed=1) if which in ("batch", "compare") else None
+calls = {
+    "train": lambda: unforeseen.train("intersection", episodes=1_000_000),
+    "train_agents": lambda: unforeseen.train_agents([1, 2], episodes=1_000_000, cache=None),
+    "batch": lambda: unforeseen.batch("jaywalk", agents=agent, episodes=1_000_000, methods=["never-brake"]),
+    "compare": lambda: unforeseen.compare(agents=agent, episodes=1_000_000),
+    "evaluate_builtin": lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=1_000_000),
+}
+threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+start = time.monotonic()
+try:
+    calls[which]()
+    print("finished")
+except KeyboardInterrupt:
+    print(f"interrupted after {time.monotonic() - start:.2f} s")
+"""
+
+
+@pytest.mark.parametrize("which", ["train", "train_agents", "batch", "compare", "evaluate_builtin"])
+def test_long_calls_stop_on_ctrl_c(which, tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", INTERRUPTED, which], capture_output=True, text=True, env=env,
+                          timeout=120)
+    assert "interrupted after" in done.stdout, done.stdout + done.stderr
+    seconds = float(done.stdout.split("after ")[1].split(" s")[0])
+    assert seconds < 6.0, f"{which} took {seconds} s to stop after SIGINT (sent at 1 s)"
+    assert not list(tmp_path.glob("unforeseen-python-batch-*")), "a temporary file was left"
