@@ -388,17 +388,8 @@ fn evaluate_json(
         return Err(errors::value(format!("{method} needs a trained agent: pass agent=...")));
     }
     let report = crate::interrupt::interruptible(py, |progress| {
-            evaluate_map(
-                &map,
-                m,
-                proto,
-                agent.map(|a| &a.bundle),
-                &p,
-                episodes,
-                seed,
-                progress,
-            )
-        })?;
+        evaluate_map(&map, m, proto, agent.map(|a| &a.bundle), &p, episodes, seed, progress)
+    })?;
     serde_json::to_string(&report.document().map_err(errors::to_py)?).map_err(errors::to_py)
 }
 

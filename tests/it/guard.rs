@@ -28,7 +28,7 @@ fn search(out: &Path, extra: &[&str]) -> std::process::Output {
         "--out",
         out.to_str().unwrap(),
     ];
-    if !extra.iter().any(|a| *a == "--space") {
+    if !extra.contains(&"--space") {
         args.extend(["--space", SPACE]);
     }
     args.extend(extra);
