@@ -47,12 +47,17 @@ def test_evaluate_refuses_a_file_that_is_not_results_unless_forced(tmp_path):
     assert json.loads(agent_file.read_text().splitlines()[0])["method"] == "always-fast"
 
 
-def test_evaluate_twice_into_one_file_replaces_it(tmp_path):
+def test_evaluate_twice_into_one_file_is_refused(tmp_path):
     out = tmp_path / "r.jsonl"
-    for _ in range(2):
+    unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out)
+    with pytest.raises(ValueError, match="counted twice"):
         unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out)
     assert len(out.read_text().splitlines()) == 1
-    assert [len(r["train_seeds"]) for r in unforeseen.summarize(out)] == [1]
+    assert [r["train_seeds"] for r in unforeseen.summarize(out)] == [[None]]
+    # The lock was released: another method goes beside it.
+    unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out,
+                        method="other")
+    assert len(out.read_text().splitlines()) == 2
 
 
 def test_summarize_a_missing_file_is_an_error(tmp_path):
@@ -135,3 +140,13 @@ def test_long_calls_stop_on_ctrl_c(which, tmp_path):
     seconds = float(done.stdout.split("after ")[1].split(" s")[0])
     assert seconds < 6.0, f"{which} took {seconds} s to stop after SIGINT (sent at 1 s)"
     assert not list(tmp_path.glob("unforeseen-python-batch-*")), "a temporary file was left"
+
+
+def test_the_vector_env_refuses_fractional_and_nan_actions():
+    envs = unforeseen.VectorEnv("jaywalk", num_envs=2)
+    envs.reset(seed=0)
+    for bad in ([0.5, 1.0], [np.nan, 1.0]):
+        with pytest.raises(ValueError, match="whole numbers"):
+            envs.step(np.array(bad))
+    envs.step(np.array([1.0, 2.0]))  # whole floats are actions
+    envs.step(np.array([1, 2]))

@@ -277,3 +277,35 @@ fn stream_descriptions_refuse_control_characters() {
     ]);
     assert_exit(&r, 2, &["description", "control"]);
 }
+
+#[test]
+fn merge_names_a_part_given_twice_or_not_a_file() {
+    let d = tempfile::tempdir().unwrap();
+    let part = d.path().join("part.jsonl");
+    let p = part.to_str().unwrap();
+    let out = d.path().join("m.jsonl");
+    let o = out.to_str().unwrap();
+    let batch = run_cli(&[
+        "batch",
+        "jaywalk",
+        "--method",
+        "never-brake",
+        "--episodes",
+        "1",
+        "--out",
+        p,
+    ]);
+    assert_exit(&batch, 0, &[]);
+    assert_exit(&run_cli(&["merge", p, p, "--out", o]), 2, &["given twice"]);
+    let folder = d.path().to_str().unwrap();
+    assert_exit(
+        &run_cli(&["merge", p, folder, "--out", o]),
+        2,
+        &["not a regular file", "shard files"],
+    );
+    assert_exit(
+        &run_cli(&["batch", "jaywalk", "--shard", " 1/2", "--out", o]),
+        2,
+        &["--shard"],
+    );
+}
