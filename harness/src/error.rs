@@ -155,6 +155,9 @@ pub enum Error {
         /// The method's name.
         method: String,
     },
+    /// The caller asked the run to stop ([`crate::progress::Progress::cancelled`]).
+    #[error("interrupted")]
+    Interrupted,
 }
 
 impl Error {
@@ -184,7 +187,8 @@ impl Error {
             | Error::Plot { .. }
             | Error::Threads(_)
             | Error::MissingAgent { .. }
-            | Error::NotScripted { .. } => false,
+            | Error::NotScripted { .. }
+            | Error::Interrupted => false,
         }
     }
 

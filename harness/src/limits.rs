@@ -7,6 +7,10 @@ use crate::error::Error;
 /// here, and each episode keeps a result in memory; run more as shards or seeds.
 pub const MAX_EPISODES: u64 = 1_000_000;
 
+/// Most worker threads one run may ask for (`--jobs`, Python's `jobs`, a driver's
+/// threads): more only spends time starting threads on any machine this runs on.
+pub const MAX_JOBS: usize = 256;
+
 /// `n` if it is an episode count one run may ask for (1..=[`MAX_EPISODES`]), else an
 /// [`Error::OutOfRange`] naming `field` (`episodes`, `train_episodes`, ...).
 pub fn check_episodes(field: &str, n: u64) -> Result<u64, Error> {

@@ -9,6 +9,8 @@
 //! ([`crate::training::train_with_progress`], [`crate::episodes::experiments::evaluate_under`] and
 //! its siblings) only advance, so several of them running in parallel share one phase.
 
+use crate::error::Error;
+
 /// What a line for the user is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Message {
@@ -32,6 +34,37 @@ pub trait Progress: Sync {
     fn finish(&self);
     /// A line for the user.
     fn message(&self, kind: Message, line: &str);
+    /// Whether the caller asks the run to stop (the Python package: a pending Ctrl-C).
+    /// Runs ask at every step ([`step`]) and then return [`Error::Interrupted`]; by
+    /// default, never.
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+/// Passes on only whether the caller asks `0` to stop: the progress of a run's inner
+/// steps (a unit's episodes) when only its outer steps are shown.
+pub struct CancelOnly<'a>(pub &'a dyn Progress);
+
+impl Progress for CancelOnly<'_> {
+    fn phase(&self, _name: &str, _total: u64) {}
+    fn advance(&self, _n: u64) {}
+    fn finish(&self) {}
+    fn message(&self, _kind: Message, _line: &str) {}
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
+    }
+}
+
+/// One more step of the current phase of `progress` is done; [`Error::Interrupted`]
+/// when the caller asks the run to stop.
+pub fn step<P: Progress + ?Sized>(progress: &P) -> Result<(), Error> {
+    progress.advance(1);
+    if progress.cancelled() {
+        Err(Error::Interrupted)
+    } else {
+        Ok(())
+    }
 }
 
 /// Ignores all progress.

@@ -15,7 +15,6 @@ use unforeseen_harness::episodes::experiments::evaluate_map;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::limits::check_episodes;
-use unforeseen_harness::progress::NoProgress;
 
 use crate::errors;
 
@@ -148,9 +147,9 @@ fn train(py: Python<'_>, map: &str, episodes: u64, seed: u64) -> PyResult<PyAgen
     check_episodes("episodes", episodes).map_err(errors::to_py)?;
     let map = crate::maps::load(map, None)?;
     let cfg = unforeseen_harness::training::TrainConfig::new(episodes, seed);
-    let (bundle, log) = py
-        .detach(|| unforeseen_harness::training::train(&map, &cfg))
-        .map_err(errors::to_py)?;
+    let (bundle, log) = crate::interrupt::interruptible(py, |progress| {
+        unforeseen_harness::training::train_with_progress(&map, &cfg, progress)
+    })?;
     Ok(PyAgent {
         bundle,
         returns: log.returns,
@@ -182,11 +181,9 @@ fn train_agents(
         timeout_as,
         ..unforeseen_harness::training::TrainConfig::new(episodes, 0)
     };
-    let agents = py
-        .detach(|| {
-            unforeseen_harness::training::seed_agents::train_agents(&map, &seeds, &cfg, cache.as_deref(), &NoProgress)
-        })
-        .map_err(errors::to_py)?;
+    let agents = crate::interrupt::interruptible(py, |progress| {
+        unforeseen_harness::training::seed_agents::train_agents(&map, &seeds, &cfg, cache.as_deref(), progress)
+    })?;
     Ok(agents
         .into_iter()
         .map(|a| PyAgent {
@@ -268,9 +265,14 @@ pub fn joint_index(sizes: &[usize], obs: &Bound<'_, PyAny>) -> PyResult<usize> {
             ))
         });
     }
+    // At most one factor more than the model has is read: an endless iterator is refused.
     let factors: Vec<i64> = obs
         .try_iter()
-        .and_then(|it| it.map(|x| x?.extract::<i64>()).collect::<PyResult<Vec<_>>>())
+        .and_then(|it| {
+            it.take(sizes.len() + 1)
+                .map(|x| x?.extract::<i64>())
+                .collect::<PyResult<Vec<_>>>()
+        })
         .map_err(|_| {
             errors::value(format!(
                 "observation {obs}: expected a joint index or (d, v, L, p), e.g. info['observed']"
@@ -385,20 +387,9 @@ fn evaluate_json(
     if !m.is_scripted() && agent.is_none() {
         return Err(errors::value(format!("{method} needs a trained agent: pass agent=...")));
     }
-    let report = py
-        .detach(|| {
-            evaluate_map(
-                &map,
-                m,
-                proto,
-                agent.map(|a| &a.bundle),
-                &p,
-                episodes,
-                seed,
-                &NoProgress,
-            )
-        })
-        .map_err(errors::to_py)?;
+    let report = crate::interrupt::interruptible(py, |progress| {
+        evaluate_map(&map, m, proto, agent.map(|a| &a.bundle), &p, episodes, seed, progress)
+    })?;
     serde_json::to_string(&report.document().map_err(errors::to_py)?).map_err(errors::to_py)
 }
 

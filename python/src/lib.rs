@@ -20,6 +20,7 @@
 mod agent;
 mod env;
 mod errors;
+mod interrupt;
 mod maps;
 mod render;
 mod results;

@@ -21,7 +21,8 @@ pub fn load(arg: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Map> {
             let mut fields = Vec::new();
             for (k, v) in o.iter() {
                 let key: String = k.extract()?;
-                fields.push((key, ron_value(&v)?));
+                let value = ron_value(&key, &v, 0)?;
+                fields.push((key, value));
             }
             patch(&map, arg, &fields)
         }
@@ -81,23 +82,46 @@ fn locate(key: &str, sections: &[(String, Vec<String>)]) -> PyResult<(String, St
     }
 }
 
-/// A Python value as RON text: bool, int, float, a list or tuple of them, or a string
-/// taken as RON text as written (e.g. `offset="Random"`).
-fn ron_value(v: &Bound<'_, PyAny>) -> PyResult<String> {
+/// Deepest nesting of lists in an override value (a map field nests a few levels at
+/// most; a list that contains itself, or one nested thousands deep, is refused rather
+/// than exhausting the stack).
+const MAX_DEPTH: usize = 8;
+
+/// Most items of one list in an override value (a map's longest lists hold a few dozen).
+const MAX_ITEMS: usize = 10_000;
+
+/// A Python value as RON text: bool, int (a Python or NumPy integer), float, a list or
+/// tuple of them nested at most [`MAX_DEPTH`] deep, or a string taken as RON text as
+/// written (e.g. `offset="Random"`). `depth` is the nesting of `v`; errors name `key`.
+fn ron_value(key: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<String> {
     if v.is_instance_of::<PyBool>() {
         Ok(if v.extract::<bool>()? { "true" } else { "false" }.into())
-    } else if v.is_instance_of::<PyInt>() {
-        Ok(v.extract::<i128>()?.to_string())
     } else if v.is_instance_of::<PyFloat>() {
         Ok(format!("{:?}", v.extract::<f64>()?))
+    } else if v.is_instance_of::<PyInt>() || v.hasattr("__index__")? {
+        Ok(v.extract::<i128>()?.to_string())
     } else if v.is_instance_of::<PyString>() {
         v.extract::<String>()
     } else if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
-        let items = v.try_iter()?.map(|x| ron_value(&x?)).collect::<PyResult<Vec<_>>>()?;
+        if depth >= MAX_DEPTH {
+            return Err(errors::value(format!(
+                "map override {key}: lists nested more than {MAX_DEPTH} deep (or a list that contains itself); give the field's value"
+            )));
+        }
+        if v.len()? > MAX_ITEMS {
+            return Err(errors::value(format!(
+                "map override {key}: a list of {} items; at most {MAX_ITEMS}",
+                v.len()?
+            )));
+        }
+        let items = v
+            .try_iter()?
+            .map(|x| ron_value(key, &x?, depth + 1))
+            .collect::<PyResult<Vec<_>>>()?;
         Ok(format!("[{}]", items.join(", ")))
     } else {
         Err(errors::value(format!(
-            "map override value {v}: expected a bool, a number, a list of numbers or RON text"
+            "map override {key}: value {v}: expected a bool, a number, a list of numbers or RON text"
         )))
     }
 }

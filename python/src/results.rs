@@ -5,7 +5,6 @@
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
-use unforeseen_harness::progress::NoProgress;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList};
@@ -13,6 +12,7 @@ use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::runs::batch::{BatchConfig, Scenario};
 use unforeseen_harness::runs::compare::{CompareReport, StudySetup};
+use unforeseen_harness::runs::outputs::{Guarded, Outputs};
 use unforeseen_harness::training::seed_agents::Agent;
 
 use crate::agent::{PyAgent, method, protocol, scaled_params};
@@ -70,9 +70,9 @@ fn compare_json(
         episodes,
         seed,
     };
-    let tables = py
-        .detach(|| unforeseen_harness::runs::compare::run_study(&setup, &agents, &NoProgress))
-        .map_err(errors::to_py)?;
+    let tables = crate::interrupt::interruptible(py, |progress| {
+        unforeseen_harness::runs::compare::run_study(&setup, &agents, progress)
+    })?;
     let report = CompareReport::new(&setup, &agents, tables, None, None).map_err(errors::to_py)?;
     serde_json::to_string(&report).map_err(errors::to_py)
 }
@@ -96,6 +96,7 @@ fn batch_json(
     sweep: Option<&Bound<'_, PyDict>>,
     jobs: usize,
 ) -> PyResult<String> {
+    crate::units::check_episodes("episodes", episodes)?;
     let agents = agents_of(agents)?;
     let protocols = self::protocols(protocols)?;
     let methods: Vec<Method> = match methods {
@@ -164,15 +165,45 @@ fn batch_json(
         std::process::id(),
         RUN.fetch_add(1, Ordering::Relaxed)
     ));
-    let lines = py.detach(|| unforeseen_harness::runs::batch::run(&cfg, &out, false, &NoProgress));
+    let lines = crate::interrupt::interruptible(py, |progress| {
+        unforeseen_harness::runs::batch::run(&cfg, &out, false, progress)
+    });
     let _ = std::fs::remove_file(&out);
-    let lines = lines.map_err(errors::to_py)?;
+    let lines = lines?;
     let summary = unforeseen_harness::runs::batch::summarize(&lines);
     serde_json::to_string(&serde_json::json!({"lines": lines, "summary": summary})).map_err(errors::to_py)
 }
 
+/// The output guard of a results file `out` written from Python (`evaluate`): refuses,
+/// with a `ValueError`, an `out` that is one of `inputs` (map files) or holds something
+/// other than batch results (unless `force`), and holds the lock on it until
+/// [`ResultsGuard::release`] (or until collected).
+#[pyclass(module = "unforeseen._unforeseen")]
+pub struct ResultsGuard {
+    held: Option<Guarded>,
+}
+
+#[pymethods]
+impl ResultsGuard {
+    #[new]
+    #[pyo3(signature = (out, inputs, force = false))]
+    fn new(out: PathBuf, inputs: Vec<PathBuf>, force: bool) -> PyResult<ResultsGuard> {
+        let guard = inputs
+            .iter()
+            .fold(Outputs::results("out", &out), |g, m| g.input("maps", m));
+        let held = guard.guard(force).map_err(errors::to_py)?;
+        Ok(ResultsGuard { held: Some(held) })
+    }
+
+    /// Releases the lock (a second writer may then take it).
+    fn release(&mut self) {
+        self.held = None;
+    }
+}
+
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<ResultsGuard>()?;
     m.add_function(wrap_pyfunction!(compare_json, m)?)?;
     m.add_function(wrap_pyfunction!(batch_json, m)?)?;
     Ok(())

@@ -233,8 +233,14 @@ fn drive_search(
     command: String,
 ) -> PyResult<String> {
     let built = Built::new(spec, agents, from_file)?;
-    let cfg = built.config(jobs, command);
+    // One driver thread per failure minimised at once, waiting on its remote calls.
+    let cfg = built.config(jobs.clamp(1, unforeseen_harness::limits::MAX_JOBS), command);
     cfg.check().map_err(errors::to_py)?;
+    let _guard = search::output::outputs(&out)
+        .input("map", &built.spec.map)
+        .input("space", &built.spec.space)
+        .guard(resume)
+        .map_err(errors::to_py)?;
     let remote = PyEvaluator {
         evaluate,
         raised: Mutex::new(None),

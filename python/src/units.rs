@@ -25,6 +25,7 @@ use unforeseen_harness::runs::batch::{
     BatchConfig, DEFAULT_METHODS, RunIdentity, Scenario, agent_file_identity, checked_sweep, load_scenarios, run_unit,
     trained_agents_identity,
 };
+use unforeseen_harness::runs::outputs::Outputs;
 use unforeseen_harness::training::seed_agents::Agent;
 use unforeseen_harness::training::{DEFAULT_TRAIN_MAP, TrainConfig};
 
@@ -59,24 +60,6 @@ fn locate(s: &Scenario) -> String {
     }
 }
 
-/// Refuses an `out` that holds something other than a batch's results (as `batch` does
-/// without `--force`).
-fn check_out(out: &Path, force: bool, resume: bool) -> PyResult<()> {
-    if force || resume {
-        return Ok(());
-    }
-    let head: Vec<u8> = std::fs::read(out)
-        .map(|b| b.into_iter().take(16).collect())
-        .unwrap_or_default();
-    if !head.is_empty() && !head.starts_with(b"{\"run\":") {
-        return Err(errors::value(format!(
-            "--out {}: exists and is not a batch's results file (its first line is not {{\"run\": ...}}); give another --out, or add --force to replace it",
-            out.display()
-        )));
-    }
-    Ok(())
-}
-
 /// Plans a batch run into `out` as `unforeseen batch` does (same arguments, same run
 /// identity, `resume` keeping the lines of an earlier run of it), without running or
 /// training anything. Returns JSON text: `spec` (for [`run_units`]), `head` (the
@@ -102,8 +85,16 @@ fn plan_batch(
 ) -> PyResult<String> {
     check_episodes("episodes", episodes)?;
     check_episodes("train_episodes", train_episodes)?;
-    check_out(&out, force, resume)?;
     let scenarios = load_scenarios(&maps).map_err(errors::to_py)?;
+    // The checks of `unforeseen batch --out` (the driver writes `out` and its summary).
+    let guard = maps
+        .iter()
+        .fold(Outputs::results("out", &out), |g, m| g.input("maps", m));
+    let guard = match &agent {
+        Some(a) => guard.input("agent", a),
+        None => guard,
+    };
+    guard.check(force || resume).map_err(errors::to_py)?;
     let methods: Vec<Method> = match methods {
         Some(names) if !names.is_empty() => names.iter().map(|n| method(n)).collect::<PyResult<_>>()?,
         _ => DEFAULT_METHODS.to_vec(),

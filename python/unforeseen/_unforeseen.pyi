@@ -204,6 +204,10 @@ class ScaledHabitAgent:
 
 def q_table_habit(agent: Agent, **params: Any) -> npt.NDArray[np.float64]:
     """``σ(Q[s, ·]/T)`` of ``agent``'s Q-table, ``(n_states, n_actions)``."""
+class ResultsGuard:
+    def __init__(self, out: str, inputs: list[str], force: bool = False) -> None: ...
+    def release(self) -> None: ...
+
 def summarize_json(path: str) -> str:
     """The batch summary over training seeds of a results file, as JSON text."""
 def plan_batch(

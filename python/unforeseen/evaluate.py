@@ -149,10 +149,16 @@ def evaluate(
     method: str | None = None,
     seed: int = 7,
     train_episodes: int | None = None,
+    force: bool = False,
 ) -> list[dict[str, Any]]:
     """Evaluates a policy per training seed on every map under every protocol and
     returns the batch result lines (dicts); with ``out``, appends them to that JSON Lines
-    file (one line per unit as it finishes).
+    file (one line per unit as it finishes), beside the lines of other methods. ``out``
+    is checked first as ``unforeseen batch --out`` is: a ``ValueError`` if it is one of
+    the map files, if it holds something other than batch results (unless ``force``:
+    then it is replaced), if it already holds a line of the same map, method, protocol
+    and training seed (a second call would count it twice), or if another run is writing
+    it.
 
     ``policy``: a policy, a mapping ``train_seed -> policy`` or a callable
     ``train_seed -> policy`` (the policy trained with that seed). ``seeds``: the training
@@ -179,6 +185,13 @@ def evaluate(
 
     lines = []
     unit = 0
+    guard = None
+    if out is not None:
+        files = [m for m in maps if os.path.exists(m)]
+        guard = _unforeseen.ResultsGuard(os.fspath(out), files, force=force)
+        if force:
+            open(out, "w").close()
+        _refuse_repeats(out, maps, seeds, method or getattr(policy, "method", None), guard)
     fh = open(out, "a", encoding="utf-8") if out is not None else None
     try:
         for m in maps:
@@ -201,11 +214,34 @@ def evaluate(
     finally:
         if fh is not None:
             fh.close()
+        if guard is not None:
+            guard.release()
     return lines
+
+
+def _refuse_repeats(out: Any, maps: list[str], seeds: list[int | None], method: str | None, guard: Any) -> None:
+    """Refuses an ``out`` that already holds a line of one of these (map, method,
+    training seed): the summary would count it twice."""
+    if not method or not os.path.isfile(out):
+        return
+    names = {_source(m)[0] for m in maps}
+    with open(out, encoding="utf-8") as f:
+        for number, text in enumerate(f, 1):
+            if text.startswith('{"run":') or not text.strip():
+                continue
+            line = json.loads(text)
+            if line.get("method") == method and line.get("scenario") in names and line.get("train_seed") in seeds:
+                guard.release()
+                raise ValueError(
+                    f"{os.fspath(out)}: line {number} is already {method} on {line['scenario']} (training seed "
+                    f"{line['train_seed']}); a second line would be counted twice: give another out, or remove it"
+                )
 
 
 def summarize(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     """The batch summary over training seeds of a results file (``results.summary.json``'s
     rows: means with 95% intervals and the worst seed), computed by the Rust code
-    ``unforeseen batch`` uses."""
+    ``unforeseen batch`` uses. A path that is not a file is a ``ValueError``."""
+    if not os.path.isfile(path):
+        raise ValueError(f"{os.fspath(path)}: not a results file (no such file); give the file `evaluate` or `batch` wrote")
     return json.loads(_unforeseen.summarize_json(os.fspath(path)))

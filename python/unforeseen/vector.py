@@ -82,7 +82,12 @@ class VectorEnv(_GymVectorEnv):
         return obs, self._info(info)
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
-        obs, rewards, terminated, truncated, info = self._env.step(np.asarray(actions, dtype=np.int64).reshape(-1))
+        given = np.asarray(actions).reshape(-1)
+        if given.dtype.kind not in "iu":
+            whole = given.dtype.kind == "f" and bool(np.all(np.isfinite(given))) and bool(np.all(given == np.round(given)))
+            if not whole:
+                raise ValueError(f"actions {given!r}: expected whole numbers 0, 1 or 2, one per env")
+        obs, rewards, terminated, truncated, info = self._env.step(given.astype(np.int64))
         return obs, rewards, terminated, truncated, self._info(info)
 
     def _info(self, info: dict[str, Any]) -> dict[str, Any]:

@@ -19,6 +19,7 @@ use unforeseen_harness::runs::batch::{
     trained_agents_identity,
 };
 use unforeseen_harness::runs::merge::summary_document;
+use unforeseen_harness::runs::outputs::Outputs;
 use unforeseen_harness::training::seed_agents::Agent;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
@@ -110,7 +111,9 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         None => load_scenarios(&args.maps)?,
     };
     let summary = summary_path(&args.out);
-    check_out(&args, &scenarios, &summary)?;
+    // One run at a time per results file: a second one would interleave its lines with
+    // this run's and lose them. The lock is released when the run ends.
+    let _guard = guard(&args, &scenarios)?;
     let methods = if args.methods.is_empty() {
         DEFAULT_METHODS.to_vec()
     } else {
@@ -119,9 +122,6 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let params = checked_sweep(&args.sweep)?;
     let protocols = args.protocol.protocols();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs.max(1)).build()?;
-    // One run at a time per results file: a second one would interleave its lines with
-    // this run's and lose them. The lock is released when the process ends.
-    let _lock = lock_results(&args.out)?;
     // Without --train-seeds, the one agent (loaded, or trained now) and what determines
     // it; with them, what determines the agents, trained once the plan says which the
     // units still to run need.
@@ -280,71 +280,23 @@ fn memory_bound_jobs(jobs: usize, states: usize) -> usize {
     }
 }
 
-/// Checks `--out` and the summary beside it before any work: regular files (or not
-/// there yet) in a folder that can hold files, none of them an input (`--agent`, a map),
-/// and `--out` a batch's results file (first line `{"run": ...}`), empty, or missing,
-/// unless `--force`.
-fn check_out(args: &BatchArgs, scenarios: &[Scenario], summary: &std::path::Path) -> anyhow::Result<()> {
-    use super::outputs;
-    outputs::file("--out", &args.out)?;
-    outputs::file("--out (its summary)", summary)?;
-    let mut inputs: Vec<(&str, &std::path::Path)> = args.agent.iter().map(|p| ("--agent", p.as_path())).collect();
-    inputs.extend(scenarios.iter().map(|s| {
-        let flag = match s.kind {
-            ScenarioKind::Map(_) => "MAP",
-            ScenarioKind::Stream(_) => "--stream",
+/// The output guard of `batch` (`--out` and the summary beside it; the inputs `--agent`,
+/// the maps, or the stream and its maps): checked before any work and held until the
+/// end of the run (a second run into the same `--out` is refused).
+fn guard(args: &BatchArgs, scenarios: &[Scenario]) -> anyhow::Result<unforeseen_harness::runs::outputs::Guarded> {
+    let mut guard = Outputs::results("--out", &args.out);
+    if let Some(agent) = &args.agent {
+        guard = guard.input("--agent", agent);
+    }
+    for s in scenarios {
+        guard = match (&s.kind, &args.stream) {
+            (ScenarioKind::Stream(stream), Some(file)) => guard.stream("--stream", file, stream),
+            _ => guard.input("MAP", &s.source),
         };
-        (flag, std::path::Path::new(&s.source))
-    }));
-    outputs::not_an_input("--out", &args.out, &inputs)?;
-    outputs::not_an_input("--out (its summary)", summary, &inputs)?;
-    if !args.force && !args.resume {
-        let mut head = Vec::new();
-        if let Ok(f) = std::fs::File::open(&args.out) {
-            use std::io::Read;
-            f.take(16)
-                .read_to_end(&mut head)
-                .map_err(|e| unforeseen_harness::error::Error::io("read", &args.out, e))?;
-        }
-        if !head.is_empty() && !head.starts_with(b"{\"run\":") {
-            return Err(unforeseen_harness::error::Error::flag(
-                format!("--out {}", args.out.display()),
-                "exists and is not a batch's results file (its first line is not {\"run\": ...}); \
-                 give another --out, or add --force to replace it",
-            )
-            .into());
-        }
     }
-    Ok(())
-}
-
-/// Takes an advisory lock on `OUT.lock` beside the results file `out` (created if
-/// missing, left in place), or refuses a run while another holds it.
-fn lock_results(out: &std::path::Path) -> anyhow::Result<std::fs::File> {
-    let mut name = out.as_os_str().to_owned();
-    name.push(".lock");
-    let path = std::path::PathBuf::from(name);
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| unforeseen_harness::error::Error::io("create folder", dir, e))?;
-    }
-    let file = std::fs::OpenOptions::new()
-        .create(true)
-        .truncate(false)
-        .write(true)
-        .open(&path)
-        .map_err(|e| unforeseen_harness::error::Error::io("open the lock file", &path, e))?;
-    match file.try_lock() {
-        Ok(()) => Ok(file),
-        Err(std::fs::TryLockError::WouldBlock) => Err(unforeseen_harness::error::Error::flag(
-            format!("--out {}", out.display()),
-            format!(
-                "another batch is writing this results file now (it holds {}); wait for it to finish, or give another --out",
-                path.display()
-            ),
-        )
-        .into()),
-        Err(std::fs::TryLockError::Error(e)) => Err(unforeseen_harness::error::Error::io("lock", &path, e).into()),
-    }
+    guard.check(args.force || args.resume)?;
+    super::outputs::note_created("--out", args.out.parent().unwrap_or(std::path::Path::new("")));
+    Ok(guard.guard(args.force || args.resume)?)
 }
 
 /// Prints one row per (scenario, method, parameters, protocol) over its training seeds

@@ -87,6 +87,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         &args.out,
         &["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"],
         &[&args.train_map, &args.test_map],
+        None,
     )?;
     let train_map = maps::load(&args.train_map)?;
     let test_map = maps::load(&args.test_map)?;

@@ -49,7 +49,8 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     if let Some(file) = &args.stream {
         return run_stream(&args, file);
     }
-    args.agent.check_out_dir(&args.out, &["eval.json"], &[&args.map])?;
+    args.agent
+        .check_out_dir(&args.out, &["eval.json"], &[&args.map], None)?;
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bars = Bars::new(args.agent.quiet);
@@ -116,8 +117,8 @@ fn protocol_note(method: Method, protocol: Protocol, params: &unforeseen_agent::
 fn run_stream(args: &EvalArgs, file: &std::path::Path) -> anyhow::Result<()> {
     use unforeseen_harness::runs::stream::{Stream, evaluate_stream, per_map};
     let stream = Stream::load(file)?;
-    args.agent
-        .check_out_dir(&args.out, &["eval.json"], &[&file.display().to_string()])?;
+    let inputs = unforeseen_harness::runs::outputs::Outputs::new().stream("--stream", file, &stream);
+    args.agent.check_out_dir(&args.out, &["eval.json"], &[], Some(inputs))?;
     let params = args.agent.params()?;
     let bundle = if args.method.is_scripted() {
         None

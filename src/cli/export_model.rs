@@ -32,8 +32,7 @@ pub struct ExportModelArgs {
 /// Runs `export-model`: writes A, the planning B (terminal states absorbing), C, D, the
 /// observation, the horizon and γ of the scaled agent's parameters.
 pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
-    super::outputs::file("--out", &args.out)?;
-    super::outputs::not_an_input("--out", &args.out, &args.agent.inputs())?;
+    super::outputs::file("--out", &args.out, args.agent.inputs())?;
     let params = args.agent.params()?;
     let values: Vec<usize> = args
         .obs

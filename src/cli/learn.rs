@@ -10,6 +10,7 @@ use unforeseen_harness::episodes::experiments::{LearnPoint, learn};
 use unforeseen_harness::maps;
 use unforeseen_harness::reports::figures::{Series, line_panels};
 use unforeseen_harness::reports::files::{Csv, num, write_json};
+use unforeseen_harness::runs::outputs::Outputs;
 use unforeseen_harness::runs::stream::{Stream, learn_stream};
 
 /// Arguments of `learn`.
@@ -51,12 +52,12 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     let subject = match &args.stream {
         Some(file) => {
             let stream = Stream::load(file)?;
-            args.agent
-                .check_out_dir(&args.out, &OUTPUTS, &[&file.display().to_string()])?;
+            let inputs = Outputs::new().stream("--stream", file, &stream);
+            args.agent.check_out_dir(&args.out, &OUTPUTS, &[], Some(inputs))?;
             Subject::Stream(stream)
         }
         None => {
-            args.agent.check_out_dir(&args.out, &OUTPUTS, &[&args.map])?;
+            args.agent.check_out_dir(&args.out, &OUTPUTS, &[&args.map], None)?;
             Subject::Map(Box::new(maps::load(&args.map)?))
         }
     };

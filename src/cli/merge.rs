@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use super::batch::{failures, print_summary};
 use unforeseen_harness::runs::merge::{merge, write_merged};
+use unforeseen_harness::runs::outputs::Outputs;
 
 /// Arguments of `merge`.
 #[derive(Debug, Clone, Args)]
@@ -16,19 +17,23 @@ pub struct MergeArgs {
     /// Merged results file; the summary goes beside it (`sweep.summary.json`).
     #[arg(long, value_name = "FILE", default_value = "results.jsonl")]
     pub out: PathBuf,
+    /// Replace --out even when it holds something other than a batch's results (a file
+    /// whose first line is not `{"run": ...}`); without it such a file is refused.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Runs `merge`: refuses parts of different runs, overlapping parts and gaps (naming the
 /// missing units, exit 2); fails (exit 1) when an expectation fails on the mean over
 /// training seeds, as `batch` does.
 pub fn run(args: MergeArgs) -> anyhow::Result<()> {
-    use super::outputs;
-    outputs::file("--out", &args.out)?;
-    let summary = unforeseen_harness::runs::batch::summary_path(&args.out);
-    outputs::file("--out (its summary)", &summary)?;
-    let inputs: Vec<(&str, &std::path::Path)> = args.parts.iter().map(|p| ("PART", p.as_path())).collect();
-    outputs::not_an_input("--out", &args.out, &inputs)?;
-    outputs::not_an_input("--out (its summary)", &summary, &inputs)?;
+    let guard = args
+        .parts
+        .iter()
+        .fold(Outputs::results("--out", &args.out), |g, p| g.input("PART", p));
+    guard.check(args.force)?;
+    super::outputs::note_created("--out", args.out.parent().unwrap_or(std::path::Path::new("")));
+    let _guard = guard.guard(args.force)?;
     let merged = merge(&args.parts)?;
     let report = write_merged(&merged, &args.out)?;
     print_summary(&report.rows);

@@ -231,21 +231,31 @@ impl AgentArgs {
         load_or_train(self.agent.as_deref(), map, episodes, self.seed, self.quiet)
     }
 
-    /// The input files among these options (`--agent`), with their flags, for
-    /// [`outputs::not_an_input`].
-    pub fn inputs(&self) -> Vec<(&'static str, &std::path::Path)> {
-        self.agent.iter().map(|p| ("--agent", p.as_path())).collect()
+    /// The input files among these options (`--agent`), for the output guard.
+    pub fn inputs(&self) -> unforeseen_harness::runs::outputs::Outputs {
+        let guard = unforeseen_harness::runs::outputs::Outputs::new();
+        match &self.agent {
+            Some(p) => guard.input("--agent", p),
+            None => guard,
+        }
     }
 
     /// Checks the output folder `dir` (`--out`) and the files `names` in it before any
-    /// work: none of them is an input (`--agent`, or the map files `maps`).
-    pub fn check_out_dir(&self, dir: &std::path::Path, names: &[&str], maps: &[&str]) -> anyhow::Result<()> {
-        outputs::dir("--out", dir)?;
-        let mut inputs = self.inputs();
-        inputs.extend(maps.iter().map(|m| ("--map", std::path::Path::new(*m))));
-        for n in names {
-            outputs::not_an_input("--out", &dir.join(n), &inputs)?;
-        }
+    /// work: none of them is an input (`--agent`, the map files `maps`, or the inputs
+    /// already in `extra`, e.g. a stream and its maps).
+    pub fn check_out_dir(
+        &self,
+        dir: &std::path::Path,
+        names: &[&str],
+        maps: &[&str],
+        extra: Option<unforeseen_harness::runs::outputs::Outputs>,
+    ) -> anyhow::Result<()> {
+        let guard = maps.iter().fold(extra.unwrap_or_default(), |g, m| g.input("--map", m));
+        let guard = match &self.agent {
+            Some(p) => guard.input("--agent", p),
+            None => guard,
+        };
+        outputs::dir("--out", dir, names, guard)?;
         Ok(())
     }
 
@@ -262,7 +272,7 @@ pub fn episodes_or_none(s: &str) -> Result<u64, String> {
 }
 
 /// Most worker threads: `--jobs` and `RAYON_NUM_THREADS` beyond it are capped.
-pub const MAX_JOBS: usize = 256;
+pub const MAX_JOBS: usize = unforeseen_harness::limits::MAX_JOBS;
 
 /// Caps `RAYON_NUM_THREADS` (which sizes the thread pools of every command but batch)
 /// at [`MAX_JOBS`], with a warning: a huge value spent minutes starting threads.

@@ -87,8 +87,11 @@ fn checked_lines(path: &std::path::Path) -> Result<Vec<ResultLine>, Error> {
 
 /// Runs `plot-sweep`.
 pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
-    super::outputs::file("--out", &args.out)?;
-    super::outputs::not_an_input("--out", &args.out, &[("RESULTS.jsonl", &args.results)])?;
+    super::outputs::file(
+        "--out",
+        &args.out,
+        unforeseen_harness::runs::outputs::Outputs::new().input("RESULTS.jsonl", &args.results),
+    )?;
     let lines = checked_lines(&args.results)?;
     if lines.is_empty() {
         return Err(Error::Results {

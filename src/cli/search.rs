@@ -58,9 +58,14 @@ pub struct SearchArgs {
     /// evaluate only the rest.
     #[arg(long)]
     pub resume: bool,
-    /// Output folder.
+    /// Output folder: candidates.jsonl, summary.json, search.svg and failures/*.ron.
+    /// No input may be inside it.
     #[arg(long, value_name = "DIR", default_value = "out/search")]
     pub out: PathBuf,
+    /// Replace files in --out that a search did not write (a failure map edited by hand,
+    /// a file of another program); without it they are refused.
+    #[arg(long)]
+    pub force: bool,
     /// Training episodes when no --agent is given.
     #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
     pub train_episodes: u64,
@@ -82,7 +87,17 @@ pub fn run(args: SearchArgs) -> anyhow::Result<()> {
     }
     let base = maps::load(&args.map)?;
     let space = Space::load(&args.space, &base)?;
-    super::outputs::dir("--out", &args.out)?;
+    SearchConfig::check_arguments(&space, args.budget, args.sobol_share)?;
+    // Every output checked, the folder created and locked, before any work.
+    let mut guard = search::output::outputs(&args.out)
+        .input("--map", &args.map)
+        .input("--space", &args.space);
+    if let Some(agent) = &args.agent {
+        guard = guard.input("--agent", agent);
+    }
+    guard.check(args.force || args.resume)?;
+    super::outputs::note_created("--out", &args.out);
+    let _guard = guard.guard(args.force || args.resume)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs).build()?;
     let (agents, train_seeds, agents_identity): (Vec<Agent>, Vec<Option<u64>>, String) = if args.method.is_scripted() {
         (Vec::new(), vec![None], "none (a scripted method)".into())

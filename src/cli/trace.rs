@@ -50,13 +50,14 @@ fn mode(reasoned: bool) -> &'static str {
 /// Runs `trace`.
 pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     if let Some(html) = &args.html {
-        super::outputs::file("--html", html)?;
-        let mut inputs = args.agent.inputs();
-        inputs.push(("--map", std::path::Path::new(&args.map)));
-        super::outputs::not_an_input("--html", html, &inputs)?;
+        super::outputs::file("--html", html, args.agent.inputs().input("--map", &args.map))?;
     }
-    args.agent
-        .check_out_dir(&args.out, &["trace.csv", "theta.svg", "filmstrip.svg"], &[&args.map])?;
+    args.agent.check_out_dir(
+        &args.out,
+        &["trace.csv", "theta.svg", "filmstrip.svg"],
+        &[&args.map],
+        None,
+    )?;
     let map = maps::load(&args.map)?;
     let params = args.agent.params()?;
     let bundle = args.agent.bundle()?;

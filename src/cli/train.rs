@@ -36,8 +36,11 @@ pub struct TrainArgs {
 
 /// Runs `train`.
 pub fn run(args: TrainArgs) -> anyhow::Result<()> {
-    super::outputs::file("--out", &args.out)?;
-    super::outputs::not_an_input("--out", &args.out, &[("--map", std::path::Path::new(&args.map))])?;
+    super::outputs::file(
+        "--out",
+        &args.out,
+        unforeseen_harness::runs::outputs::Outputs::new().input("--map", &args.map),
+    )?;
     let map = maps::load(&args.map)?;
     let cfg = TrainConfig {
         timeout_as: args.timeout_as,

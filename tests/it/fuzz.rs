@@ -268,3 +268,73 @@ fn mutated_agent_files_are_refused_or_drive_the_car() {
     eprintln!("agent files: {n} mutated, {accepted} accepted");
     assert!(accepted > 0 && accepted < n, "the mutator should make both kinds");
 }
+
+#[test]
+fn mutated_space_files_are_refused_or_sample_valid_names() {
+    use unforeseen_harness::runs::search::{Space, candidate_name, sobol_candidates};
+    let valid = std::fs::read_to_string("maps/spaces/jaywalk.ron").unwrap();
+    let base = unforeseen_harness::maps::load("jaywalk").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let (mut accepted, n) = (0, cases());
+    for case in 0..n {
+        let text = mutate(&valid, &mut rng);
+        let space = match Space::parse("space.ron", &text, &base) {
+            Ok(s) => s,
+            Err(e) => {
+                assert_eq!(unforeseen::cli::exit_code(&e), 2, "case {case}: {e}");
+                assert!(e.to_string().starts_with("space.ron"), "case {case}: {e}");
+                continue;
+            }
+        };
+        accepted += 1;
+        // Its name becomes file names: never a path.
+        let name = candidate_name(&space, 42);
+        assert!(
+            unforeseen_harness::runs::outputs::file_name("name", &name).is_ok(),
+            "case {case}: {name:?}"
+        );
+        // Its first candidates are maps or reasons, never a panic.
+        for c in sobol_candidates(&space, case as u64, 0..4) {
+            if let Ok(map) = &c.map {
+                Env::new(map, EnvConfig::default()).expect("a valid candidate makes an env");
+            }
+        }
+    }
+    eprintln!("space files: {n} mutated, {accepted} accepted");
+    assert!(accepted > 0 && accepted < n, "the mutator should make both kinds");
+}
+
+#[test]
+fn mutated_stream_files_are_refused_or_schedule_within_the_limits() {
+    use unforeseen_harness::runs::stream::Stream;
+    let dir = tempfile::tempdir().unwrap();
+    // The shipped stream, with its maps beside it.
+    let shipped = std::fs::read_to_string("maps/streams/deployment.ron").unwrap();
+    let valid = shipped.replace("../", &format!("{}/maps/", env!("CARGO_MANIFEST_DIR")));
+    let path = dir.path().join("stream.ron");
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let (mut accepted, n) = (0, cases() / 3);
+    for case in 0..n {
+        let text = mutate(&valid, &mut rng);
+        std::fs::write(&path, &text).unwrap();
+        let stream = match Stream::load(&path) {
+            Ok(s) => s,
+            Err(e) => {
+                assert_eq!(unforeseen::cli::exit_code(&e), 2, "case {case}: {e}");
+                assert!(
+                    e.to_string().starts_with(&path.display().to_string()),
+                    "case {case}: {e}"
+                );
+                continue;
+            }
+        };
+        accepted += 1;
+        assert!(!stream.description.chars().any(char::is_control), "case {case}");
+        // A schedule costs memory per episode, not per unit of weight.
+        let schedule = stream.schedule(5, case as u64);
+        assert_eq!(schedule.len(), 5);
+        assert!(schedule.iter().all(|&m| m < stream.maps.len()), "case {case}");
+    }
+    eprintln!("stream files: {n} mutated, {accepted} accepted");
+    assert!(accepted > 0 && accepted < n, "the mutator should make both kinds");
+}

@@ -13,6 +13,7 @@ mod end_to_end;
 mod figures;
 mod fuzz;
 mod golden;
+mod guard;
 mod merge;
 mod outputs;
 mod overrides;

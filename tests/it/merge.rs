@@ -133,12 +133,13 @@ fn shards_merge_into_the_file_of_one_run_and_gaps_overlaps_and_other_runs_are_re
     assert_exit(&gap, 2, &["do not cover the run", &first]);
     assert!(!s.path("gap.jsonl").exists() && !summary_path(&s.path("gap.jsonl")).exists());
 
-    // A shard given twice, or overlapping the whole: refused, naming both places.
+    // A shard given twice (named once, as given twice), or overlapping the whole:
+    // refused, naming both places.
     let twice = s.merge(
         &["part-1.jsonl", "part-2.jsonl", "part-2.jsonl", "part-3.jsonl"],
         "twice.jsonl",
     );
-    assert_exit(&twice, 2, &["in two places", "part-2.jsonl line", "overlap"]);
+    assert_exit(&twice, 2, &["part-2.jsonl is given twice", "give each shard file once"]);
     let overlap = s.merge(&["whole.jsonl", "part-3.jsonl"], "overlap.jsonl");
     assert_exit(&overlap, 2, &["in two places", "whole.jsonl line", "part-3.jsonl line"]);
 

@@ -174,7 +174,7 @@ fn batch_replaces_only_results_files_and_one_run_at_a_time() {
         .open(dir.path().join("precious.txt.lock"))
         .unwrap();
     lock.lock().unwrap();
-    assert_code(&batch(&a, &precious, &[]), 2, &["another batch"]);
+    assert_code(&batch(&a, &precious, &[]), 2, &["another run"]);
     drop(lock);
     // A folder with no maps is an error; an empty shard says so.
     let empty = dir.path().join("empty");

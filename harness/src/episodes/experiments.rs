@@ -45,7 +45,7 @@ pub fn evaluate(
     progress.phase(&format!("{} {}", method.name(), map.name), episodes);
     let results = (0..episodes)
         .map(|ep| {
-            progress.advance(1);
+            crate::progress::step(progress)?;
             Ok(run_episode(&mut env, controller, eval_seeds(seed, map, method, ep), false)?.0)
         })
         .collect();
@@ -94,7 +94,7 @@ pub fn evaluate_with(
     let new_env = || Env::new(map, EnvConfig::default());
     let run = |env: &mut Env, controller: &mut dyn Controller, ep: u64| -> Result<EpisodeResult, Error> {
         let result = run_episode(env, controller, eval_seeds(seed, map, method, ep), false)?.0;
-        progress.advance(1);
+        crate::progress::step(progress)?;
         Ok(result)
     };
     match protocol.effective(method, params) {
@@ -322,7 +322,7 @@ pub fn learn_over(
             success: result.success,
             reward: result.ret,
         });
-        progress.advance(1);
+        crate::progress::step(progress)?;
     }
     progress.finish();
     Ok(points)

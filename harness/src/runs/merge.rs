@@ -173,6 +173,7 @@ pub fn merge(parts: &[PathBuf]) -> Result<Merged, Error> {
     // Unit position -> (part, line number, line).
     let mut found: BTreeMap<usize, (PathBuf, usize, KeptLine)> = BTreeMap::new();
     let mut cut: Vec<String> = Vec::new();
+    let mut seen: Vec<(PathBuf, &PathBuf)> = Vec::new();
     for part in parts {
         if !part.exists() {
             return Err(Error::flag(
@@ -180,6 +181,27 @@ pub fn merge(parts: &[PathBuf]) -> Result<Merged, Error> {
                 format!("{}: no such file; give the shard files the run wrote", part.display()),
             ));
         }
+        if !part.is_file() {
+            return Err(Error::flag(
+                flag,
+                format!(
+                    "{}: not a regular file (a folder, a pipe, a device); give the shard files the run wrote",
+                    part.display()
+                ),
+            ));
+        }
+        let real = std::fs::canonicalize(part).map_err(|e| Error::io("read", part, e))?;
+        if let Some((_, first)) = seen.iter().find(|(r, _)| *r == real) {
+            return Err(Error::flag(
+                flag,
+                format!(
+                    "{} is given twice (also as {}); give each shard file once",
+                    part.display(),
+                    first.display()
+                ),
+            ));
+        }
+        seen.push((real, part));
         let file = read_results(part)?;
         let Some((first_line, first)) = file.identities.first() else {
             return Err(Error::Results {
@@ -317,8 +339,10 @@ pub fn write_merged(merged: &Merged, out: &Path) -> Result<MergeReport, Error> {
     let rows = summarize(&merged.results());
     let summary = summary_path(out);
     let doc = summary_document(out, None, &merged.identity, &rows);
-    crate::reports::files::write_atomic(out, text.as_bytes())?;
-    crate::reports::files::write_json(&summary, &doc)?;
+    crate::reports::files::all_or_none(|| {
+        crate::reports::files::write_atomic(out, text.as_bytes())?;
+        crate::reports::files::write_json(&summary, &doc)
+    })?;
     Ok(MergeReport {
         out: out.to_path_buf(),
         summary,

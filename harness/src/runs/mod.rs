@@ -1,10 +1,12 @@
 //! What runs many episodes: scenario suites and sweeps ([`batch`]), deployment streams
 //! ([`stream`]), the paper's comparison over agents and protocols ([`compare`]), the
 //! merge of shard files ([`merge`]) and the search for fair failing scenarios
-//! ([`search`]).
+//! ([`search`]); the guard all of them pass before any work ([`outputs`]: no output
+//! replaces an input or another program's file, one writer at a time).
 
 pub mod batch;
 pub mod compare;
 pub mod merge;
+pub mod outputs;
 pub mod search;
 pub mod stream;

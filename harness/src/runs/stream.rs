@@ -97,6 +97,9 @@ pub struct Stream {
     pub description: String,
     /// The maps, in the file's order, with their weights.
     pub maps: Vec<(Map, f64)>,
+    /// The file each map was read from (None for an embedded map), in the same order:
+    /// inputs no output may replace ([`crate::runs::outputs::Outputs::stream`]).
+    pub files: Vec<Option<PathBuf>>,
     /// How episodes pick their map.
     pub order: Order,
 }
@@ -139,11 +142,18 @@ impl Stream {
                 "no maps: list at least one (map: \"FILE\", weight: W)",
             ));
         }
+        if parsed.description.chars().any(char::is_control) || parsed.description.len() > 1000 {
+            return Err(invalid(
+                "description".into(),
+                "one line of at most 1000 bytes, without control characters (newlines, tabs)",
+            ));
+        }
         if parsed.maps.len() > MAX_MAPS {
             return Err(invalid("maps".into(), "more than 64 maps"));
         }
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let mut maps = Vec::with_capacity(parsed.maps.len());
+        let mut files = Vec::with_capacity(parsed.maps.len());
         for (i, e) in parsed.maps.iter().enumerate() {
             if !(e.weight.is_finite() && e.weight > 0.0 && e.weight <= 1e6) {
                 return Err(invalid(format!("maps[{i}].weight"), "must be a number in (0, 1e6]"));
@@ -155,7 +165,8 @@ impl Stream {
                 ));
             }
             let beside: PathBuf = dir.join(&e.map);
-            let arg = if beside.exists() {
+            let from_file = beside.exists();
+            let arg = if from_file {
                 beside.display().to_string()
             } else {
                 e.map.clone()
@@ -175,6 +186,7 @@ impl Stream {
                 ));
             }
             maps.push((map, e.weight));
+            files.push(from_file.then_some(beside));
         }
         let name = path
             .file_stem()
@@ -184,6 +196,7 @@ impl Stream {
             name,
             description: parsed.description,
             maps,
+            files,
             order: parsed.order,
         })
     }
@@ -192,13 +205,20 @@ impl Stream {
     pub fn schedule(&self, episodes: u64, seed: u64) -> Vec<usize> {
         match self.order {
             Order::Sequence => {
-                let cycle: Vec<usize> = self
+                // The cycle by its cumulative weights (never spelled out: a cycle is up
+                // to 64 x 1e6 episodes long).
+                let ends: Vec<u64> = self
                     .maps
                     .iter()
-                    .enumerate()
-                    .flat_map(|(i, (_, w))| std::iter::repeat_n(i, *w as usize))
+                    .scan(0u64, |end, (_, w)| {
+                        *end += *w as u64;
+                        Some(*end)
+                    })
                     .collect();
-                (0..episodes as usize).map(|k| cycle[k % cycle.len()]).collect()
+                let cycle = ends.last().copied().unwrap_or(1).max(1);
+                (0..episodes)
+                    .map(|k| ends.partition_point(|&end| end <= k % cycle).min(self.maps.len() - 1))
+                    .collect()
             }
             Order::Weighted => {
                 let mut rng = ChaCha8Rng::seed_from_u64(episode_seed(seed, &format!("stream/{}", self.name), 0));
@@ -284,7 +304,7 @@ pub fn evaluate_stream(
      -> Result<StreamEpisode, crate::error::Error> {
         let map = &stream.maps[m].0;
         let result = run_episode(env, controller, eval_seeds(seed, map, method, k as u64), false)?.0;
-        progress.advance(1);
+        crate::progress::step(progress)?;
         Ok(StreamEpisode {
             episode: k as u64,
             map: map.name.clone(),

@@ -66,10 +66,26 @@ pub fn parse(path: &Path, text: &str) -> Result<AgentBundle, Error> {
             f.message,
             format!("the file is damaged or was edited: restore it, or {}", retrain(path)),
         ),
-        other => bad(path, None, other.to_string(), retrain(path)),
+        other => bad(path, None, clipped(&other.to_string()), retrain(path)),
     })?;
     check_intersection(&bundle).map_err(|(field, problem)| bad(path, Some(field), problem, retrain(path)))?;
     Ok(bundle)
+}
+
+/// Longest parser message kept in an error (bytes): a parser may quote the text it met,
+/// and a garbage file may be one token of hundreds of megabytes.
+const MAX_MESSAGE_BYTES: usize = 300;
+
+/// `message`, cut to [`MAX_MESSAGE_BYTES`] (at a character boundary) with `...` after.
+fn clipped(message: &str) -> String {
+    if message.len() <= MAX_MESSAGE_BYTES {
+        return message.to_string();
+    }
+    let mut end = MAX_MESSAGE_BYTES;
+    while !message.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}...", &message[..end])
 }
 
 /// The bundle drives this program's car: the sim's actions, and the discretizer's
@@ -127,6 +143,20 @@ pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> Result<(), Error> {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
+    #[test]
+    fn a_garbage_file_is_not_echoed_whole() {
+        for garbage in [
+            "\"".repeat(1 << 20),
+            "x".repeat(1 << 20),
+            format!("({}", "a: 1, ".repeat(1 << 18)),
+        ] {
+            let e = parse(Path::new("agent.ron"), &garbage).unwrap_err().to_string();
+            assert!(e.len() < 1000, "{} bytes: {}", e.len(), &e[..200]);
+        }
+    }
+
     /// The map validator bounds the bins by the same number of joint states as the agent
     /// crate bounds its learners, so every valid map can be trained on.
     #[test]

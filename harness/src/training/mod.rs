@@ -175,7 +175,7 @@ pub fn train_with_progress(
         }
         q.decay_epsilon();
         log.returns.push(ret);
-        progress.advance(1);
+        crate::progress::step(progress)?;
     }
     model.materialize();
     model.set_preferences(&state_rewards(map, &disc), cfg.tau_c)?;

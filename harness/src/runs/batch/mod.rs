@@ -45,7 +45,7 @@ pub use identity::{RunIdentity, agent_file_identity, trained_agents_identity};
 pub use plan::{BatchConfig, Plan};
 pub use result_line::{MapFigures, ResultLine, UnitKey};
 pub use results_file::{KeptLine, MAX_FIGURE, ResultsFile, read_lines, read_results, resume_lines};
-pub use run::{run, run_plan, run_unit};
+pub use run::{run, run_plan, run_unit, run_unit_with};
 pub use scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};
 pub use summary::{StreamLearning, SummaryCheck, SummaryRow, WorstLine, stream_learning, summarize, summary_path};
 pub use sweep::{MAX_PARAM_SETS, ParamSet, checked_sweep, sweep};

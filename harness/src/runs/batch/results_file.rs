@@ -208,6 +208,14 @@ pub(crate) fn line_problem(l: &ResultLine, u: &Unit, identity: &RunIdentity) -> 
     if l.covers != u.covers {
         return Some(format!("covers {:?}, the unit covers {:?}", l.covers, u.covers));
     }
+    figures_problem(l)
+}
+
+/// What is wrong with the figures of result line `l` (its own, and those of each map
+/// within a stream, whose episodes must add up to the line's): rates in [0, 1]; others
+/// finite, non-negative where they count, at most [`MAX_FIGURE`] in magnitude. `batch
+/// --resume`, `merge` and `search --resume` check every kept line with it.
+pub(crate) fn figures_problem(l: &ResultLine) -> Option<String> {
     let own = figure_problem(
         "",
         [l.success_rate, l.collision_rate, l.timeout_rate, l.inference_rate],

@@ -11,7 +11,7 @@ use crate::episodes::experiments::evaluate_under;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::runner::EpisodeResult;
 use crate::error::Error;
-use crate::progress::{NoProgress, Progress};
+use crate::progress::{CancelOnly, NoProgress, Progress};
 use crate::runs::stream::{evaluate_stream, per_map};
 
 use super::expectations::check_expectations;
@@ -27,6 +27,11 @@ use super::units::Unit;
 /// [`evaluate_stream`] (the same, over the stream's maps), and the line adds the figures
 /// per map within the stream ([`per_map`]).
 pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error> {
+    run_unit_with(cfg, unit, &NoProgress)
+}
+
+/// [`run_unit`], stopping between episodes ([`Error::Interrupted`]) when `cancel` asks.
+pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) -> Result<ResultLine, Error> {
     let scenario = &cfg.scenarios[unit.scenario];
     let agent = cfg
         .agents
@@ -56,7 +61,7 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error>
                 unit.method,
                 cfg.episodes,
                 cfg.seed,
-                &NoProgress,
+                &CancelOnly(cancel),
             )?;
             (Aggregate::of(&results), Vec::new())
         }
@@ -69,7 +74,7 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error>
                 unit.protocol,
                 cfg.episodes,
                 cfg.seed,
-                &NoProgress,
+                &CancelOnly(cancel),
             )?;
             let results: Vec<EpisodeResult> = episodes.iter().map(|e| e.result.clone()).collect();
             let figures = per_map(stream, &episodes)
@@ -166,13 +171,13 @@ pub fn run_plan(
     let fresh: Vec<KeptLine> = pool.install(|| {
         todo.par_iter()
             .map(|u| {
-                let line = run_unit(cfg, u)?;
+                let line = run_unit_with(cfg, u, progress)?;
                 let raw = to_line(&line);
                 let mut f = sink.lock().expect("result file lock");
                 f.write_all(raw.as_bytes())
                     .and_then(|()| f.flush())
                     .map_err(|e| Error::io("write", out, e))?;
-                progress.advance(1);
+                crate::progress::step(progress)?;
                 Ok(KeptLine {
                     line: 0,
                     raw,

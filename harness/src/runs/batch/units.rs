@@ -110,10 +110,14 @@ impl std::str::FromStr for Shard {
     fn from_str(s: &str) -> Result<Self, String> {
         let bad = || format!("'{s}': expected I/N with 1 <= I <= N, e.g. 2/8");
         let (i, n) = s.split_once('/').ok_or_else(bad)?;
-        let (index, count): (usize, usize) = (
-            i.trim().parse().map_err(|_| bad())?,
-            n.trim().parse().map_err(|_| bad())?,
-        );
+        // Digits only, as episode counts: `" 1/2"` and `+1/2` are refused.
+        let whole = |t: &str| -> Result<usize, String> {
+            if t.is_empty() || !t.bytes().all(|b| b.is_ascii_digit()) {
+                return Err(bad());
+            }
+            t.parse().map_err(|_| bad())
+        };
+        let (index, count) = (whole(i)?, whole(n)?);
         if count == 0 || index == 0 || index > count {
             return Err(bad());
         }
@@ -125,5 +129,18 @@ impl Shard {
     /// The range of unit positions this shard runs.
     pub fn range(self, total: usize) -> std::ops::Range<usize> {
         ((self.index - 1) * total / self.count)..(self.index * total / self.count)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_are_digits_only() {
+        assert_eq!("2/8".parse::<Shard>(), Ok(Shard { index: 2, count: 8 }));
+        for bad in [" 1/2", "1/ 2", "+1/2", "1/2 ", "0/2", "3/2", "1/0", "1", ""] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad:?}");
+        }
     }
 }

@@ -94,7 +94,7 @@ pub(super) fn minimise_all(
         .enumerate()
         .map(|(rank, f)| {
             let r = minimise_one(runner, rank, f);
-            runner.progress.advance(1);
+            crate::progress::step(runner.progress)?;
             r
         })
         .collect::<Result<_, Error>>()?;

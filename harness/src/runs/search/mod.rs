@@ -129,20 +129,27 @@ impl SearchConfig<'_> {
 
     /// Checks the settings.
     pub fn check(&self) -> Result<(), Error> {
-        if self.budget == 0 || self.budget > MAX_BUDGET {
-            return Err(Error::flag(
-                "--budget",
-                format!("{}: expected 1 to {MAX_BUDGET} candidates", self.budget),
-            ));
-        }
-        if !(self.sobol_share > 0.0 && self.sobol_share <= 1.0) {
-            return Err(Error::flag("--sobol-share", "expected a share in (0, 1]"));
-        }
-        if self.space.params.len() > sampler::MAX_DIMENSIONS {
-            return Err(Error::flag("--space", "too many parameters for the Sobol sequence"));
-        }
+        Self::check_arguments(self.space, self.budget, self.sobol_share)?;
         if self.method.is_scripted() != self.agents.is_empty() && !self.method.is_scripted() {
             return Err(Error::MissingAgent { train_seed: None });
+        }
+        Ok(())
+    }
+
+    /// The checks of [`SearchConfig::check`] that need no agent, for a front to make
+    /// before training any: the budget, the Sobol share and the space's dimensions.
+    pub fn check_arguments(space: &Space, budget: usize, sobol_share: f64) -> Result<(), Error> {
+        if budget == 0 || budget > MAX_BUDGET {
+            return Err(Error::flag(
+                "--budget",
+                format!("{budget}: expected 1 to {MAX_BUDGET} candidates"),
+            ));
+        }
+        if !(sobol_share > 0.0 && sobol_share <= 1.0) {
+            return Err(Error::flag("--sobol-share", "expected a share in (0, 1]"));
+        }
+        if space.params.len() > sampler::MAX_DIMENSIONS {
+            return Err(Error::flag("--space", "too many parameters for the Sobol sequence"));
         }
         Ok(())
     }
@@ -563,7 +570,7 @@ impl Runner<'_, '_> {
         }
         self.written.lock().expect("lines lock").insert(candidate.index, raws);
         if advance {
-            self.progress.advance(1);
+            crate::progress::step(self.progress)?;
         }
         Ok(Evaluated { candidate, lines })
     }
@@ -786,14 +793,12 @@ fn resume_lines(cfg: &SearchConfig<'_>, out: &Path) -> Result<BTreeMap<usize, Ve
         }
         let parsed: CandidateLine = serde_json::from_str(raw.trim_end())
             .map_err(|e| bad(format!("line {}: not a candidate line ({e}); {fix}", i + 1)))?;
-        if parsed.result.seed != cfg.seed || parsed.result.episodes != cfg.episodes {
+        if let Some(problem) = kept_line_problem(cfg, &parsed, raw) {
             return Err(bad(format!(
-                "line {}: seed {} and episodes {}, the run's are {} and {}; {fix}",
+                "--resume: line {} (candidate {}, {:?}) {problem}; {fix}",
                 i + 1,
-                parsed.result.seed,
-                parsed.result.episodes,
-                cfg.seed,
-                cfg.episodes
+                parsed.candidate,
+                parsed.role
             )));
         }
         let entry = by.entry(parsed.candidate).or_default();
@@ -816,10 +821,62 @@ fn resume_lines(cfg: &SearchConfig<'_>, out: &Path) -> Result<BTreeMap<usize, Ve
     // Only complete candidates are kept: a candidate cut by a kill runs again.
     let need = lines_per_candidate(cfg);
     by.retain(|_, v| v.len() == need);
-    for v in by.values_mut() {
+    for (candidate, v) in by.iter_mut() {
         v.sort_by_key(|l| (l.parsed.role, l.parsed.result.train_seed));
+        // The verdicts follow from the witnesses' figures, on every line alike.
+        let fair = Fairness::of(v[0].parsed.result.success_rate, v[1].parsed.result.success_rate);
+        if let Some(l) = v.iter().find(|l| {
+            l.parsed.fairness != fair
+                || l.parsed.values != v[0].parsed.values
+                || l.parsed.stage != v[0].parsed.stage
+                || l.parsed.fails
+                    != (l.parsed.role == Role::Method
+                        && fair.is_fair()
+                        && fairness::fails(l.parsed.result.success_rate))
+        }) {
+            return Err(bad(format!(
+                "--resume: candidate {candidate} ({:?} line): its fairness, failure verdict, stage or values do not follow from its lines (fairness {:?} from the witnesses); {fix}",
+                l.parsed.role, fair
+            )));
+        }
     }
     Ok(by)
+}
+
+/// What is wrong with a kept candidate line `l` (read from `raw`) as a line of the
+/// search `cfg`: fields this program does not write, a field of the batch line that is
+/// not this search's (unit, scenario, source, method, protocol, training seed, seed,
+/// episodes, parameters), or a figure out of range (as `batch --resume` checks them).
+fn kept_line_problem(cfg: &SearchConfig<'_>, l: &CandidateLine, raw: &str) -> Option<String> {
+    let written = serde_json::to_value(l).ok();
+    if written != serde_json::from_str::<serde_json::Value>(raw.trim_end()).ok() {
+        return Some("is not a line this program writes (an unknown or edited field)".into());
+    }
+    let r = &l.result;
+    let method = match l.role {
+        Role::SurvivableWitness => Method::BrakeOnPedestrian,
+        Role::DangerousWitness => Method::NeverBrake,
+        Role::Method => cfg.method,
+    };
+    let seed_ok = match l.role {
+        Role::Method => cfg.train_seeds.contains(&r.train_seed),
+        _ => r.train_seed.is_none(),
+    };
+    let expected = [
+        ("unit", r.unit == l.candidate),
+        ("scenario", r.scenario == candidate_name(cfg.space, l.candidate)),
+        ("source", r.source == format!("search:{}", cfg.space.source)),
+        ("method", r.method == method.name()),
+        ("protocol", r.protocol == cfg.protocol && r.covers == [cfg.protocol]),
+        ("train_seed", seed_ok),
+        ("seed", r.seed == cfg.seed),
+        ("episodes", r.episodes == cfg.episodes),
+        ("param_set", r.param_set == "default" && r.params.is_empty()),
+    ];
+    if let Some((field, _)) = expected.iter().find(|(_, ok)| !ok) {
+        return Some(format!("has a {field} that is not this search's"));
+    }
+    crate::runs::batch::results_file::figures_problem(r)
 }
 
 /// Everything a search found, in memory (what [`run`] writes).
@@ -884,8 +941,11 @@ pub fn run_with(
     let text: String = std::iter::once(output::identity_line(&cfg.identity()))
         .chain(written.values().flatten().map(|l| l.raw.clone()))
         .collect();
-    crate::reports::files::write_atomic(&file, text.as_bytes())?;
-    output::write_all(cfg, out, &outcome)
+    // The candidates, failure maps, summary and figure appear together or not at all.
+    crate::reports::files::all_or_none(|| {
+        crate::reports::files::write_atomic(&file, text.as_bytes())?;
+        output::write_all(cfg, out, &outcome)
+    })
 }
 
 /// The stages (see the module doc).

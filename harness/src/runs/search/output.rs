@@ -30,6 +30,7 @@ use super::{Evaluated, Outcome, Role, SearchConfig, SearchIdentity, Stage};
 use crate::error::Error;
 use crate::reports::figures::{plot_err, tick_label, write_svg};
 use crate::runs::batch::ResultLine;
+use crate::runs::outputs::{Outputs, Own};
 use crate::stats::Stat;
 
 /// The candidates file's name.
@@ -42,6 +43,20 @@ pub const FIGURE: &str = "search.svg";
 pub const FAILURES: &str = "failures";
 /// Rejected points listed in the summary (all are counted).
 pub const MAX_LISTED_REJECTIONS: usize = 20;
+
+/// The output guard of a search into the folder `out` (the front adds the inputs: the
+/// space file, the base map, the agent file): every file in it is the search's, the
+/// candidates are a search's, and the summary, the figure and the failure maps
+/// (`failures/*.ron`, each a map an earlier search wrote) are removed when the guard is
+/// taken, as the search writes them anew at its end.
+pub fn outputs(out: &Path) -> Outputs {
+    Outputs::new()
+        .folder("--out", out)
+        .file("--out", out.join(CANDIDATES), Own::Candidates)
+        .file_at_end("--out", out.join(SUMMARY), Own::Json)
+        .file_at_end("--out", out.join(FIGURE), Own::Svg)
+        .folder_files("--out", &out.join(FAILURES), "ron", Own::FailureMap)
+}
 
 /// `{"search": identity}` and a newline.
 pub fn identity_line(identity: &SearchIdentity) -> String {
@@ -214,16 +229,9 @@ pub struct Summary {
 pub(super) fn write_all(cfg: &SearchConfig<'_>, out: &Path, outcome: &Outcome) -> Result<Summary, Error> {
     let space = cfg.space;
     let dir = out.join(FAILURES);
+    // The folder holds this run's failures only: the guard ([`outputs`]) removed the
+    // maps of an earlier search.
     std::fs::create_dir_all(&dir).map_err(|e| Error::io("create folder", &dir, e))?;
-    // The folder holds this run's failures only.
-    if let Ok(entries) = std::fs::read_dir(&dir) {
-        for e in entries.flatten() {
-            let p = e.path();
-            if p.extension().is_some_and(|x| x == "ron") {
-                std::fs::remove_file(&p).map_err(|e| Error::io("remove", &p, e))?;
-            }
-        }
-    }
     let mut failures = Vec::new();
     for m in &outcome.failures {
         failures.push(write_failure(cfg, &dir, m)?);
@@ -374,9 +382,17 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
     let never = e.witness(Role::DangerousWitness).unwrap_or(f64::NAN);
     let path = dir.join(format!("{}.ron", map.name));
     let mut text = String::new();
+    // One comment line each: a control character (a newline in a path of the command)
+    // is escaped, so it cannot end the comment.
     let c = |text: &mut String, line: String| {
         text.push_str("// ");
-        text.push_str(&line);
+        for ch in line.chars() {
+            if ch.is_control() {
+                text.extend(ch.escape_default());
+            } else {
+                text.push(ch);
+            }
+        }
         text.push('\n');
     };
     c(

@@ -587,13 +587,21 @@ impl Space {
                 base: base_value,
             });
         }
-        if !problems.is_empty() {
-            return Err(MapError::new(problems));
-        }
         let name = file.name.clone().unwrap_or_else(|| {
             let stem = origin.rsplit(['/', '\\']).next().unwrap_or(origin);
             stem.strip_suffix(".ron").unwrap_or(stem).to_string()
         });
+        // The name becomes the failure maps' file names (`failures/NAME_c0042.ron`).
+        if let Err(problem) = crate::runs::outputs::file_name("name", &name) {
+            let fix = match file.name {
+                Some(_) => "give `name:` a short plain name, such as \"jaywalk_space\"",
+                None => "rename the space file, or give `name:` a short plain name",
+            };
+            problems.push(diag(None, "name", problem, fix.into()));
+        }
+        if !problems.is_empty() {
+            return Err(MapError::new(problems));
+        }
         Ok(Space {
             name,
             description: file.description,

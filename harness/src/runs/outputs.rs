@@ -1,0 +1,481 @@
+//! The output guard every command and the Python package call before any work: a run
+//! states its inputs ([`Outputs::input`]; a stream's maps with [`Outputs::stream`]) and
+//! its outputs (files, [`Outputs::file`], and folders whose every file is the run's,
+//! [`Outputs::folder`]), then [`Outputs::check`]:
+//!
+//! * refuses an output that is one of the inputs (the same file after resolving links;
+//!   for a folder, any input inside it), naming both;
+//! * refuses an output file that exists and is not a regular file, an output folder that
+//!   exists and is not a folder, and a place where nothing can be created;
+//! * refuses, unless `force`, an output that holds something other than what this kind
+//!   of run writes ([`Own`]): a map, an agent file, notes;
+//! * takes an advisory lock (`OUT.lock` beside a results file, `OUT/.lock` in a folder)
+//!   that refuses a second writer until the [`Guarded`] is dropped;
+//! * removes the outputs of the set that the run rewrites at its end (a summary beside a
+//!   results file, a search's summary, figure and failure maps), so the set on disk is
+//!   never one run's file beside another run's.
+//!
+//! Names that become file names (a space's name, a map's name in a search's outputs)
+//! are checked by [`file_name`].
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use crate::error::Error;
+
+/// Longest name that becomes part of a file name (bytes): file systems take 255, and
+/// the name gets a suffix (`_c0046.ron`).
+pub const MAX_NAME_BYTES: usize = 128;
+
+/// Checks a name that becomes (part of) a file name: not empty, at most
+/// [`MAX_NAME_BYTES`], no path separator, no `..`, no control character. The error names
+/// `field` (e.g. `name` of a space file).
+pub fn file_name(field: &str, name: &str) -> Result<(), String> {
+    let problem = if name.is_empty() {
+        "is empty".to_string()
+    } else if name.len() > MAX_NAME_BYTES {
+        format!("is {} bytes long; at most {MAX_NAME_BYTES}", name.len())
+    } else if name.contains(['/', '\\']) {
+        "holds a path separator ('/' or '\\')".to_string()
+    } else if name.contains("..") {
+        "holds '..'".to_string()
+    } else if name.chars().any(char::is_control) {
+        "holds a control character (a newline, a tab, ...)".to_string()
+    } else {
+        return Ok(());
+    };
+    Err(format!(
+        "{field} {name:?} {problem}: it becomes a file name; use letters, digits, '_' and '-'"
+    ))
+}
+
+/// What a run writes into an output, so that a file holding something else is refused
+/// (unless `force`) instead of being replaced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Own {
+    /// Anything: the run replaces whatever file is there (an agent file of `train`, a
+    /// figure); only inputs and non-files are refused.
+    Any,
+    /// A batch results file (JSON Lines): its first line is a run identity
+    /// (`{"run": ...}`) or a result line (Python's `evaluate`).
+    Results,
+    /// A search's candidates file: its first line is `{"search": ...}`.
+    Candidates,
+    /// A JSON document (a summary, `eval.json`).
+    Json,
+    /// A CSV table whose first line is a header of names.
+    Csv,
+    /// An SVG figure.
+    Svg,
+    /// A failure map a search wrote (its first line says so).
+    FailureMap,
+}
+
+impl Own {
+    /// What it is, for the error.
+    fn what(self) -> &'static str {
+        match self {
+            Own::Any => "a file",
+            Own::Results => "a batch's results file (first line {\"run\": ...} or a result line)",
+            Own::Candidates => "a search's candidates file (first line {\"search\": ...})",
+            Own::Json => "a JSON document",
+            Own::Csv => "a CSV table",
+            Own::Svg => "an SVG figure",
+            Own::FailureMap => "a failure map written by `unforeseen search`",
+        }
+    }
+
+    /// Whether the file at `path` (which exists) holds what this run writes; an empty
+    /// file does.
+    fn holds(self, path: &Path) -> bool {
+        if self == Own::Any {
+            return true;
+        }
+        let mut head = Vec::new();
+        let Ok(f) = std::fs::File::open(path) else {
+            return false;
+        };
+        if f.take(4096).read_to_end(&mut head).is_err() {
+            return false;
+        }
+        if head.is_empty() {
+            return true;
+        }
+        let first = head.split(|&b| b == b'\n').next().unwrap_or_default();
+        let first = String::from_utf8_lossy(first);
+        match self {
+            Own::Any => true,
+            Own::Results => {
+                first.starts_with("{\"run\":")
+                    || serde_json::from_str::<crate::runs::batch::ResultLine>(first.trim_end()).is_ok()
+            }
+            Own::Candidates => first.starts_with("{\"search\":"),
+            Own::Json => {
+                let len = std::fs::metadata(path).map_or(u64::MAX, |m| m.len());
+                len <= 1 << 26
+                    && std::fs::read(path)
+                        .ok()
+                        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+                        .is_some_and(|v| v.is_object())
+            }
+            Own::Csv => {
+                let t = first.trim_end();
+                !t.is_empty()
+                    && t.split(',')
+                        .all(|c| !c.is_empty() && c.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_'))
+            }
+            Own::Svg => first.starts_with("<svg") || first.starts_with("<?xml"),
+            Own::FailureMap => first.starts_with("// ") && first.contains("found by `unforeseen search`"),
+        }
+    }
+}
+
+/// An output file of a run.
+#[derive(Debug, Clone)]
+struct OutFile {
+    flag: String,
+    path: PathBuf,
+    own: Own,
+    /// Written at the end of the run: removed when the guard is taken.
+    at_end: bool,
+}
+
+/// The inputs and outputs of one run, checked together by [`Outputs::check`].
+#[derive(Debug, Clone, Default)]
+pub struct Outputs {
+    inputs: Vec<(String, PathBuf)>,
+    files: Vec<OutFile>,
+    /// Output folders (flag, path, whether every file inside is the run's).
+    folders: Vec<(String, PathBuf, bool)>,
+    /// Files inside a folder the run replaces as a set ([`Outputs::folder_files`]).
+    folder_files: Vec<OutFile>,
+    /// Where the lock goes (the first output's).
+    lock: Option<(String, PathBuf)>,
+}
+
+/// A guarded run: holds the lock until dropped.
+#[derive(Debug)]
+pub struct Guarded {
+    _lock: std::fs::File,
+    /// Folders that did not exist and were created (for a front to mention).
+    pub created: Vec<PathBuf>,
+}
+
+impl Outputs {
+    /// No inputs or outputs yet.
+    pub fn new() -> Outputs {
+        Outputs::default()
+    }
+
+    /// An input given as `flag` (a file; a name that is no file, such as an embedded
+    /// map, is ignored).
+    pub fn input(mut self, flag: &str, path: impl AsRef<Path>) -> Outputs {
+        self.inputs.push((flag.to_string(), path.as_ref().to_path_buf()));
+        self
+    }
+
+    /// A stream file given as `flag` and every map file it lists.
+    pub fn stream(mut self, flag: &str, file: &Path, stream: &crate::runs::stream::Stream) -> Outputs {
+        self.inputs.push((flag.to_string(), file.to_path_buf()));
+        for (i, f) in stream.files.iter().enumerate() {
+            if let Some(f) = f {
+                self.inputs
+                    .push((format!("{flag} {} (its maps[{i}])", file.display()), f.clone()));
+            }
+        }
+        self
+    }
+
+    /// An output file given as `flag`, streamed or rewritten by the run (it is kept
+    /// until the run replaces it: `--resume` reads it).
+    pub fn file(mut self, flag: &str, path: impl AsRef<Path>, own: Own) -> Outputs {
+        let path = path.as_ref().to_path_buf();
+        if self.lock.is_none() {
+            let mut name = path.as_os_str().to_owned();
+            name.push(".lock");
+            self.lock = Some((flag.to_string(), PathBuf::from(name)));
+        }
+        self.files.push(OutFile {
+            flag: flag.to_string(),
+            path,
+            own,
+            at_end: false,
+        });
+        self
+    }
+
+    /// A batch results file given as `flag` and the summary beside it (written at the
+    /// end of the run): what `batch`, `merge` and Python's `batch` and `evaluate` write.
+    pub fn results(flag: &str, out: &Path) -> Outputs {
+        Outputs::new().file(flag, out, Own::Results).file_at_end(
+            &format!("{flag} (its summary)"),
+            crate::runs::batch::summary_path(out),
+            Own::Json,
+        )
+    }
+
+    /// An output file written at the end of the run (a summary beside a results file):
+    /// removed once the guard is taken, so it never describes another run.
+    pub fn file_at_end(mut self, flag: &str, path: impl AsRef<Path>, own: Own) -> Outputs {
+        self.files.push(OutFile {
+            flag: flag.to_string(),
+            path: path.as_ref().to_path_buf(),
+            own,
+            at_end: true,
+        });
+        self
+    }
+
+    /// An output folder given as `flag`: no input may be inside it; the lock goes in it.
+    pub fn folder(mut self, flag: &str, dir: impl AsRef<Path>) -> Outputs {
+        let dir = dir.as_ref().to_path_buf();
+        if self.lock.is_none() {
+            self.lock = Some((flag.to_string(), dir.join(".lock")));
+        }
+        self.folders.push((flag.to_string(), dir, true));
+        self
+    }
+
+    /// A folder given as `flag` that the run's output files go in (made if missing);
+    /// the run leaves its other files alone.
+    pub fn place(mut self, flag: &str, dir: impl AsRef<Path>) -> Outputs {
+        self.folders.push((flag.to_string(), dir.as_ref().to_path_buf(), false));
+        self
+    }
+
+    /// The files with extension `ext` in the output folder `dir` (a search's
+    /// `failures/*.ron`): each must be [`Own`] `own` (unless `force`); they are removed
+    /// when the guard is taken, as the run writes the set anew at its end.
+    pub fn folder_files(mut self, flag: &str, dir: &Path, ext: &str, own: Own) -> Outputs {
+        self.folders.push((flag.to_string(), dir.to_path_buf(), true));
+        if let Ok(entries) = std::fs::read_dir(dir) {
+            let mut paths: Vec<PathBuf> = entries
+                .flatten()
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|x| x == ext))
+                .collect();
+            paths.sort();
+            for path in paths {
+                self.folder_files.push(OutFile {
+                    flag: flag.to_string(),
+                    path,
+                    own,
+                    at_end: true,
+                });
+            }
+        }
+        self
+    }
+
+    /// Checks everything (module docs) before any work, without touching the disk.
+    pub fn check(&self, force: bool) -> Result<(), Error> {
+        for (flag, dir, owned) in &self.folders {
+            if let Ok(meta) = std::fs::metadata(dir)
+                && !meta.is_dir()
+            {
+                return Err(Error::flag(
+                    format!("{flag} {}", dir.display()),
+                    "exists and is not a folder; give a folder for the outputs (or move that file away)",
+                ));
+            }
+            creatable_in(flag, dir, dir)?;
+            let inside = std::fs::canonicalize(dir).ok().filter(|_| *owned);
+            for (in_flag, input) in &self.inputs {
+                if let (Some(d), Ok(i)) = (&inside, std::fs::canonicalize(input))
+                    && i.starts_with(d)
+                {
+                    return Err(Error::flag(
+                        format!("{flag} {}", dir.display()),
+                        format!(
+                            "holds the file given as {in_flag} ({}); the run replaces what is in this folder: copy that input elsewhere, or give {flag} another folder",
+                            input.display()
+                        ),
+                    ));
+                }
+            }
+        }
+        for f in self.files.iter().chain(&self.folder_files) {
+            if let Ok(meta) = std::fs::metadata(&f.path)
+                && !meta.is_file()
+            {
+                return Err(Error::flag(
+                    format!("{} {}", f.flag, f.path.display()),
+                    "exists and is not a regular file (a folder, a device, a pipe); give a file path",
+                ));
+            }
+            creatable_in(&f.flag, &f.path, f.path.parent().unwrap_or(Path::new("")))?;
+            for (in_flag, input) in &self.inputs {
+                if same_file(&f.path, input) {
+                    return Err(Error::flag(
+                        format!("{} {}", f.flag, f.path.display()),
+                        format!(
+                            "is the file given as {in_flag} ({}); writing it would destroy that input: give {} another path",
+                            input.display(),
+                            f.flag
+                        ),
+                    ));
+                }
+            }
+            if !force && f.path.is_file() && !f.own.holds(&f.path) {
+                return Err(Error::flag(
+                    format!("{} {}", f.flag, f.path.display()),
+                    format!(
+                        "exists and is not {}; give another path, or add --force (force=True) to replace it",
+                        f.own.what()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Outputs::check`], then creates the missing folders, takes the lock (refusing a
+    /// second writer) and removes the outputs written at the end of the run.
+    pub fn guard(&self, force: bool) -> Result<Guarded, Error> {
+        self.check(force)?;
+        let mut created = Vec::new();
+        for (_, dir, _) in &self.folders {
+            if !dir.exists() {
+                created.push(dir.clone());
+            }
+        }
+        let lock = match &self.lock {
+            Some((flag, path)) => lock(flag, path)?,
+            None => return Err(Error::flag("outputs", "a run with no output: nothing to guard")),
+        };
+        for (_, dir, _) in &self.folders {
+            std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
+        }
+        for f in self.files.iter().chain(&self.folder_files).filter(|f| f.at_end) {
+            match std::fs::remove_file(&f.path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(Error::io("remove", &f.path, e));
+                }
+                _ => {}
+            }
+        }
+        Ok(Guarded { _lock: lock, created })
+    }
+}
+
+/// The same file: both exist and resolve (links followed) to one path.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// The nearest folder of `dir` that exists (`dir`, or its parent, ...).
+fn existing_ancestor(dir: &Path) -> PathBuf {
+    let mut cur = if dir.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        dir.to_path_buf()
+    };
+    loop {
+        if std::fs::symlink_metadata(&cur).is_ok() {
+            return cur;
+        }
+        match cur.parent() {
+            Some(p) if !p.as_os_str().is_empty() => cur = p.to_path_buf(),
+            _ => return PathBuf::from("."),
+        }
+    }
+}
+
+/// The topmost folder of `dir` that does not exist yet (and that a run writing into
+/// `dir` creates), if any: for a front to mention it.
+pub fn missing_folder(dir: &Path) -> Option<PathBuf> {
+    let base = existing_ancestor(dir);
+    let mut cur = dir;
+    let mut top = None;
+    while cur != base && !cur.as_os_str().is_empty() {
+        top = Some(cur.to_path_buf());
+        cur = cur.parent()?;
+    }
+    top
+}
+
+/// Checks that files can be created in `dir` (made if missing): its nearest existing
+/// folder must be a folder a file can be created in.
+fn creatable_in(flag: &str, shown: &Path, dir: &Path) -> Result<(), Error> {
+    let base = existing_ancestor(dir);
+    let bad = |problem: String| Error::flag(format!("{flag} {}", shown.display()), problem);
+    if !base.is_dir() {
+        return Err(bad(format!(
+            "{} is not a folder; give {flag} a path in a folder",
+            base.display()
+        )));
+    }
+    if let Err(e) = tempfile::tempfile_in(&base) {
+        return Err(bad(format!(
+            "cannot create files in {} ({e}); give {flag} a path in a writable folder",
+            base.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Takes an advisory lock on `path` (created if missing, left in place), or refuses
+/// while another run holds it. The lock is released when the file is closed.
+fn lock(flag: &str, path: &Path) -> Result<std::fs::File, Error> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
+    }
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(path)
+        .map_err(|e| Error::io("open the lock file", path, e))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => Err(Error::flag(
+            flag,
+            format!(
+                "another run is writing these outputs now (it holds {}); wait for it to finish, or give {flag} another path",
+                path.display()
+            ),
+        )),
+        Err(std::fs::TryLockError::Error(e)) => Err(Error::io("lock", path, e)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_that_become_file_names_are_checked() {
+        assert!(file_name("name", "jaywalk_space").is_ok());
+        for bad in ["../../escaped", "/tmp/x/absname", "a\nb", "", "a\\b", &"x".repeat(300)] {
+            let e = file_name("name", bad).expect_err(bad);
+            assert!(e.starts_with("name "), "{e}");
+        }
+    }
+
+    #[test]
+    fn an_input_is_not_an_output_and_a_foreign_file_needs_force() {
+        let d = tempfile::tempdir().unwrap();
+        let map = d.path().join("m.ron");
+        std::fs::write(&map, "Map()").unwrap();
+        let same = Outputs::new().input("MAP", &map).file("--out", &map, Own::Results);
+        assert!(same.check(true).unwrap_err().to_string().contains("would destroy"));
+        let foreign = Outputs::new().file("--out", &map, Own::Results);
+        assert!(foreign.check(false).unwrap_err().to_string().contains("--force"));
+        assert!(foreign.check(true).is_ok());
+        let inside = Outputs::new().input("--map", &map).folder("--out", d.path());
+        assert!(inside.check(true).unwrap_err().to_string().contains("holds the file"));
+    }
+
+    #[test]
+    fn a_second_writer_is_refused() {
+        let d = tempfile::tempdir().unwrap();
+        let out = Outputs::new().file("--out", d.path().join("r.jsonl"), Own::Results);
+        let first = out.guard(false).unwrap();
+        assert!(out.guard(false).unwrap_err().to_string().contains("another run"));
+        drop(first);
+        assert!(out.guard(false).is_ok());
+    }
+}
