@@ -17,9 +17,18 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
+
+# Run as a script, Python puts this file's folder first on sys.path: python/, which holds
+# the package's source without its compiled extension and would shadow the installed
+# package (an editable install adds python/ again, later on the path). The benchmark
+# measures the installed package.
+if sys.path and Path(sys.path[0] or ".").resolve() == Path(__file__).resolve().parent:
+    del sys.path[0]
 
 ACTIONS = [1, 0, 2, 1]
 
