@@ -23,6 +23,7 @@ import gymnasium as gym
 import numpy as np
 
 import unforeseen
+from unforeseen import baselines
 
 SMALL = os.environ.get("UNFORESEEN_EXAMPLE_SMALL") == "1"
 TRAIN_EPISODES = 300 if SMALL else 6000
@@ -49,11 +50,12 @@ env.reset(seed=7)
 for _ in range(6):
     env.step(1)
 frame = env.render()
+print(f"2. a {frame.shape[1]}x{frame.shape[0]} frame", end="")
 if have("PIL"):
     from PIL import Image
 
     Image.fromarray(frame).save("tour-frame.png")
-    print(f"2. a {frame.shape[1]}x{frame.shape[0]} frame in tour-frame.png", end="")
+    print(" in tour-frame.png", end="")
 if have("moviepy"):
     video = gym.wrappers.RecordVideo(env, "videos", episode_trigger=lambda ep: True, disable_logger=True)
     video.reset(seed=7)
@@ -89,11 +91,11 @@ if have("stable_baselines3"):
 
     dqn = DQNPolicy()
     print(f"3. Stable-Baselines3 DQN, {model.num_timesteps} steps on 8 native envs")
-elif unforeseen.baselines.have_deep_extra():
-    cfg = unforeseen.baselines.TrainConfig(
+elif baselines.have_deep_extra():
+    cfg = baselines.TrainConfig(
         algo="dqn", observation="kinematic", timesteps=DQN_STEPS, learning_starts=min(1000, DQN_STEPS // 4)
     )
-    dqn, run = unforeseen.baselines.train(cfg, seed=1)
+    dqn, run = baselines.train(cfg, seed=1)
     print(f"3. skrl DQN, {run['steps']} steps, {run['episodes']} episodes")
 else:
     dqn = None
