@@ -1,11 +1,13 @@
-"""Every Python block of the README (```python and ```py fences) runs as written, in order
-and in one namespace (a reader following the README top to bottom), in a scratch folder
-with the repository's maps/ beside it, at small sizes: episodes capped at 300, learning at
+"""Every Python block of the README (```python and ```py fences) runs as written, in order,
+each in a fresh namespace (a block must import what it uses: a reader may copy any one
+of them), in a scratch folder with the repository's maps/ beside it, at small sizes: episodes capped at 300, learning at
 600 steps. Blocks that import Stable-Baselines3
 run where it is installed (UNFORESEEN_REQUIRE_SB3=1 fails instead of skipping them)."""
 
 from __future__ import annotations
 
+import ast
+import builtins
 import os
 import re
 from pathlib import Path
@@ -27,6 +29,36 @@ def python_blocks() -> list[str]:
     return re.findall(r"```(?:python|py)\n(.*?)```", README.read_text(), flags=re.S)
 
 
+def unbound_names(code: str) -> set[str]:
+    """Names `code` reads that nothing in it binds and that are not builtins (a missing
+    import, even inside a function the run never calls). Scopes are not told apart: a
+    name bound anywhere counts as bound."""
+    tree = ast.parse(code)
+    bound: set[str] = set(dir(builtins))
+    loaded: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name):
+            (loaded if isinstance(node.ctx, ast.Load) else bound).add(node.id)
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            bound.update((a.asname or a.name).split(".")[0] for a in node.names)
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            bound.add(node.name)
+        elif isinstance(node, ast.arg):
+            bound.add(node.arg)
+    return loaded - bound
+
+
+def test_every_python_block_imports_what_it_uses():
+    for i, code in enumerate(python_blocks()):
+        assert not unbound_names(code), f"README Python block {i + 1} uses {unbound_names(code)} without importing"
+
+
+def test_unbound_names_finds_a_missing_import():
+    code = "def probs(q):\n    return np.exp(q)\n"
+    assert unbound_names(code) == {"np"}
+    assert unbound_names("import numpy as np\n" + code) == set()
+
+
 def _needs_sb3(code: str) -> bool:
     return "stable_baselines3" in code
 
@@ -46,16 +78,17 @@ def test_every_python_block_of_the_readme_runs(tmp_path, monkeypatch):
     assert len(blocks) >= 4, "the README's Python blocks"
     monkeypatch.chdir(tmp_path)
     (tmp_path / "maps").symlink_to(REPO / "maps")
-    namespace: dict = {}
     skipped = []
-    for code in blocks:
+    for i, code in enumerate(blocks):
         if _needs_sb3(code) and not _have_sb3():
             skipped.append(code.splitlines()[0])
             continue
         for pattern, repl in CAPS:
             code = re.sub(pattern, repl, code)
-        exec(compile(code, str(README), "exec"), namespace)
-    assert namespace["terminated"] or namespace["truncated"]
+        namespace: dict = {}
+        exec(compile(code, f"{README} (Python block {i + 1})", "exec"), namespace)
+        if i == 0:
+            assert namespace["terminated"] or namespace["truncated"]
     if skipped:
         if os.environ.get("UNFORESEEN_REQUIRE_SB3") == "1":
             pytest.fail(f"Stable-Baselines3 is required here; blocks not run: {skipped}")
