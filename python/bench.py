@@ -10,7 +10,8 @@ Every figure is the best of ``--repeats`` runs (like ``timeit``: on a shared mac
 best run is the one least disturbed), the runs of all configurations interleaved so
 that each sees the same load; ``cpu_per_wall`` says how many cores a vector run got. The actions are the same fixed cycle
 everywhere (speed up, maintain, slow down, speed up), and episodes restart as they end.
-Results are printed as one JSON object (nothing else is printed).
+Results are printed as one JSON object (nothing else is printed); ``package`` is the
+file of the package measured.
 """
 
 from __future__ import annotations
@@ -122,6 +123,9 @@ def main() -> None:
     a = p.parse_args()
     results: dict = {}
     if a.only != "highway":
+        import unforeseen
+
+        results["package"] = unforeseen.__file__  # the package measured
         results["unforeseen"] = [unforeseen_figures(a.map, a.steps, a.repeats, hz) for hz in (1, 10)]
     if a.highway or a.only == "highway":
         results["highway_env"] = [highway_figures(hz, a.highway_steps, a.repeats) for hz in (1, 10)]
