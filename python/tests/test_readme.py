@@ -29,6 +29,9 @@ def python_blocks() -> list[str]:
     return re.findall(r"```(?:python|py)\n(.*?)```", README.read_text(), flags=re.S)
 
 
+BLOCKS = python_blocks()
+
+
 def unbound_names(code: str) -> set[str]:
     """Names `code` reads that nothing in it binds and that are not builtins (a missing
     import, even inside a function the run never calls). Scopes are not told apart: a
@@ -49,7 +52,7 @@ def unbound_names(code: str) -> set[str]:
 
 
 def test_every_python_block_imports_what_it_uses():
-    for i, code in enumerate(python_blocks()):
+    for i, code in enumerate(BLOCKS):
         assert not unbound_names(code), f"README Python block {i + 1} uses {unbound_names(code)} without importing"
 
 
@@ -71,25 +74,24 @@ def _have_sb3() -> bool:
     return True
 
 
+def test_the_readme_has_python_blocks():
+    assert len(BLOCKS) >= 4
+
+
 @pytest.mark.filterwarnings("ignore::DeprecationWarning")
 @pytest.mark.filterwarnings("ignore::UserWarning")
-def test_every_python_block_of_the_readme_runs(tmp_path, monkeypatch):
-    blocks = python_blocks()
-    assert len(blocks) >= 4, "the README's Python blocks"
+@pytest.mark.parametrize("i", range(len(BLOCKS)), ids=[f"block{i + 1}" for i in range(len(BLOCKS))])
+def test_python_block_of_the_readme_runs(i, tmp_path, monkeypatch):
+    code = BLOCKS[i]
+    if _needs_sb3(code) and not _have_sb3():
+        if os.environ.get("UNFORESEEN_REQUIRE_SB3") == "1":
+            pytest.fail("Stable-Baselines3 is required here (UNFORESEEN_REQUIRE_SB3=1)")
+        pytest.skip("Stable-Baselines3 is not installed: pip install stable-baselines3")
     monkeypatch.chdir(tmp_path)
     (tmp_path / "maps").symlink_to(REPO / "maps")
-    skipped = []
-    for i, code in enumerate(blocks):
-        if _needs_sb3(code) and not _have_sb3():
-            skipped.append(code.splitlines()[0])
-            continue
-        for pattern, repl in CAPS:
-            code = re.sub(pattern, repl, code)
-        namespace: dict = {}
-        exec(compile(code, f"{README} (Python block {i + 1})", "exec"), namespace)
-        if i == 0:
-            assert namespace["terminated"] or namespace["truncated"]
-    if skipped:
-        if os.environ.get("UNFORESEEN_REQUIRE_SB3") == "1":
-            pytest.fail(f"Stable-Baselines3 is required here; blocks not run: {skipped}")
-        pytest.skip(f"Stable-Baselines3 is not installed; blocks not run: {skipped}")
+    for pattern, repl in CAPS:
+        code = re.sub(pattern, repl, code)
+    namespace: dict = {}
+    exec(compile(code, f"{README} (Python block {i + 1})", "exec"), namespace)
+    if i == 0:
+        assert namespace["terminated"] or namespace["truncated"]
