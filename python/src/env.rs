@@ -57,13 +57,25 @@ pub fn action_index(action: i64) -> PyResult<usize> {
 }
 
 /// The observation as a numpy array: int64 `(d, v, L, p)` or float32 kinematic values.
-fn observation<'py>(py: Python<'py>, obs: &Observation) -> Bound<'py, PyAny> {
+pub fn observation<'py>(py: Python<'py>, obs: &Observation) -> Bound<'py, PyAny> {
     match obs {
         Observation::Discrete { state, .. } => {
             PyArray1::from_slice(py, &[state.d as i64, state.v as i64, state.l as i64, state.p as i64]).into_any()
         }
         Observation::Kinematic(v) => PyArray1::from_slice(py, v).into_any(),
     }
+}
+
+/// The frame of `env`'s current tick as a uint8 `(height, width, 3)` array, at `scale`
+/// pixels per metre (checked: 0.5..=50).
+pub fn frame_array<'py>(py: Python<'py>, env: &Env, scale: f32) -> PyResult<Bound<'py, PyAny>> {
+    if !(0.5..=50.0).contains(&scale) {
+        return Err(errors::value(format!(
+            "scale {scale}: expected 0.5..=50 pixels per metre"
+        )));
+    }
+    let (rgb, h, w) = render::frame(env.map(), env.snapshot(), scale);
+    Ok(PyArray1::from_vec(py, rgb).reshape([h, w, 3])?.into_any())
 }
 
 /// Light phase as a small integer: 0 green, 1 amber, 2 red.
@@ -293,16 +305,10 @@ impl PyEnv {
     }
 
     /// A top-down frame, uint8 `(height, width, 3)`, at `scale` pixels per metre.
-    #[pyo3(signature = (scale = 6.0))]
+    #[pyo3(signature = (scale = render::DEFAULT_SCALE))]
     fn render_rgb<'py>(&self, py: Python<'py>, scale: f32) -> PyResult<Bound<'py, PyAny>> {
         self.started()?;
-        if !(0.5..=50.0).contains(&scale) {
-            return Err(errors::value(format!(
-                "scale {scale}: expected 0.5..=50 pixels per metre"
-            )));
-        }
-        let (rgb, h, w) = render::frame(self.env.map(), self.env.snapshot(), scale);
-        Ok(PyArray1::from_vec(py, rgb).reshape([h, w, 3])?.into_any())
+        frame_array(py, &self.env, scale)
     }
 
     /// The frame as one line of text.

@@ -5,15 +5,20 @@
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Transform};
 use unforeseen_sim::{LightPhase, Map, Snapshot};
 
+/// Pixels per metre of a frame unless asked otherwise: the default maps' frames are then
+/// about 1080x130 pixels, the car 45 pixels long and a pedestrian 12 pixels across.
+pub const DEFAULT_SCALE: f32 = 10.0;
+
 /// A frame of `snap` on `map` at `scale` pixels per metre: `(rgb bytes, height, width)`.
+/// Both sides are even (video encoders' 4:2:0 chroma needs it).
 pub fn frame(map: &Map, snap: &Snapshot, scale: f32) -> (Vec<u8>, usize, usize) {
     let road = &map.road;
     let half = road.half_width() as f32;
     let y_top = half + road.sidewalk_width as f32 + 1.0;
     let x_lo = (map.vehicle.start_x - map.vehicle.length).min(road.goal_x) as f32 - 2.0;
     let x_hi = road.goal_x as f32 + map.vehicle.max_speed as f32 * map.episode.decision_dt as f32 + 2.0;
-    let width = ((x_hi - x_lo) * scale).ceil().max(1.0) as u32;
-    let height = (2.0 * y_top * scale).ceil().max(1.0) as u32;
+    let even = |v: f32| (v.ceil().max(2.0) as u32).next_multiple_of(2);
+    let (width, height) = (even((x_hi - x_lo) * scale), even(2.0 * y_top * scale));
     let Some(mut pix) = Pixmap::new(width, height) else {
         return (Vec::new(), 0, 0);
     };
@@ -92,9 +97,12 @@ pub fn frame(map: &Map, snap: &Snapshot, scale: f32) -> (Vec<u8>, usize, usize) 
         lane_y + w / 2.0,
         [150, 190, 255],
     );
+    // Pedestrians: a dark ring around a bright disc, larger than life (0.6 m) so that
+    // one reads at the default scale; orange on the crosswalk, magenta elsewhere.
     for p in &snap.pedestrians {
         let rgb = if p.on_crosswalk { [250, 120, 20] } else { [230, 60, 160] };
-        disc(&mut pix, p.x as f32, p.y as f32, 0.4, rgb);
+        disc(&mut pix, p.x as f32, p.y as f32, 0.6, [20, 20, 20]);
+        disc(&mut pix, p.x as f32, p.y as f32, 0.45, rgb);
     }
     let rgb = pix
         .data()

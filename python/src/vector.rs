@@ -2,9 +2,11 @@
 //! released, writing into buffers allocated once; numpy arrays are made from the buffers
 //! (one copy each), never by a loop in Python.
 //!
-//! Autoreset is Gymnasium's NEXT_STEP mode: the step after the one that ended an env's
-//! episode resets that env (its action is ignored) and returns the reset observation
-//! with reward 0 and neither flag set. Env `i` keys its episode stream like a single env
+//! Autoreset follows one of Gymnasium's modes. NEXT_STEP (the default): the step after
+//! the one that ended an env's episode resets that env (its action is ignored) and
+//! returns the reset observation with reward 0 and neither flag set. SAME_STEP (what
+//! Stable-Baselines3 expects): the step that ends an episode resets the env at once and
+//! returns the reset observation, the final observation and info aside. Env `i` keys its episode stream like a single env
 //! ([`crate::env`]): with the keys a single env seeded `s + i` draws, env `i` runs
 //! exactly that env's episodes, whatever the number of threads.
 
@@ -14,7 +16,7 @@ use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
 use unforeseen_env::{Env, Info, Observation, ObservationForm, kinematic};
 
-use crate::env::{action_index, light_code, new_env, observation_form, stream_seed};
+use crate::env::{action_index, frame_array, light_code, new_env, observation, observation_form, stream_seed};
 use crate::errors;
 
 /// One env of the vector and its episode stream.
@@ -53,12 +55,15 @@ fn write_obs(o: &Observation, obs: &mut [f32], ints: &mut [i64]) {
 }
 
 /// What one env's tick wrote besides its observation.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 struct Out {
     reward: f64,
     terminated: bool,
     truncated: bool,
+    /// The tick's info (under SAME_STEP, for an env that ended: its final info).
     info: Option<Info>,
+    /// SAME_STEP, an env that ended this tick: its final observation and the reset's info.
+    reset: Option<(Observation, Info)>,
 }
 
 /// `num_envs` envs of one map (`unforeseen._unforeseen.VectorEnv`).
@@ -74,14 +79,16 @@ pub struct PyVectorEnv {
     outs: Vec<Out>,
     actions: Vec<usize>,
     pool: Option<rayon::ThreadPool>,
+    /// Autoreset in the step that ends an episode (SAME_STEP) instead of the next.
+    same_step: bool,
 }
 
 #[pymethods]
 impl PyVectorEnv {
     /// `num_envs` envs of `map` with map `overrides`; `num_threads` threads (default:
-    /// rayon's global pool, one per core).
+    /// rayon's global pool, one per core); `autoreset` "next_step" or "same_step".
     #[new]
-    #[pyo3(signature = (map, num_envs, observation = "discrete", pedestrian_slots = 4, overrides = None, num_threads = None))]
+    #[pyo3(signature = (map, num_envs, observation = "discrete", pedestrian_slots = 4, overrides = None, num_threads = None, autoreset = "next_step"))]
     fn new(
         map: &str,
         num_envs: usize,
@@ -89,7 +96,17 @@ impl PyVectorEnv {
         pedestrian_slots: usize,
         overrides: Option<&Bound<'_, PyDict>>,
         num_threads: Option<usize>,
+        autoreset: &str,
     ) -> PyResult<Self> {
+        let same_step = match autoreset {
+            "next_step" => false,
+            "same_step" => true,
+            _ => {
+                return Err(errors::value(format!(
+                    "autoreset '{autoreset}': expected \"next_step\" or \"same_step\""
+                )));
+            }
+        };
         if num_envs == 0 || num_envs > 1 << 16 {
             return Err(errors::value(format!("num_envs {num_envs}: expected 1..=65536")));
         }
@@ -124,6 +141,7 @@ impl PyVectorEnv {
             terminated: false,
             truncated: false,
             info: None,
+            reset: None,
         };
         Ok(PyVectorEnv {
             slots,
@@ -148,6 +166,7 @@ impl PyVectorEnv {
             outs: vec![out; num_envs],
             actions: vec![0; num_envs],
             pool,
+            same_step,
         })
     }
 
@@ -180,12 +199,15 @@ impl PyVectorEnv {
         }
         self.run(py, true);
         let obs = self.observations(py)?;
-        (obs, self.info(py)?).into_pyobject(py)
+        (obs, self.info(py, |o| o.info)?).into_pyobject(py)
     }
 
     /// Steps every env with `actions[i]` (int64, one per env): `(observations, rewards,
-    /// terminated, truncated, info)`; an env whose episode ended at the previous step is
-    /// reset instead (NEXT_STEP autoreset).
+    /// terminated, truncated, info)`. NEXT_STEP: an env whose episode ended at the
+    /// previous step is reset instead. SAME_STEP: an env whose episode ends now is reset
+    /// now; `info` is then the reset's, and holds `final_obs` (a list: the final
+    /// observation of each env that ended, else None) and `final_info` (the step's info
+    /// of every env, as arrays).
     fn step<'py>(&mut self, py: Python<'py>, actions: PyReadonlyArray1<'py, i64>) -> PyResult<Bound<'py, PyTuple>> {
         let a = actions.as_slice()?;
         if a.len() != self.slots.len() {
@@ -207,14 +229,36 @@ impl PyVectorEnv {
         let rewards: Vec<f64> = self.outs.iter().map(|o| o.reward).collect();
         let terminated: Vec<bool> = self.outs.iter().map(|o| o.terminated).collect();
         let truncated: Vec<bool> = self.outs.iter().map(|o| o.truncated).collect();
+        let info = self.info(py, |o| o.reset.as_ref().map_or(o.info, |(_, i)| Some(*i)))?;
+        if self.same_step {
+            let finals = self
+                .outs
+                .iter()
+                .map(|o| o.reset.as_ref().map(|(obs, _)| observation(py, obs)))
+                .collect::<Vec<_>>();
+            info.set_item("final_obs", finals)?;
+            info.set_item("final_info", self.info(py, |o| o.info)?)?;
+        }
         (
             self.observations(py)?,
             PyArray1::from_vec(py, rewards),
             PyArray1::from_vec(py, terminated),
             PyArray1::from_vec(py, truncated),
-            self.info(py)?,
+            info,
         )
             .into_pyobject(py)
+    }
+
+    /// The frame of every env's current tick (a list of uint8 `(height, width, 3)`
+    /// arrays) at `scale` pixels per metre.
+    #[pyo3(signature = (scale = crate::render::DEFAULT_SCALE))]
+    fn render_rgb<'py>(&self, py: Python<'py>, scale: f32) -> PyResult<Vec<Bound<'py, PyAny>>> {
+        if self.slots.iter().any(Slot::info_missing) {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "no episode yet: call reset() before render()",
+            ));
+        }
+        self.slots.iter().map(|s| frame_array(py, &s.env, scale)).collect()
     }
 }
 
@@ -228,6 +272,7 @@ impl PyVectorEnv {
         let kin = form == ObservationForm::Kinematic;
         let (obs, ints) = (&mut self.obs, &mut self.ints);
         let pool = self.pool.as_ref();
+        let same_step = self.same_step;
         py.detach(move || {
             let mut work = move || {
                 let n = slots.len();
@@ -254,17 +299,25 @@ impl PyVectorEnv {
                                 terminated: false,
                                 truncated: false,
                                 info: Some(info),
+                                reset: None,
                             };
                             return;
                         }
                         let step = slot.env.step(action).expect("a valid action on a running episode");
-                        write_obs(&step.observation, o, i);
                         slot.ended = step.terminated || step.truncated;
+                        let reset = if same_step && slot.ended {
+                            let info = slot.reset_next(o, i);
+                            Some((step.observation, info))
+                        } else {
+                            write_obs(&step.observation, o, i);
+                            None
+                        };
                         *out = Out {
                             reward: step.reward,
                             terminated: step.terminated,
                             truncated: step.truncated,
                             info: Some(step.info),
+                            reset,
                         };
                     });
             };
@@ -285,13 +338,14 @@ impl PyVectorEnv {
         })
     }
 
-    /// The info of every env as arrays (one entry per env; documented on the Python class).
-    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    /// The info of every env as arrays (one entry per env; documented on the Python
+    /// class), each env's info picked from its tick's output by `pick`.
+    fn info<'py>(&self, py: Python<'py>, pick: impl Fn(&Out) -> Option<Info>) -> PyResult<Bound<'py, PyDict>> {
         let n = self.slots.len();
         let infos: Vec<Info> = self
             .outs
             .iter()
-            .map(|o| o.info.expect("run fills every info"))
+            .map(|o| pick(o).expect("run fills every info"))
             .collect();
         let d = PyDict::new(py);
         let col = |f: &dyn Fn(&Info) -> i64| PyArray1::from_vec(py, infos.iter().map(f).collect::<Vec<_>>());

@@ -123,7 +123,7 @@ def test_render_modes():
     line = text.render()
     assert isinstance(line, str) and "C" in line and "light" in line
     with pytest.raises(ValueError, match="render_mode"):
-        unforeseen.make_env("jaywalk", render_mode="human")
+        unforeseen.make_env("jaywalk", render_mode="window")
 
 
 def test_each_step_gets_its_own_info_dicts():

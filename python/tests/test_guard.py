@@ -140,13 +140,3 @@ def test_long_calls_stop_on_ctrl_c(which, tmp_path):
     seconds = float(done.stdout.split("after ")[1].split(" s")[0])
     assert seconds < 6.0, f"{which} took {seconds} s to stop after SIGINT (sent at 1 s)"
     assert not list(tmp_path.glob("unforeseen-python-batch-*")), "a temporary file was left"
-
-
-def test_the_vector_env_refuses_fractional_and_nan_actions():
-    envs = unforeseen.VectorEnv("jaywalk", num_envs=2)
-    envs.reset(seed=0)
-    for bad in ([0.5, 1.0], [np.nan, 1.0]):
-        with pytest.raises(ValueError, match="whole numbers"):
-            envs.step(np.array(bad))
-    envs.step(np.array([1.0, 2.0]))  # whole floats are actions
-    envs.step(np.array([1, 2]))

@@ -123,7 +123,7 @@ def test_a_python_thread_runs_while_a_large_vector_step_runs():
 def test_bad_vector_input():
     vec = unforeseen.VectorEnv("jaywalk", 3)
     with pytest.raises(RuntimeError, match="before reset"):
-        vec.step(np.zeros(3))
+        vec.step(np.zeros(3, dtype=np.int64))
     vec.reset(seed=0)
     with pytest.raises(ValueError, match="action 3"):
         vec.step(np.array([0, 3, 1]))
@@ -131,3 +131,71 @@ def test_bad_vector_input():
         vec.step(np.array([0, 1]))
     with pytest.raises(ValueError, match="num_envs"):
         unforeseen.VectorEnv("jaywalk", 0)
+
+
+@pytest.mark.parametrize("actions", [[1.7, 0.2, 1.0], [np.nan, 0, 1], np.array([1.0, 0.0, 2.0], dtype=np.float32)])
+def test_float_actions_are_refused_as_by_the_single_env(actions):
+    single = unforeseen.make_env("jaywalk")
+    single.reset(seed=0)
+    with pytest.raises(TypeError):
+        single.step(1.7)
+    vec = unforeseen.VectorEnv("jaywalk", 3)
+    vec.reset(seed=0)
+    with pytest.raises(TypeError, match="integers"):
+        vec.step(actions)
+    # Integers of any width are fine.
+    vec.step(np.array([1, 0, 2], dtype=np.uint8))
+    vec.step([1, 0, 2])
+
+
+@pytest.mark.parametrize("observation", ["discrete", "kinematic"])
+def test_same_step_autoreset_equals_gymnasiums_sync_vector_env(observation):
+    n, steps = 4, 120
+    actions = np.random.default_rng(3).integers(0, 3, size=(steps, n))
+    ours = unforeseen.VectorEnv("jaywalk", n, observation, autoreset_mode=AutoresetMode.SAME_STEP)
+    assert ours.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP
+    ref = gym.vector.SyncVectorEnv(
+        [lambda: unforeseen.make_env("jaywalk", observation) for _ in range(n)],
+        autoreset_mode=AutoresetMode.SAME_STEP,
+    )
+    np.testing.assert_array_equal(ours.reset(seed=8)[0], ref.reset(seed=8)[0])
+    ended = 0
+    for t in range(steps):
+        a = ours.step(actions[t])
+        b = ref.step(actions[t])
+        for x, y in zip(a[:4], b[:4]):
+            np.testing.assert_array_equal(x, y)
+        ia, ib = a[4], b[4]
+        done = a[2] | a[3]
+        if done.any():
+            ended += int(done.sum())
+            np.testing.assert_array_equal(ia["_final_obs"], ib["_final_obs"])
+            for i in np.flatnonzero(done):
+                np.testing.assert_array_equal(ia["final_obs"][i], ib["final_obs"][i])
+                assert ia["final_info"]["goal"][i] == ib["final_info"]["goal"][i]
+                assert ia["final_info"]["step"][i] == ib["final_info"]["step"][i]
+        np.testing.assert_array_equal(ia["step"], ib["step"])  # the reset's info for ended envs
+    assert ended > n
+    ref.close()
+
+
+def test_get_attr_set_attr_and_call():
+    vec = unforeseen.VectorEnv("two_pedestrians", 3)
+    assert vec.get_attr("map_name") == ("two_pedestrians",) * 3
+    assert vec.get_attr("observation_space") == (vec.single_observation_space,) * 3
+    assert vec.get_attr("render_mode") == (None, None, None)
+    with pytest.raises(AttributeError, match="no attribute 'nope'"):
+        vec.get_attr("nope")
+    vec.set_attr("tag", ["a", "b", "c"])
+    assert vec.get_attr("tag") == ("a", "b", "c")
+    vec.set_attr("weight", 2.0)
+    assert vec.call("weight") == (2.0, 2.0, 2.0)
+    vec.set_attr("double", [lambda x, k=k: k * x for k in range(3)])
+    assert vec.call("double", 5) == (0, 5, 10)
+    with pytest.raises(ValueError, match="2 values for 3 envs"):
+        vec.set_attr("tag", ["a", "b"])
+    with pytest.raises(AttributeError, match="new VectorEnv"):
+        vec.set_attr("render_mode", "rgb_array")
+    with pytest.raises(AttributeError, match="stepped together"):
+        vec.call("step", 0)
+    assert vec.call("map_name") == ("two_pedestrians",) * 3

@@ -95,13 +95,15 @@ class Env:
         """Starts the next episode of the stream."""
     def step(self, action: int) -> tuple[npt.NDArray[Any], float, bool, bool, Info]: ...
     def kinematic(self) -> npt.NDArray[np.float32]: ...
-    def render_rgb(self, scale: float = 6.0) -> npt.NDArray[np.uint8]:
-        """Top-down frame, ``(height, width, 3)`` uint8."""
+    def render_rgb(self, scale: float = 10.0) -> npt.NDArray[np.uint8]:
+        """Top-down frame, ``(height, width, 3)`` uint8, ``scale`` pixels per metre."""
     def render_ansi(self) -> str: ...
 
 @final
 class VectorEnv:
-    """``num_envs`` envs stepped in parallel in Rust (GIL released), NEXT_STEP autoreset."""
+    """``num_envs`` envs stepped in parallel in Rust (GIL released); autoreset
+    ``"next_step"`` (Gymnasium's default) or ``"same_step"`` (the step's info then holds
+    ``final_obs`` and ``final_info``)."""
 
     def __init__(
         self,
@@ -111,6 +113,7 @@ class VectorEnv:
         pedestrian_slots: int = 4,
         overrides: dict[str, Any] | None = None,
         num_threads: int | None = None,
+        autoreset: str = "next_step",
     ) -> None: ...
     @property
     def num_envs(self) -> int: ...
@@ -122,6 +125,8 @@ class VectorEnv:
     ) -> tuple[
         npt.NDArray[Any], npt.NDArray[np.float64], npt.NDArray[np.bool_], npt.NDArray[np.bool_], dict[str, Any]
     ]: ...
+    def render_rgb(self, scale: float = 10.0) -> list[npt.NDArray[np.uint8]]:
+        """Every env's top-down frame."""
 
 @final
 class Agent:

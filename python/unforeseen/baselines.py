@@ -4,9 +4,9 @@ PPO), evaluated as methods of the tables, alone and wrapped by the scaled agent.
 Needs the ``deep`` extra (``pip install './python[deep]'``: skrl with JAX, CPU only).
 From the command line::
 
-    python -m unforeseen.baselines train --algo dqn --observation kinematic --seeds 1..10 --out out/deep
+    python -m unforeseen.baselines train --algo dqn --observation kinematic --seeds 1..10 --policies out/deep
     python -m unforeseen.baselines evaluate --algo dqn --observation kinematic --seeds 1..10 \\
-        --agents /tmp/agents --maps maps/ --out out/deep/results.jsonl --wrapped
+        --policies out/deep --agents /tmp/agents --maps maps/ --out out/deep/results.jsonl --wrapped
 
 ``train`` writes one policy file per training seed (``dqn-kinematic-seed3.npz``: the
 network's weights and the observation scaler, read back by :func:`load_policy` without
@@ -32,7 +32,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ["TrainConfig", "DeepPolicy", "train", "load_policy", "main", "have_deep_extra"]
+__all__ = ["TrainConfig", "DeepPolicy", "train", "load_policy", "main", "parser", "have_deep_extra"]
 
 
 def have_deep_extra() -> bool:
@@ -327,8 +327,8 @@ def _maps(items: Sequence[str]) -> list[str]:
     return out
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m unforeseen.baselines {train,evaluate} ...``."""
+def parser() -> argparse.ArgumentParser:
+    """The command line of ``python -m unforeseen.baselines``."""
     ap = argparse.ArgumentParser(prog="python -m unforeseen.baselines", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
     for name in ("train", "evaluate"):
@@ -350,7 +350,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     e.add_argument("--agents", help="agent cache folder (train_agents) for --wrapped")
     e.add_argument("--wrapped", action="store_true", help="also the scaled agent around each network")
     e.add_argument("--out", default="out/deep/results.jsonl")
-    args = ap.parse_args(argv)
+    return ap
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m unforeseen.baselines {train,evaluate} ...``."""
+    args = parser().parse_args(argv)
     if not have_deep_extra() and args.command == "train":
         print("error: training needs the deep extra: pip install './python[deep]'", file=sys.stderr)
         return 2

@@ -103,14 +103,28 @@ class UnforeseenEnv(gym.Env):
     ## Arguments
 
     ``map``: an embedded map name (``unforeseen.embedded_maps()``) or a map file;
-    ``observation``: ``"discrete"`` or ``"kinematic"``; ``render_mode``: ``None``,
-    ``"rgb_array"`` (a top-down uint8 frame drawn in Rust) or ``"ansi"`` (a text line);
+    ``observation``: ``"discrete"`` or ``"kinematic"``; ``render_mode``: see Rendering;
+    ``render_scale``: pixels per metre of a frame (default 10);
     ``pedestrian_slots`` (kinematic, default 4); any other keyword overrides a map field
     (``max_steps=60``, ``lane_width=3.0``, ``reward__goal=40``; ``section__field`` when a
     name is in several sections), checked by the map loader.
+
+    ## Rendering
+
+    ``render_mode="rgb_array"``: ``render()`` returns a top-down uint8 frame
+    ``(height, width, 3)`` drawn in Rust (tiny-skia), about 1080x130 pixels for the
+    shipped maps: grass, grey sidewalks, the road with its lane lines, the zebra
+    crosswalk, the yellow destination line, the light (a disc on the near sidewalk, in
+    its colour), the blue car (its windscreen lighter) and each pedestrian (a dark ring
+    around orange on the crosswalk, magenta elsewhere). ``"ansi"``: one line of text.
+    ``"human"``: the frame in a pygame window, redrawn at each ``reset`` and ``step``
+    at ``metadata["render_fps"]`` (one frame per decision tick: 1 per second by
+    default); needs the ``render`` extra (``pip install "unforeseen[render]"``).
+    ``gymnasium.wrappers.RecordVideo`` records ``rgb_array`` episodes to mp4 with the
+    ``video`` extra (moviepy).
     """
 
-    metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 1}
+    metadata = {"render_modes": ["rgb_array", "ansi", "human"], "render_fps": 1}
 
     def __init__(
         self,
@@ -118,13 +132,14 @@ class UnforeseenEnv(gym.Env):
         observation: str = "discrete",
         render_mode: str | None = None,
         pedestrian_slots: int = 4,
-        render_scale: float = 6.0,
+        render_scale: float = 10.0,
         **map_overrides: Any,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode {render_mode!r}: expected None or one of {self.metadata['render_modes']}"
             )
+        self._window: _Window | None = _Window() if render_mode == "human" else None
         self._env = _unforeseen.Env(map, observation, pedestrian_slots, map_overrides)
         self.render_mode = render_mode
         self._scale = float(render_scale)
@@ -147,22 +162,68 @@ class UnforeseenEnv(gym.Env):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         if options and "world_seed" in options:
-            return self._env.reset(int(options["world_seed"]))
-        if seed is not None or not self._keyed:
-            self._env.set_stream(episode_key(self.np_random))
-            self._keyed = True
-        return self._env.reset_next()
+            out = self._env.reset(int(options["world_seed"]))
+        else:
+            if seed is not None or not self._keyed:
+                self._env.set_stream(episode_key(self.np_random))
+                self._keyed = True
+            out = self._env.reset_next()
+        if self._window is not None:
+            self._window.show(self._env.render_rgb(self._scale), self.metadata["render_fps"])
+        return out
 
     def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
-        return self._env.step(action)
+        out = self._env.step(action)
+        if self._window is not None:
+            self._window.show(self._env.render_rgb(self._scale), self.metadata["render_fps"])
+        return out
 
     def render(self) -> np.ndarray | str | None:
         if self.render_mode == "rgb_array":
             return self._env.render_rgb(self._scale)
         if self.render_mode == "ansi":
             return self._env.render_ansi()
-        return None
+        return None  # "human" draws at each reset and step, as Gymnasium's envs do
+
+    def close(self) -> None:
+        if self._window is not None:
+            self._window.close()
+        super().close()
 
     def kinematic(self) -> np.ndarray:
         """The kinematic vector now, whatever the observation form."""
         return self._env.kinematic()
+
+
+class _Window:
+    """The pygame window of ``render_mode="human"``."""
+
+    def __init__(self) -> None:
+        try:
+            import pygame
+        except ImportError as e:
+            raise gym.error.DependencyNotInstalled(
+                'render_mode="human" needs pygame, which the render extra installs: '
+                'pip install "unforeseen[render]" (or pip install pygame)'
+            ) from e
+        self._pygame = pygame
+        self._screen: Any = None
+        self._clock = pygame.time.Clock()
+
+    def show(self, frame: np.ndarray, fps: float) -> None:
+        pg = self._pygame
+        h, w, _ = frame.shape
+        if self._screen is None:
+            pg.init()
+            pg.display.set_caption("unforeseen")
+            self._screen = pg.display.set_mode((w, h))
+        pg.event.pump()
+        self._screen.blit(pg.surfarray.make_surface(frame.swapaxes(0, 1)), (0, 0))
+        pg.display.flip()
+        self._clock.tick(fps)
+
+    def close(self) -> None:
+        if self._screen is not None:
+            self._pygame.display.quit()
+            self._pygame.quit()
+            self._screen = None

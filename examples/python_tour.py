@@ -1,0 +1,118 @@
+"""A tour of the Python package, top to bottom (install it first: README.md, "Python").
+
+    python examples/python_tour.py               # full sizes: a few minutes on 2 cores
+    UNFORESEEN_EXAMPLE_SMALL=1 python examples/python_tour.py   # what CI runs: seconds
+
+1. The Gymnasium env: gym.make, one episode.
+2. A frame (tour-frame.png) and a video of an episode (videos/, with the `video` extra).
+3. A DQN trained on the training map: with Stable-Baselines3 on the native vector env if
+   it is installed (the `sb3` extra), else with skrl's JAX DQN (the `deep` extra).
+4. The scaled agent around that DQN (ScaledWrapper), beside the DQN alone, on jaywalk.
+5. The paper's table (unforeseen.compare) over independently trained agents (shared
+   with the command line's agent cache, out/agents/).
+
+It writes into the current folder.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+
+import gymnasium as gym
+import numpy as np
+
+import unforeseen
+from unforeseen import baselines
+
+SMALL = os.environ.get("UNFORESEEN_EXAMPLE_SMALL") == "1"
+TRAIN_EPISODES = 300 if SMALL else 6000
+EVAL_EPISODES = 5 if SMALL else 100
+DQN_STEPS = 600 if SMALL else 20_000
+
+
+def have(module: str) -> bool:
+    return importlib.util.find_spec(module) is not None
+
+
+# 1. The env, as any Gymnasium env.
+env = gym.make("unforeseen/Jaywalk-v0")
+obs, info = env.reset(seed=7)
+ret, terminated, truncated = 0.0, False, False
+while not (terminated or truncated):
+    obs, reward, terminated, truncated, info = env.step(1)  # always speed up
+    ret += reward
+print(f"1. jaywalk, always speeding up: return {ret:.1f}, goal {info['goal']}, collision {info['collision']}")
+
+# 2. A frame and a video.
+env = gym.make("unforeseen/Jaywalk-v0", render_mode="rgb_array")
+env.reset(seed=7)
+for _ in range(6):
+    env.step(1)
+frame = env.render()
+print(f"2. a {frame.shape[1]}x{frame.shape[0]} frame", end="")
+if have("PIL"):
+    from PIL import Image
+
+    Image.fromarray(frame).save("tour-frame.png")
+    print(" in tour-frame.png", end="")
+if have("moviepy"):
+    video = gym.wrappers.RecordVideo(env, "videos", episode_trigger=lambda ep: True, disable_logger=True)
+    video.reset(seed=7)
+    terminated = truncated = False
+    while not (terminated or truncated):
+        _, _, terminated, truncated, _ = video.step(1)
+    video.close()
+    print("; an episode in videos/rl-video-episode-0.mp4")
+else:
+    print("; no video: pip install 'unforeseen[video]'")
+
+# 3. A DQN on the training map (kinematic observations).
+if have("stable_baselines3"):
+    from stable_baselines3 import DQN
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from unforeseen.sb3 import make_vec_env
+
+    venv = VecMonitor(make_vec_env("intersection", num_envs=8, observation="kinematic"))
+    model = DQN("MlpPolicy", venv, learning_starts=200, seed=1, device="cpu").learn(DQN_STEPS)
+
+    class DQNPolicy:
+        """The trained network as a policy (greedy) and a habit (softmax of its Q-values)."""
+
+        method, observation = "sb3-dqn-kinematic", "kinematic"
+
+        def act(self, obs, info):
+            return int(model.predict(obs, deterministic=True)[0])
+
+        def probs(self, obs):
+            q = model.q_net(model.q_net.obs_to_tensor(obs)[0]).detach().numpy()[0]
+            return np.exp(q - q.max()) / np.exp(q - q.max()).sum()
+
+    dqn = DQNPolicy()
+    print(f"3. Stable-Baselines3 DQN, {model.num_timesteps} steps on 8 native envs")
+elif baselines.have_deep_extra():
+    cfg = baselines.TrainConfig(
+        algo="dqn", observation="kinematic", timesteps=DQN_STEPS, learning_starts=min(1000, DQN_STEPS // 4)
+    )
+    dqn, run = baselines.train(cfg, seed=1)
+    print(f"3. skrl DQN, {run['steps']} steps, {run['episodes']} episodes")
+else:
+    dqn = None
+    print("3. no DQN: pip install 'unforeseen[sb3]' or 'unforeseen[deep]'")
+
+# 4. The scaled agent around the DQN: the DQN's probabilities are its habit.
+agent = unforeseen.train("intersection", episodes=TRAIN_EPISODES, seed=1)
+if dqn is not None:
+    for policy in (dqn, unforeseen.ScaledWrapper(habit=dqn, agent=agent)):
+        lines = unforeseen.evaluate(policy, ["jaywalk"], [1], episodes=EVAL_EPISODES, protocol="zero-shot")
+        print(f"4. {lines[0]['method']:>24} on jaywalk: success {lines[0]['success_rate']:.0%}")
+
+# 5. The paper's table: the methods on the test map, over independently trained agents.
+agents = unforeseen.train_agents([1, 2] if SMALL else list(range(1, 11)), episodes=TRAIN_EPISODES)
+report = unforeseen.compare(agents=agents, episodes=EVAL_EPISODES, protocols=["zero-shot"])
+print(f"5. the paper's table ({len(agents)} agents, zero-shot, {report['test_map']}):")
+print(f"   {'method':>22} {'success':>8} {'collision':>9} {'inference':>9}")
+for row in report["tables"][0]["methods"]:
+    print(f"   {row['method']:>22} {row['success_rate']['mean']:>8.0%} {row['collision_rate']['mean']:>9.0%}"
+          f" {row['inference_rate']['mean']:>9.0%}")
