@@ -180,9 +180,11 @@ fn a_base_beside_the_map_wins_over_the_embedded_one() {
     let map = result.unwrap();
     assert_eq!(map.road.goal_x, 100.0, "the copy beside the map");
     // The copy's own base, not found beside it, is the embedded training map: its rule
-    // (pedestrians on red), not the embedded jaywalk's.
+    // (pedestrians on red) and its expectations, not the embedded jaywalk's.
     assert_eq!(map.pedestrians.len(), 1);
-    assert!(map.expect.is_empty());
+    let training = unforeseen_sim::embedded::load("intersection").unwrap();
+    assert_eq!(map.expect, training.expect);
+    assert_ne!(map.expect, unforeseen_sim::embedded::load("jaywalk").unwrap().expect);
 }
 
 #[test]
