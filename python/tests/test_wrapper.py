@@ -10,6 +10,7 @@ import pytest
 import unforeseen
 from unforeseen import ScaledWrapper, q_table_habit
 from unforeseen.envs import UnforeseenEnv
+from unforeseen.evaluate import evaluate_policy
 
 DECISION = ("action", "reasoned", "surprise", "theta", "policy", "psi", "scaling_iters")
 
@@ -128,12 +129,12 @@ def test_a_wrapped_habit_that_never_restarts_is_started_again(agent, protocol):
     # them, and once they have crossed only the competence check sees that holding
     # "maintain" at a standstill never arrives (issue 32: with the gate alone every
     # episode timed out).
-    episodes = unforeseen.evaluate_policy(ScaledWrapper(habit=never_restarts, agent=agent), "jaywalk", 10, protocol)
+    episodes = evaluate_policy(ScaledWrapper(habit=never_restarts, agent=agent), "jaywalk", 10, protocol)
     assert sum(e["timeout"] for e in episodes) == 0, episodes
     assert sum(e["success"] for e in episodes) == 10, episodes
     # The paper's agent (the gate alone) is kept as the ablation, and stalls.
     alone = ScaledWrapper(habit=never_restarts, agent=agent, competence="surprise-only")
-    assert sum(e["timeout"] for e in unforeseen.evaluate_policy(alone, "jaywalk", 3, protocol)) == 3
+    assert sum(e["timeout"] for e in evaluate_policy(alone, "jaywalk", 3, protocol)) == 3
 
 
 def test_bad_habits_are_refused_with_the_reason(agent):
