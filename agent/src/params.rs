@@ -254,16 +254,18 @@ pub enum RootStep {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum CrashPlanning {
-    /// The paper's model: every state with a pedestrian on the crosswalk while the car
-    /// moves in the crosswalk's distance bin is a crash, absorbing, whatever the car does.
-    #[default]
+    /// The paper's model (the ablation): every state with a pedestrian on the crosswalk
+    /// while the car moves in the crosswalk's distance bin is a crash, absorbing, whatever
+    /// the car does, so braking there earns nothing and a dash to the goal looks best.
     States,
-    /// Beyond the paper, an option: a tick in the crosswalk zone with a pedestrian on the
-    /// crosswalk ends in a crash with a probability that grows with the distance the car
-    /// covers under the action, and a crashed episode forfeits the goal
-    /// ([`crate::model::CrashModel`]); braking there earns what it saves, also where the
-    /// car is already on the crosswalk and stopping there is what gets it hit
-    /// (EXPERIMENTS.md). Agents without a crash model plan as `states`.
+    /// Beyond the paper, the default: a tick in the crosswalk's bin with a pedestrian on
+    /// the crosswalk ends in a crash with a probability that grows with the distance the
+    /// car covers under the action, and a crashed episode forfeits the goal
+    /// ([`crate::model::CrashModel`]); braking there earns what it saves. Where the car is
+    /// already on the crosswalk when a pedestrian steps on, stopping can be what gets it
+    /// hit (EXPERIMENTS.md, "The crosswalk's distance bins and the crash model"). Agents
+    /// without a crash model plan as `states`.
+    #[default]
     Hazard,
 }
 
@@ -296,7 +298,7 @@ pub enum CrashPlanning {
 /// | `planning` | `gamma` γ | 0.5 | finite and > 0 | Cor. 1 q(π) = σ(-γG), §VI |
 /// | `planning` | `horizon` H | 3 | 1..=8 | policy length (n_actions^H policies, Prop. 1) |
 /// | `planning` | `root_step` | `learned` | `learned`, `absorbing` | the EFE tree's first step uses the learned `B`, later steps the absorbing planning model ([`RootStep`]; `absorbing` absorbs from the root on) |
-/// | `planning` | `crash_model` | `states` | `states`, `hazard` | the paper's absorbing crash-risk states, or a crash as a transition whose probability grows with the distance the car covers, forfeiting the goal (beyond the paper) ([`CrashPlanning`]) |
+/// | `planning` | `crash_model` | `hazard` | `hazard`, `states` | a crash as a transition whose probability grows with the distance the car covers, forfeiting the goal (beyond the paper), or the paper's absorbing crash-risk states ([`CrashPlanning`]) |
 /// | `planning` | `persistence_ignores` | `"d+L"` | next-time parents' names joined by `+`, or `""` (also written `none`) | the watched factor's persistence (rows where it was present) is pooled over these parents in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
 /// | `scaling` | `varsigma` ς | 0.05 | finite and >= 0 | eq. "stopping_criterion", §VI |
 /// | `scaling` | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
@@ -436,7 +438,7 @@ impl Default for PlanningParams {
             gamma: 0.5,
             horizon: 3,
             root_step: RootStep::Learned,
-            crash_model: CrashPlanning::States,
+            crash_model: CrashPlanning::Hazard,
             persistence_ignores: "d+L".into(),
         }
     }

@@ -71,7 +71,8 @@ pub fn scale_iterative(
     }
 }
 
-/// Closed form of Theorem 1: `π' ∝ π_o exp(-γ θ Q_S) = π_o ψ^θ`, into `out`.
+/// Closed form of Theorem 1: `π' ∝ π_o exp(-γ θ Q_S) = π_o ψ^θ`, into `out`, with `ψ`
+/// floored at [`crate::maths::LN_FLOOR`] (as `ln ψ` is everywhere).
 pub fn scale_closed_form(pi_o: &[f64], psi: &[f64], theta: f64, out: &mut [f64]) {
     for ((o, p), s) in out.iter_mut().zip(pi_o).zip(psi) {
         *o = p * s.max(crate::maths::LN_FLOOR).powf(theta);

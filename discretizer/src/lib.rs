@@ -15,20 +15,22 @@
 //!
 //! The paper's `d = 1` is the intersection. By default the distance edges are anchored
 //! to the crosswalk ([`distance_edges`]), so that `d` means the same on every map: `d = 1`
-//! from 4 m before the crosswalk's near edge to the goal, `d = 2` the approach in which
-//! the car can still stop, `d = 3` beyond. On the training intersection these are the
-//! paper's edges `[0, 30, 60]`; a map that moves the crosswalk moves them with it.
+//! from the crosswalk's near edge to the goal (a car observed there has entered the
+//! crosswalk), `d = 2` the approach in which the car can still stop, `d = 3` beyond. On
+//! the training intersection these are `[0, 26, 60]`, the paper's `[0, 30, 60]` with its
+//! first edge moved 4 m to the crosswalk; a map that moves the crosswalk moves them with
+//! it. A map can give the paper's edges as a list (`distance_edges: [0.0, 30.0, 60.0]`).
 //!
 //! ```
 //! use unforeseen_discretizer::Discretizer;
 //! let mut map = unforeseen_sim::Map::default();
 //! let disc = Discretizer::new(&map).unwrap();
-//! assert_eq!(disc.distance_edges(), [0.0, 30.0, 60.0]);
+//! assert_eq!(disc.distance_edges(), [0.0, 26.0, 60.0]);
 //! assert_eq!(disc.factor_sizes(), [4, 4, 2, 2]);
 //! assert_eq!(disc.distance_bin(45.0), 2);
 //! assert_eq!(disc.speed_bin(9.0), 3);
 //! map.crosswalk.x = 81.0; // near edge 11 m before the goal
-//! assert_eq!(Discretizer::new(&map).unwrap().distance_edges(), [0.0, 15.0, 45.0]);
+//! assert_eq!(Discretizer::new(&map).unwrap().distance_edges(), [0.0, 11.0, 45.0]);
 //! ```
 
 use rand::{Rng, RngExt};
@@ -77,7 +79,9 @@ pub enum DiscretizerError {
 /// where `v_max` is the car's top speed, `b` its braking and `Δt` a decision tick: the
 /// approach is never shorter than the distance in which a car at top speed, braking one
 /// tick after it sees a pedestrian, comes to a stop. On the training intersection
-/// (`n = 26`, 9 m/s, 3 m/s², 1 s: 22.5 m) this is `[0, 30, 60]`, the paper's edges.
+/// (`n = 26`, 9 m/s, 3 m/s², 1 s: 22.5 m) the default `Crosswalk(lead: 0.0, approach:
+/// 34.0)` gives `[0, 26, 60]`, and `Crosswalk(lead: 4.0, approach: 30.0)` the paper's
+/// `[0, 30, 60]`.
 pub fn distance_edges(map: &Map) -> Vec<f64> {
     match &map.bins.distance_edges {
         DistanceEdges::Goal(edges) => edges.clone(),

@@ -158,22 +158,22 @@ fn noise_free_observation_is_the_state_and_the_confusion_model_is_stochastic() {
 fn anchored_edges_follow_the_crosswalk_and_the_car() {
     // The training intersection: near edge 26 m from the goal; stopping 9 + 81/6 = 22.5 m.
     let mut map = Map::default();
-    assert_eq!(distance_edges(&map), [0.0, 30.0, 60.0]);
-    // The crosswalk at x = 81 (near edge 11 m), top speed 10.6: stopping 10.6 + 18.73 < 30.
+    assert_eq!(distance_edges(&map), [0.0, 26.0, 60.0]);
+    // The crosswalk at x = 81 (near edge 11 m), top speed 10.6: stopping 10.6 + 18.73 < 34.
     map.crosswalk.x = 81.0;
     map.vehicle.max_speed = 10.6;
-    assert_eq!(distance_edges(&map), [0.0, 15.0, 45.0]);
+    assert_eq!(distance_edges(&map), [0.0, 11.0, 45.0]);
     // 11 m/s braking at 2 m/s²: 11 + 121/4 = 41.25 m of approach.
     map.vehicle.max_speed = 11.0;
     map.vehicle.max_brake = 2.0;
-    assert_eq!(distance_edges(&map), [0.0, 15.0, 56.25]);
-    // A lead of 0 puts the edge at the near edge (maps/red_light/: [0, 26, 60]).
+    assert_eq!(distance_edges(&map), [0.0, 11.0, 52.25]);
+    // A lead of 4 m and a 30 m approach: the paper's edges [0, 30, 60] on the intersection.
     let mut map = Map::default();
     map.bins.distance_edges = DistanceEdges::Crosswalk(CrosswalkBins {
-        lead: 0.0,
-        approach: 34.0,
+        lead: 4.0,
+        approach: 30.0,
     });
-    assert_eq!(distance_edges(&map), [0.0, 26.0, 60.0]);
+    assert_eq!(distance_edges(&map), [0.0, 30.0, 60.0]);
 }
 
 /// Wherever the crosswalk and whatever the car, the crosswalk lies wholly in d = 1 and

@@ -180,7 +180,7 @@ config_struct! {
 /// Where the distance bins' edges lie (the paper's `d` factor, §VI).
 ///
 /// Written in a map as a list (`[0.0, 30.0, 60.0]`: edges on the distance to the goal,
-/// the same on every map) or as `Crosswalk(lead: 4.0, approach: 30.0)`: edges derived
+/// the same on every map) or as `Crosswalk(lead: 0.0, approach: 34.0)`: edges derived
 /// from the map's crosswalk and car, so that `d` means the same on every map
 /// (`d = 1` the crosswalk zone, `d = 2` the approach, `d = 3` beyond). The discretizer
 /// derives the edges (`unforeseen_discretizer::distance_edges`).
@@ -201,9 +201,11 @@ pub enum DistanceEdges {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename = "Crosswalk")]
 pub struct CrosswalkBins {
-    /// Metres before the crosswalk's near edge where `d = 1` starts (>= 0). Default 4.
+    /// Metres before the crosswalk's near edge where `d = 1` starts (>= 0). Default 0:
+    /// `d = 1` is the crosswalk and what lies beyond it, so a car observed there has
+    /// entered the crosswalk.
     pub lead: f64,
-    /// Shortest length of the approach bin `d = 2`, m (> 0). Default 30.
+    /// Shortest length of the approach bin `d = 2`, m (> 0). Default 34.
     pub approach: f64,
 }
 
@@ -216,7 +218,7 @@ impl<'de> Deserialize<'de> for DistanceEdges {
             type Value = DistanceEdges;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str(
-                    "a list of edges in m to the goal, e.g. [0.0, 30.0, 60.0], or Crosswalk(lead: 4.0, approach: 30.0)",
+                    "a list of edges in m to the goal, e.g. [0.0, 30.0, 60.0], or Crosswalk(lead: 0.0, approach: 34.0)",
                 )
             }
             fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<DistanceEdges, A::Error> {
@@ -232,12 +234,13 @@ impl<'de> Deserialize<'de> for DistanceEdges {
 }
 
 impl Default for DistanceEdges {
-    /// `Crosswalk(lead: 4.0, approach: 30.0)`: on the training intersection (near edge
-    /// 26 m from the goal) the paper's edges `[0, 30, 60]`.
+    /// `Crosswalk(lead: 0.0, approach: 34.0)`: on the training intersection (near edge
+    /// 26 m from the goal) the edges `[0, 26, 60]`, the paper's `[0, 30, 60]` with the
+    /// first edge moved to the crosswalk.
     fn default() -> Self {
         DistanceEdges::Crosswalk(CrosswalkBins {
-            lead: 4.0,
-            approach: 30.0,
+            lead: 0.0,
+            approach: 34.0,
         })
     }
 }
@@ -268,8 +271,8 @@ impl DistanceEdges {
 config_struct! {
     /// Discretizer bins (the paper's d and v factors).
     pub struct Bins / BinsPatch as "Bins" {
-        /// Distance bins: anchored to the crosswalk (default `Crosswalk(lead: 4.0,
-        /// approach: 30.0)`, the paper's `[0, 30, 60]` on the training intersection) or
+        /// Distance bins: anchored to the crosswalk (default `Crosswalk(lead: 0.0,
+        /// approach: 34.0)`, `[0, 26, 60]` on the training intersection) or
         /// fixed edges on the distance to the goal (`[0.0, 30.0, 60.0]`); see [`DistanceEdges`].
         distance_edges: DistanceEdges = DistanceEdges::default(),
         /// Edges on speed, m/s, strictly increasing; v = number of edges e with speed >= e.

@@ -26,6 +26,25 @@ pub fn bundle() -> &'static AgentBundle {
     })
 }
 
+/// An embedded map with the paper's distance edges `[0, 30, 60]` m to the goal (§VI) in
+/// place of the default crosswalk-anchored ones (`[0, 26, 60]` on the intersection).
+pub fn papers_bins(name: &str) -> unforeseen_sim::Map {
+    let mut map = unforeseen_harness::maps::load(name).expect("embedded map");
+    map.bins.distance_edges = unforeseen_sim::DistanceEdges::Goal(vec![0.0, 30.0, 60.0]);
+    map
+}
+
+/// The agent trained with seed 7 on the embedded intersection with the paper's distance
+/// edges ([`papers_bins`]), shared.
+pub fn papers_bundle() -> &'static AgentBundle {
+    static BUNDLE: OnceLock<AgentBundle> = OnceLock::new();
+    BUNDLE.get_or_init(|| {
+        train(&papers_bins("intersection"), &small_config(7))
+            .expect("training")
+            .0
+    })
+}
+
 /// A map file of a tiny state space (d: 3 bins, v: 2, so 24 states) on the embedded
 /// intersection, with short episodes: for tests that build many agents or episodes.
 pub const TINY_MAP: &str = "Map(base: \"intersection\", name: \"tiny\", bins: (distance_edges: [0.0, 45.0], speed_edges: [4.5]), episode: (max_steps: 12))";

@@ -5,6 +5,7 @@
 use crate::common;
 
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::experiments::{evaluate, learn, trace};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::metrics::Aggregate;
@@ -135,28 +136,32 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
 }
 
 /// A pedestrian who walks slowly keeps the crosswalk under green for 6-8 ticks. The car
-/// can stop in time, and the scaled agent does, in every episode. On this agent it is the
-/// tree's first step that matters (EXPERIMENTS.md, item 6): the braking car enters the
-/// crash-risk state (d = 1, still moving) and, with the planning model absorbing from
-/// the root on (`root_step=absorbing`), every action from there ends alike; that planner
-/// loses episodes here, which shows the test sees the difference. (With the crash model,
-/// `crash_model = hazard`, no state is a crash and the root step does not matter here.)
+/// can stop in time, and the scaled agent does, in every episode, with the crash model
+/// (the default) and with the paper's crash states. With the paper's states and the
+/// paper's distance edges (`d = 1` from 4 m before the crosswalk) it is the tree's first
+/// step that matters (EXPERIMENTS.md, item 6): the braking car enters the crash-risk
+/// state (d = 1, still moving) and, with the planning model absorbing from the root on
+/// (`root_step=absorbing`), every action from there ends alike; that planner loses
+/// episodes here, which shows the test sees the difference. (With the crash model no
+/// state is a crash, and with the default edges the braking car stops before `d = 1`, so
+/// the root step does not matter there.)
 #[test]
 fn scaled_waits_for_the_slow_walker() {
-    let bundle = common::bundle();
-    let map = unforeseen_harness::maps::load("slow_walker").unwrap();
-    let success = |params: &ScaledParams| {
-        let mut agent = Method::Scaled.controller(bundle, params, &map).unwrap();
-        Aggregate::of(&evaluate(&map, agent.as_mut(), Method::Scaled, 10, 7, &NoProgress).unwrap()).success_rate
+    let success = |bundle: &AgentBundle, map: &unforeseen_sim::Map, params: &ScaledParams| {
+        let mut agent = Method::Scaled.controller(bundle, params, map).unwrap();
+        Aggregate::of(&evaluate(map, agent.as_mut(), Method::Scaled, 10, 7, &NoProgress).unwrap()).success_rate
     };
-    assert_eq!(success(&ScaledParams::default()), 1.0);
-    let mut hazard = ScaledParams::default();
-    hazard.planning.crash_model = unforeseen_agent::params::CrashPlanning::Hazard;
-    assert_eq!(success(&hazard), 1.0);
-    let mut absorbing = ScaledParams::default();
+    let map = unforeseen_harness::maps::load("slow_walker").unwrap();
+    let mut states = ScaledParams::default();
+    states.planning.crash_model = unforeseen_agent::params::CrashPlanning::States;
+    assert_eq!(success(common::bundle(), &map, &ScaledParams::default()), 1.0);
+    assert_eq!(success(common::bundle(), &map, &states), 1.0);
+    let (papers, papers_map) = (common::papers_bundle(), common::papers_bins("slow_walker"));
+    assert_eq!(success(papers, &papers_map, &states), 1.0);
+    let mut absorbing = states;
     absorbing.planning.root_step = unforeseen_agent::params::RootStep::Absorbing;
     assert!(
-        success(&absorbing) < 1.0,
+        success(papers, &papers_map, &absorbing) < 1.0,
         "the absorbing root should lose a slow-walker episode"
     );
 }

@@ -106,38 +106,45 @@ fn episodes_digest(bundle: &AgentBundle, map: &unforeseen_sim::Map, params: &Sca
     content_hash(out.as_bytes())
 }
 
-/// The jaywalk with observation noise, so the noisy observation path is covered too.
-fn noisy_jaywalk() -> unforeseen_sim::Map {
+/// The jaywalk with observation noise, so the noisy observation path is covered too;
+/// with the paper's distance edges when `papers`.
+fn noisy_jaywalk(papers: bool) -> unforeseen_sim::Map {
     let text = "Map(base: \"jaywalk\", name: \"noisy_jaywalk\", bins: (observation_noise: 0.1))";
     let embedded = |base: &str| {
         let name = base.strip_suffix(".ron").unwrap_or(base);
         unforeseen_sim::embedded::source(name).map(|t| (format!("embedded:{name}"), t.to_string()))
     };
-    unforeseen_sim::Map::from_str_named("noisy_jaywalk.ron", text, &embedded).expect("valid map")
+    let mut map = unforeseen_sim::Map::from_str_named("noisy_jaywalk.ron", text, &embedded).expect("valid map");
+    if papers {
+        map.bins.distance_edges = common::papers_bins("jaywalk").bins.distance_edges;
+    }
+    map
 }
 
-/// The scaled agent's default parameters with the competence check off
-/// (`competence = surprise-only`): the paper's agent, whose decisions these digests
-/// recorded before the check (docs/ARCHITECTURE.md §4.11).
-fn surprise_only() -> ScaledParams {
+/// The paper's agent (docs/ARCHITECTURE.md §4.3, §4.11): the scaled agent's default
+/// parameters without the competence check (`competence = surprise-only`) and with the
+/// paper's crash-risk states (`crash_model = states`), whose decisions the digests below
+/// recorded before either was added.
+fn papers_agent() -> ScaledParams {
     let mut params = ScaledParams::default();
     params.gate.competence = CompetenceCheck::SurpriseOnly;
+    params.planning.crash_model = CrashPlanning::States;
     params
 }
 
 /// The agent's digest and its episodes' on the intersection, the jaywalk and the noisy
-/// jaywalk, with [`surprise_only`]'s parameters.
+/// jaywalk, all with the paper's distance edges, under [`papers_agent`].
 fn digests(bundle: &AgentBundle) -> [String; 4] {
-    digests_with(bundle, &surprise_only())
+    papers_digests(bundle, &papers_agent())
 }
 
 /// [`digests`] with the scaled agent's parameters `params`.
-fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
+fn papers_digests(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
     [
         agent_digest(bundle),
-        episodes_digest(bundle, &unforeseen_harness::maps::load("intersection").unwrap(), params),
-        episodes_digest(bundle, &unforeseen_harness::maps::load("jaywalk").unwrap(), params),
-        episodes_digest(bundle, &noisy_jaywalk(), params),
+        episodes_digest(bundle, &common::papers_bins("intersection"), params),
+        episodes_digest(bundle, &common::papers_bins("jaywalk"), params),
+        episodes_digest(bundle, &noisy_jaywalk(true), params),
     ]
 }
 
@@ -145,9 +152,9 @@ fn digests_with(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
 /// exactly as the code before it did: the digests recorded on that code.
 #[test]
 fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
-    let mut params = surprise_only();
+    let mut params = papers_agent();
     params.set_str("handback", "theta").unwrap();
-    assert_eq!(digests_with(common::bundle(), &params), GOLDEN_THETA_HANDBACK);
+    assert_eq!(papers_digests(common::papers_bundle(), &params), GOLDEN_THETA_HANDBACK);
 }
 
 /// Training with time-outs taken as terminal states reproduces the agent, and every
@@ -155,44 +162,61 @@ fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
 /// recorded on that code.
 #[test]
 fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
-    let map = unforeseen_harness::maps::load("intersection").unwrap();
     let mut cfg = common::small_config(7);
     cfg.timeout_as = TimeoutAs::Termination;
-    let (bundle, _) = train(&map, &cfg).unwrap();
+    let (bundle, _) = train(&common::papers_bins("intersection"), &cfg).unwrap();
     assert_eq!(digests(&bundle), GOLDEN_TIMEOUT_AS_TERMINATION);
 }
 
 /// The default training (time-outs truncate: the learners bootstrap through them). None of
 /// this agent's training episodes times out, so it is the agent of before too (the two
 /// settings differ where episodes time out: `timeouts_truncate_and_learners_bootstrap`);
-/// without the competence check it decides as before.
+/// with the paper's edges and as the paper's agent it decides as before.
 #[test]
 fn trained_agent_and_decisions_are_unchanged() {
-    let map = unforeseen_harness::maps::load("intersection").unwrap();
-    let (_, log) = train(&map, &common::small_config(7)).unwrap();
+    let (_, log) = train(&common::papers_bins("intersection"), &common::small_config(7)).unwrap();
     assert_eq!(log.timeouts, 0);
-    assert_eq!(digests(common::bundle()), GOLDEN);
+    assert_eq!(digests(common::papers_bundle()), GOLDEN);
 }
 
-/// Planning with the crash model (`crash_model = hazard`, docs/ARCHITECTURE.md §4.3): the
-/// same agent tables; the episodes change where the planner reasons (digests recorded
-/// when the option was added).
+/// Planning with the crash model (`crash_model = hazard`, docs/ARCHITECTURE.md §4.3) on
+/// the paper's edges, without the competence check: the same agent tables; the episodes
+/// change where the planner reasons (digests recorded when the option was added).
 #[test]
 fn the_crash_model_decisions_are_recorded() {
-    let mut params = surprise_only();
+    let mut params = papers_agent();
     params.planning.crash_model = CrashPlanning::Hazard;
-    assert_eq!(digests_with(common::bundle(), &params), GOLDEN_CRASH_MODEL);
+    assert_eq!(papers_digests(common::papers_bundle(), &params), GOLDEN_CRASH_MODEL);
 }
 
-/// The default agent, with the competence check (docs/ARCHITECTURE.md §4.11): the same
-/// agent tables; the episodes change where the check sends a tick to reasoning (digests
-/// recorded when the check was added).
+/// The competence check (docs/ARCHITECTURE.md §4.11) with the paper's edges and crash
+/// states: the same agent tables; the episodes change where the check sends a tick to
+/// reasoning (digests recorded when the check was added).
 #[test]
 fn the_competence_check_decisions_are_recorded() {
-    assert_eq!(
-        digests_with(common::bundle(), &ScaledParams::default()),
-        GOLDEN_COMPETENCE
-    );
+    let mut params = papers_agent();
+    params.gate.competence = CompetenceCheck::Regret;
+    assert_eq!(papers_digests(common::papers_bundle(), &params), GOLDEN_COMPETENCE);
+}
+
+/// The default agent on the default maps: distance edges anchored at the crosswalk's near
+/// edge, the crash model and the competence check (digests recorded when the edges and
+/// the crash model became the defaults).
+#[test]
+fn the_default_agent_decisions_are_recorded() {
+    let bundle = common::bundle();
+    let params = ScaledParams::default();
+    let digests = [
+        agent_digest(bundle),
+        episodes_digest(
+            bundle,
+            &unforeseen_harness::maps::load("intersection").unwrap(),
+            &params,
+        ),
+        episodes_digest(bundle, &unforeseen_harness::maps::load("jaywalk").unwrap(), &params),
+        episodes_digest(bundle, &noisy_jaywalk(false), &params),
+    ];
+    assert_eq!(digests, GOLDEN_DEFAULT);
 }
 
 /// On a map whose episodes often time out (the tiny map: 12 ticks), the two settings
@@ -247,6 +271,14 @@ const GOLDEN_COMPETENCE: [&str; 4] = [
     "31a9127450a408ad",
     "fd86969ccbedd97b",
     "42645404ec0bad2e",
+];
+
+/// Digests of [`the_default_agent_decisions_are_recorded`].
+const GOLDEN_DEFAULT: [&str; 4] = [
+    "9be644aee445c8c1",
+    "a66a655d43352ba3",
+    "46e9face67f3d281",
+    "c551e19e55cbb59c",
 ];
 
 /// Digests of [`the_theta_handback_ablation_reproduces_the_decisions_of_before`]: those of

@@ -135,7 +135,13 @@ fn scaling_mode_closed_form_reaches_the_closed_form_and_acts() {
         }
         reasoned += 1;
         let (th, tr) = (d.theta.unwrap(), agent.last_reasoning());
-        let raw: Vec<f64> = tr.pi_o.iter().zip(&tr.psi).map(|(o, p)| o * p.powf(th)).collect();
+        let floor = unforeseen_agent::maths::LN_FLOOR;
+        let raw: Vec<f64> = tr
+            .pi_o
+            .iter()
+            .zip(&tr.psi)
+            .map(|(o, p)| o * p.max(floor).powf(th))
+            .collect();
         let z: f64 = raw.iter().sum();
         for (got, want) in d.policy.iter().zip(&raw) {
             assert!((got - want / z).abs() < 1e-9, "{:?} vs {raw:?}/{z}", d.policy);

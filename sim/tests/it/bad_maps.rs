@@ -90,14 +90,14 @@ fn bad_crosswalk_anchored_bins_are_rejected() {
         has(&lines, &["bins.distance_edges.approach", "greater than 0"]),
         "{lines:?}"
     );
-    let (file, lines) = reject("Map(bins: (distance_edges: Crosswalk(lead: 4.0, aproach: 30.0)))");
+    let (file, lines) = reject("Map(bins: (distance_edges: Crosswalk(lead: 0.0, aproach: 34.0)))");
     assert!(
         lines[0].starts_with(&format!("{file}:1:")) && has(&lines, &["aproach", "approach"]),
         "{lines:?}"
     );
     let (_, lines) = reject("Map(bins: (distance_edges: 30.0))");
     assert!(
-        has(&lines, &["bins.distance_edges", "Crosswalk(lead: 4.0, approach: 30.0)"]),
+        has(&lines, &["bins.distance_edges", "Crosswalk(lead: 0.0, approach: 34.0)"]),
         "{lines:?}"
     );
 }
@@ -244,7 +244,8 @@ fn binary_file_is_rejected() {
 #[test]
 fn truncated_file_is_rejected() {
     let full = unforeseen_sim::embedded::INTERSECTION;
-    let cut = &full[..full.len() / 2];
+    // Cut at a line's end halfway through: the text stops, not a word in it.
+    let cut = &full[..full[..full.len() / 2].rfind('\n').expect("a line break")];
     let (_, lines) = reject(cut);
     assert!(has(&lines, &["truncated"]) || has(&lines, &["end"]), "{lines:?}");
     assert!(
