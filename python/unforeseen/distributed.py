@@ -286,7 +286,8 @@ def run_batch(
         run = ray.remote(num_cpus=jobs, **options)(_units_task)
 
         def submit(block: list[int]) -> Any:
-            seeds = sorted({seed_of[u] for u in block}, key=lambda s: (s is None, s or 0))
+            # The block's agents (a scripted method's units need none: none is trained for them).
+            seeds = sorted({seed_of[u] for u in block} & agent_refs.keys(), key=lambda s: (s is None, s or 0))
             return run.remote(plan["spec"], seeds, *(agent_refs[s] for s in seeds), units=block, threads=jobs)
 
         progress = _Progress(plan["total"], plan["kept"], quiet)
