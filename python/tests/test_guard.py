@@ -140,3 +140,87 @@ def test_long_calls_stop_on_ctrl_c(which, tmp_path):
     seconds = float(done.stdout.split("after ")[1].split(" s")[0])
     assert seconds < 6.0, f"{which} took {seconds} s to stop after SIGINT (sent at 1 s)"
     assert not list(tmp_path.glob("unforeseen-python-batch-*")), "a temporary file was left"
+
+
+SEARCH_INTERRUPTED = """
+import json, os, signal, sys, threading, time, types
+import unforeseen
+from unforeseen import _unforeseen
+which, out, space = sys.argv[1], sys.argv[2], sys.argv[3]
+spec = json.dumps({"map": "jaywalk", "space": space, "method": "never-brake", "protocol": "zero-shot",
+                   "budget": 4, "episodes": 1_000_000, "seed": 3, "sobol_share": 0.5, "rounds": 1,
+                   "max_failures": 1, "train_seeds": None, "train_episodes": 1})
+
+class Ray(types.ModuleType):
+    # A cluster whose tasks never finish: run_search's own waiting is what Ctrl-C must stop.
+    class exceptions:
+        RayError = RuntimeError
+        RayTaskError = RuntimeError
+    def __init__(self):
+        super().__init__("ray")
+        self.cancelled = 0
+    def is_initialized(self):
+        return True
+    def cluster_resources(self):
+        return {"CPU": 2}
+    def get(self, refs):
+        return []
+    def remote(self, **options):
+        return lambda f: types.SimpleNamespace(remote=lambda *a, **k: object())
+    def wait(self, refs, num_returns, timeout):
+        time.sleep(timeout)
+        return [], refs
+    def cancel(self, ref, force):
+        self.cancelled += 1
+
+ray = Ray()
+if which == "run_search":
+    sys.modules["ray"] = ray
+    from unforeseen.distributed import run_search
+    call = lambda: run_search(space=space, method="never-brake", budget=4, episodes=1_000_000, seed=3, rounds=1,
+                              max_failures=1, out=out)
+else:
+    # The Sobol stage's candidates, as the driver hands them to its evaluator.
+    class Got(Exception):
+        pass
+    got = []
+    def capture(candidates):
+        got.extend(candidates)
+        raise Got
+    try:
+        _unforeseen.drive_search(spec, [], capture, os.path.join(out, "first"))
+    except Got:
+        pass
+    call = lambda: _unforeseen.evaluate_search_candidates(spec, [], got, threads=2)
+threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+start = time.monotonic()
+try:
+    call()
+    print("finished")
+except KeyboardInterrupt:
+    print(f"interrupted after {time.monotonic() - start:.2f} s; {ray.cancelled} task(s) cancelled")
+"""
+
+
+@pytest.mark.parametrize("which", ["run_search", "evaluate_search_candidates"])
+def test_search_stops_on_ctrl_c(which, tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", SEARCH_INTERRUPTED, which, str(out), str(MAPS / "spaces" / "jaywalk.ron")],
+                          capture_output=True, text=True, env=env, timeout=120)
+    assert "interrupted after" in done.stdout, done.stdout + done.stderr
+    seconds = float(done.stdout.split("after ")[1].split(" s")[0])
+    assert seconds < 6.0, f"{which} took {seconds} s to stop after SIGINT (sent at 1 s)"
+    if which == "run_search":
+        # The waiting driver cancelled its pending tasks; the search wrote only its
+        # candidates file (the identity line, for resume=True), its lock and the
+        # (empty) folder of failure maps.
+        assert "0 task(s) cancelled" not in done.stdout, done.stdout
+        assert sorted(p.name for p in out.iterdir()) == [".lock", "candidates.jsonl", "failures"]
+        assert list((out / "failures").iterdir()) == []
+    temporary = [p for p in tmp_path.rglob("*") if p.name.startswith(".tmp") or p.name.startswith("unforeseen-")]
+    assert temporary == [], "a temporary file was left"
