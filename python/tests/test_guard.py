@@ -99,6 +99,41 @@ def test_numpy_integers_are_override_values():
     assert env._env.max_steps == 60
 
 
+def test_an_endless_observation_is_refused_by_the_wrapper(agent):
+    wrapper = unforeseen.ScaledWrapper(agent=agent)
+    wrapper.begin_episode(1)
+    with pytest.raises(ValueError, match="factors"):
+        wrapper.act(None, {"observed": itertools.count()})
+
+
+def test_the_search_drivers_threads_are_capped(tmp_path):
+    # The distributed search passes jobs=max_failures; 20000 threads did not finish in 60 s.
+    import time
+
+    from unforeseen import _unforeseen
+
+    spec = json.dumps({"map": "jaywalk", "space": str(MAPS / "spaces" / "jaywalk.ron"), "method": "never-brake",
+                       "protocol": "zero-shot", "budget": 2, "episodes": 1, "seed": 3, "sobol_share": 0.5,
+                       "rounds": 1, "max_failures": 1, "train_seeds": None, "train_episodes": 1})
+
+    def evaluate(candidates):
+        return _unforeseen.evaluate_search_candidates(spec, [], candidates)
+
+    start = time.monotonic()
+    summary = json.loads(_unforeseen.drive_search(spec, [], evaluate, tmp_path / "out", jobs=20_000))
+    assert time.monotonic() - start < 30
+    assert summary["counts"]["sobol"] == 1
+
+
+def test_a_float_for_a_whole_number_override_names_the_key():
+    # It used to fail in the RON parser: "episode.?: Expected comma".
+    with pytest.raises(ValueError, match=r"max_steps: 1\.5 is not an integer.*give an int"):
+        unforeseen.make_env("jaywalk", max_steps=1.5)
+    with pytest.raises(ValueError, match="episode__max_steps: 60.0 is not an integer"):
+        gym.make("unforeseen/Jaywalk-v0", episode__max_steps=60.0)
+    assert unforeseen.make_env("jaywalk", max_steps=60)._env.max_steps == 60
+
+
 def test_an_endless_observation_is_refused(agent):
     c = agent.controller("scaled")
     with pytest.raises(ValueError, match="factors"):
