@@ -63,6 +63,9 @@ def test_evaluate_twice_into_one_file_is_refused(tmp_path):
 def test_summarize_a_missing_file_is_an_error(tmp_path):
     with pytest.raises(ValueError, match="no such file"):
         unforeseen.summarize(tmp_path / "nonexistent.jsonl")
+    # A folder is an input that is not a results file, not a problem writing results.
+    with pytest.raises(ValueError, match="not a results file"):
+        unforeseen.summarize(tmp_path)
 
 
 @pytest.mark.parametrize("episodes", [0, 10**7])

@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use super::common::{assert_exit, run_cli};
+use super::common::{assert_exit, output_text as common_text, run_cli};
 
 const SPACE: &str = "maps/spaces/jaywalk.ron";
 
@@ -303,9 +303,57 @@ fn merge_names_a_part_given_twice_or_not_a_file() {
         2,
         &["not a regular file", "shard files"],
     );
+    // A pipe is not read (it would block) and is named as the input it is.
+    let fifo = d.path().join("pipe.jsonl");
+    if std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        let r = run_cli(&["merge", p, fifo.to_str().unwrap(), "--out", o]);
+        assert_exit(&r, 2, &["pipe.jsonl", "not a regular file"]);
+        assert!(!common_text(&r).contains("write results"), "{}", common_text(&r));
+    }
     assert_exit(
         &run_cli(&["batch", "jaywalk", "--shard", " 1/2", "--out", o]),
         2,
         &["--shard"],
     );
+}
+
+/// Finding 12: a newline in `--out` (it is in the command written in each failure map's
+/// `// Found by:` comment) ended the comment and broke the map's RON.
+#[test]
+fn a_newline_in_out_leaves_the_failure_maps_valid() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("a\nb");
+    let r = run_cli(&[
+        "search",
+        "--space",
+        SPACE,
+        "--method",
+        "never-brake",
+        "--budget",
+        "6",
+        "--episodes",
+        "2",
+        "--seed",
+        "9",
+        "--max-failures",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_exit(&r, 0, &[]);
+    let maps: Vec<_> = std::fs::read_dir(out.join("failures"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert!(!maps.is_empty(), "never-brake fails on every fair candidate");
+    for m in maps {
+        let text = std::fs::read_to_string(&m).unwrap();
+        let found = text.lines().find(|l| l.starts_with("// Found by:")).unwrap();
+        assert!(found.contains("a\\nb"), "{found}");
+        unforeseen_harness::maps::load_file(&m).unwrap_or_else(|e| panic!("{}: {e}\n{text}", m.display()));
+    }
 }
