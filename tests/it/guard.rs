@@ -62,6 +62,13 @@ fn search_never_replaces_an_input_inside_its_out() {
     std::fs::copy("maps/jaywalk.ron", &map).unwrap();
     assert_exit(&search(&out, &["--map", map.to_str().unwrap()]), 2, &["--map"]);
     assert_eq!(read(&map), read(Path::new("maps/jaywalk.ron")));
+    // An agent file at the summary's name.
+    let agent = out.join("summary.json");
+    unforeseen_harness::training::agent_file::save(&agent, super::common::bundle()).unwrap();
+    let before = read(&agent);
+    let r = search(&out, &["--agent", agent.to_str().unwrap()]);
+    assert_exit(&r, 2, &["--agent"]);
+    assert_eq!(read(&agent), before);
 }
 
 #[test]
@@ -137,12 +144,14 @@ fn search_resume_checks_every_kept_line() {
     assert_exit(&search(&out, &["--resume"]), 0, &[]);
     let line = text.lines().nth(1).expect("a candidate line");
     let value: serde_json::Value = serde_json::from_str(line).unwrap();
-    let edits: [(&str, serde_json::Value); 6] = [
+    let edits: [(&str, serde_json::Value); 8] = [
         ("success_rate", (-3.0).into()),
         ("mean_reward", 1e300.into()),
         ("unit", 99.into()),
         ("scenario", "other".into()),
         ("method", "scaled".into()),
+        ("protocol", "continual".into()),
+        ("train_seed", 3.into()),
         ("surprise", 1.into()),
     ];
     for (field, v) in edits {
@@ -228,6 +237,26 @@ fn a_streams_maps_are_inputs() {
     ]);
     assert_exit(&r, 2, &["--stream"]);
     assert_eq!(read(&out.join("eval.json")), read(Path::new("maps/crowd.ron")));
+    // learn --stream with a map at OUT/learn.csv (learn needs a real agent).
+    let agent = d.path().join("agent.ron");
+    unforeseen_harness::training::agent_file::save(&agent, super::common::bundle()).unwrap();
+    let out = d.path().join("le");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::copy("maps/crowd.ron", out.join("learn.csv")).unwrap();
+    let stream4 = stream_with(d.path(), "le/learn.csv");
+    let r = run_cli(&[
+        "learn",
+        "--stream",
+        stream4.to_str().unwrap(),
+        "--agent",
+        agent.to_str().unwrap(),
+        "--episodes",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_exit(&r, 2, &["--stream"]);
+    assert_eq!(read(&out.join("learn.csv")), read(Path::new("maps/crowd.ron")));
     assert_eq!(read(&map), before);
 }
 
