@@ -176,7 +176,8 @@ def test_long_calls_stop_on_ctrl_c(which, tmp_path):
                           timeout=120)
     assert "interrupted after" in done.stdout, done.stdout + done.stderr
     seconds = float(done.stdout.split("after ")[1].split(" s")[0])
-    assert seconds < 6.0, f"{which} took {seconds} s to stop after SIGINT (sent at 1 s)"
+    # The bound: control returns within 2 s of SIGINT (sent at 1 s).
+    assert seconds < 3.0, f"{which} took {seconds - 1:.2f} s to stop after SIGINT (sent at 1 s)"
     assert not list(tmp_path.glob("unforeseen-python-batch-*")), "a temporary file was left"
 
 
@@ -252,7 +253,8 @@ def test_search_stops_on_ctrl_c(which, tmp_path):
                           capture_output=True, text=True, env=env, timeout=120)
     assert "interrupted after" in done.stdout, done.stdout + done.stderr
     seconds = float(done.stdout.split("after ")[1].split(" s")[0])
-    assert seconds < 6.0, f"{which} took {seconds} s to stop after SIGINT (sent at 1 s)"
+    # The bound: control returns within 2 s of SIGINT (sent at 1 s).
+    assert seconds < 3.0, f"{which} took {seconds - 1:.2f} s to stop after SIGINT (sent at 1 s)"
     if which == "run_search":
         # The waiting driver cancelled its pending tasks; the search wrote only its
         # candidates file (the identity line, for resume=True), its lock and the
