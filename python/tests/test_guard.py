@@ -2,7 +2,9 @@
 output guard of ``unforeseen batch --out`` (an input is never replaced, another
 program's file needs ``force``, lines are not appended to an earlier run's); arguments
 are bounded; conversions refuse recursive and over-deep values with ValueError instead
-of crashing the interpreter; endless iterables are refused."""
+of crashing the interpreter; endless iterables are refused; a float for a whole-number
+map field names the key; the long calls and the search stop on Ctrl-C within 2 s and
+leave no temporary file (issue 35)."""
 
 from __future__ import annotations
 
