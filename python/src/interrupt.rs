@@ -42,6 +42,20 @@ where
     T: Send,
     F: FnOnce(&dyn Progress) -> Result<T, Error> + Send,
 {
+    interruptible_then(py, |_| Ok(()), work)
+}
+
+/// [`interruptible`], calling `on_signal` (with the GIL, on the calling thread) once a
+/// signal arrived, after asking the work to stop: for work that waits on Python code
+/// the library cannot stop (e.g. setting a `threading.Event` a search's evaluator
+/// checks). An error of `on_signal` is dropped: the signal's exception is raised.
+pub fn interruptible_then<T, F, S>(py: Python<'_>, on_signal: S, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce(&dyn Progress) -> Result<T, Error> + Send,
+    S: FnOnce(Python<'_>) -> PyResult<()>,
+{
+    let mut on_signal = Some(on_signal);
     let watch = Watch::default();
     let mut raised: Option<PyErr> = None;
     let done = std::thread::scope(|s| {
@@ -62,6 +76,9 @@ where
             {
                 raised = Some(e);
                 watch.stop.store(true, Ordering::Relaxed);
+                if let Some(f) = on_signal.take() {
+                    let _ = f(py);
+                }
             }
         }
         handle.join()

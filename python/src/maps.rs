@@ -18,11 +18,19 @@ pub fn load(arg: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Map> {
     let map = unforeseen_harness::maps::load(arg).map_err(errors::to_py)?;
     match overrides {
         Some(o) if !o.is_empty() => {
+            let sections = sections();
             let mut fields = Vec::new();
             for (k, v) in o.iter() {
                 let key: String = k.extract()?;
+                let (section, field) = locate(&key, &sections)?;
+                if v.is_instance_of::<PyFloat>() && is_whole_number(&section, &field) {
+                    return Err(errors::value(format!(
+                        "map override {key}: {v} is not an integer; {section}.{field} is a whole number: give an int (e.g. {key}={})",
+                        v.extract::<f64>()?.round().max(0.0)
+                    )));
+                }
                 let value = ron_value(&key, &v, 0)?;
-                fields.push((key, value));
+                fields.push((section, field, value));
             }
             patch(&map, arg, &fields)
         }
@@ -43,6 +51,15 @@ fn sections() -> Vec<(String, Vec<String>)> {
         }
     }
     out
+}
+
+/// Whether `section.field` of a map is a whole number (its default serializes as an
+/// integer), so a float override is refused by name instead of failing in the RON parser.
+fn is_whole_number(section: &str, field: &str) -> bool {
+    let value = serde_json::to_value(Map::default()).unwrap_or_default();
+    value[section][field]
+        .as_number()
+        .is_some_and(|n| n.is_u64() || n.is_i64())
 }
 
 /// `key` as `(section, field)`: `section__field`, or a field name that only one
@@ -126,16 +143,15 @@ fn ron_value(key: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<String> 
     }
 }
 
-/// Lays `fields` (key, RON value) over `map` and validates the result with the loader.
-fn patch(map: &Map, arg: &str, fields: &[(String, String)]) -> PyResult<Map> {
-    let sections = sections();
+/// Lays `fields` (section, field, RON value) over `map` and validates the result with
+/// the loader.
+fn patch(map: &Map, arg: &str, fields: &[(String, String, String)]) -> PyResult<Map> {
     let mut by_section: Vec<(String, Vec<String>)> = Vec::new();
-    for (key, value) in fields {
-        let (s, f) = locate(key, &sections)?;
+    for (s, f, value) in fields {
         let line = format!("{f}: {value}");
-        match by_section.iter_mut().find(|(x, _)| *x == s) {
+        match by_section.iter_mut().find(|(x, _)| x == s) {
             Some((_, lines)) => lines.push(line),
-            None => by_section.push((s, vec![line])),
+            None => by_section.push((s.clone(), vec![line])),
         }
     }
     let quote = |s: &str| ron::to_string(s).unwrap_or_else(|_| format!("{s:?}"));

@@ -20,7 +20,6 @@ use serde::Deserialize;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::error::Error;
-use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::{agent_file_identity, trained_agents_identity};
 use unforeseen_harness::runs::search::{self, CandidateWire, Evaluator, SearchConfig, Space};
 use unforeseen_harness::training::DEFAULT_TRAIN_MAP;
@@ -28,6 +27,7 @@ use unforeseen_harness::training::seed_agents::Agent;
 
 use crate::agent::method;
 use crate::errors;
+use crate::interrupt::{interruptible, interruptible_then};
 use crate::units::{check_episodes, parse_agent};
 
 /// The arguments of `unforeseen search` that determine its results.
@@ -156,7 +156,8 @@ fn search_agent_text<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py,
 /// Evaluates the candidates (JSON texts of `unforeseen_harness::runs::search::CandidateWire`) of the
 /// search `spec` with its agents, on `threads` threads with the GIL released; returns
 /// each candidate's lines of `candidates.jsonl`, in the order given. Raises `ValueError`
-/// for input that cannot run here (a space or map that differs, a missing agent).
+/// for input that cannot run here (a space or map that differs, a missing agent), and
+/// `KeyboardInterrupt` at the next episode after Ctrl-C ([`interruptible`]).
 #[pyfunction]
 #[pyo3(signature = (spec, agents, candidates, from_file = false, threads = 1))]
 fn evaluate_search_candidates(
@@ -172,17 +173,16 @@ fn evaluate_search_candidates(
         .iter()
         .map(|c| serde_json::from_str(c).map_err(|e| errors::value(format!("candidate: {e}"))))
         .collect::<PyResult<_>>()?;
-    py.detach(|| {
+    interruptible(py, |cancel| {
         let cfg = built.config(threads, String::new());
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build()?;
         pool.install(|| {
             wires
                 .par_iter()
-                .map(|w| search::evaluate_wire(&cfg, w))
+                .map(|w| search::evaluate_wire_with(&cfg, w, cancel))
                 .collect::<Result<Vec<_>, Error>>()
         })
     })
-    .map_err(errors::to_py)
 }
 
 /// Calls the driver's Python `evaluate(candidates) -> lines per candidate`.
@@ -217,9 +217,14 @@ impl Evaluator for PyEvaluator {
 /// returning each one's lines, as [`evaluate_search_candidates`] does); `jobs` failures
 /// are minimised at once. `command` goes in the failure maps' comments. Returns
 /// `summary.json`'s contents. The GIL is released while the search runs; `evaluate` is
-/// called with it held, from up to `jobs` threads.
+/// called with it held, from up to `jobs` threads (never the calling one).
+///
+/// Ctrl-C raises `KeyboardInterrupt` once the search stops ([`interruptible_then`]): at
+/// its next episode, or before its next call to `evaluate`; a call under way is asked to
+/// return early by setting `stop` (e.g. a `threading.Event` that `evaluate` checks),
+/// when given. The candidates finished stay in `candidates.jsonl` for `resume`.
 #[pyfunction]
-#[pyo3(signature = (spec, agents, evaluate, out, resume = false, from_file = false, jobs = 1, command = String::new()))]
+#[pyo3(signature = (spec, agents, evaluate, out, resume = false, from_file = false, jobs = 1, command = String::new(), stop = None))]
 #[allow(clippy::too_many_arguments)]
 fn drive_search(
     py: Python<'_>,
@@ -231,6 +236,7 @@ fn drive_search(
     from_file: bool,
     jobs: usize,
     command: String,
+    stop: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let built = Built::new(spec, agents, from_file)?;
     // One driver thread per failure minimised at once, waiting on its remote calls.
@@ -246,14 +252,24 @@ fn drive_search(
         raised: Mutex::new(None),
         out: out.clone(),
     };
-    let done = py.detach(|| search::run_with(&cfg, Path::new(&out), resume, &NoProgress, Some(&remote)));
-    match done {
-        Ok(summary) => serde_json::to_string(&summary).map_err(errors::to_py),
-        Err(e) => Err(remote
-            .raised
-            .into_inner()
-            .unwrap_or_else(|p| p.into_inner())
-            .unwrap_or_else(|| errors::to_py(e))),
+    let signalled = std::cell::Cell::new(false);
+    let on_signal = |py: Python<'_>| {
+        signalled.set(true);
+        match &stop {
+            Some(stop) => stop.call_method0(py, "set").map(drop),
+            None => Ok(()),
+        }
+    };
+    let done = interruptible_then(py, on_signal, |cancel| {
+        let summary = search::run_with(&cfg, Path::new(&out), resume, cancel, Some(&remote))?;
+        Ok(serde_json::to_string(&summary)?)
+    });
+    // The error `evaluate` raised as is (not the search's report of it), unless a signal
+    // came: then the signal's exception.
+    let raised = remote.raised.into_inner().unwrap_or_else(|p| p.into_inner());
+    match (done, raised) {
+        (Err(_), Some(first)) if !signalled.get() => Err(first),
+        (done, _) => done,
     }
 }
 

@@ -22,8 +22,8 @@ use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::{
-    BatchConfig, DEFAULT_METHODS, RunIdentity, Scenario, agent_file_identity, checked_sweep, load_scenarios, run_unit,
-    trained_agents_identity,
+    BatchConfig, DEFAULT_METHODS, RunIdentity, SCRIPTED_ONLY, Scenario, agent_file_identity, checked_sweep,
+    load_scenarios, run_unit, trained_agents_identity,
 };
 use unforeseen_harness::runs::outputs::Outputs;
 use unforeseen_harness::training::seed_agents::Agent;
@@ -125,6 +125,8 @@ fn plan_batch(
                 Some(bundle.to_ron_string()),
             )
         }
+        // Scripted methods only: no agent, as `unforeseen batch` runs them.
+        (None, None) if methods.iter().all(|m| m.is_scripted()) => (vec![None], SCRIPTED_ONLY.to_string(), None),
         (None, None) => {
             let axis = vec![Some(seed)];
             let id = trained_agents_identity(&train_map, &axis, train_episodes).map_err(errors::to_py)?;

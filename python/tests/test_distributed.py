@@ -17,8 +17,10 @@ import subprocess
 import sys
 import tempfile
 import time
+import types
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -435,3 +437,71 @@ def test_a_sweep_whose_worker_node_is_killed_equals_one_machine(cluster: Cluster
 def one_code(one: Path) -> int:
     """The exit code `batch` gives these results: 1 when an expectation fails on the mean."""
     return 1 if json.loads(one.with_suffix(".summary.json").read_text())["failed"] else 0
+
+
+class _Ref:
+    """A finished task's result (hashable, as Ray's object refs are)."""
+
+    def __init__(self, value: Any) -> None:
+        self.value = value
+
+
+class _InlineRay:
+    """Just enough of Ray to run the driver in this process: every task runs when it is
+    submitted; the names of the tasks run are kept."""
+
+    class exceptions:  # noqa: N801 - Ray's name
+        RayError = RuntimeError
+        RayTaskError = RuntimeError
+
+    def __init__(self) -> None:
+        self.ran: list[str] = []
+
+    def is_initialized(self) -> bool:
+        return True
+
+    def cluster_resources(self) -> dict[str, float]:
+        return {"CPU": 1}
+
+    def put(self, value: Any) -> _Ref:
+        return _Ref(value)
+
+    def remote(self, **_options: Any) -> Any:
+        def task(f: Any) -> Any:
+            def run(*args: Any, **kwargs: Any) -> _Ref:
+                self.ran.append(f.__name__)
+                return _Ref(f(*(a.value if isinstance(a, _Ref) else a for a in args), **kwargs))
+
+            return types.SimpleNamespace(remote=run)
+
+        return task
+
+    def wait(self, refs: list[_Ref], num_returns: int, timeout: float) -> tuple[list[_Ref], list[_Ref]]:
+        return refs[:num_returns], refs[num_returns:]
+
+    def get(self, ref: Any) -> Any:
+        return [r.value for r in ref] if isinstance(ref, list) else ref.value
+
+    def cancel(self, ref: _Ref, force: bool) -> None:
+        pass
+
+
+def test_a_batch_of_scripted_methods_trains_no_agent_and_equals_the_command_line(tmp_path: Path, monkeypatch):
+    """Issue 35, finding 12: scripted methods alone need no agent; the driver's plan
+    (its identity: no agent) and lines are the command line's."""
+    cli = cli_binary()
+    if cli is None:
+        pytest.skip("no unforeseen binary: cargo build (or set UNFORESEEN_CLI)")
+    ray = _InlineRay()
+    monkeypatch.setitem(sys.modules, "ray", ray)
+    from unforeseen.distributed import run_batch
+
+    args = dict(episodes=2, seed=5, methods=["never-brake", "brake-on-pedestrian"], protocol="zero-shot")
+    report = run_batch(["jaywalk"], out=tmp_path / "py.jsonl", quiet=True, **args)
+    assert "_train_task" not in ray.ran and "_units_task" in ray.ran
+    assert [line["train_seed"] for line in report["lines"]] == [None, None]
+    cli_out = tmp_path / "cli.jsonl"
+    subprocess.run([str(cli), "batch", "jaywalk", "--method", "never-brake", "--method", "brake-on-pedestrian",
+                    "--protocol", "zero-shot", "--episodes", "2", "--seed", "5", "-q", "--out", str(cli_out)],
+                   check=True, capture_output=True, timeout=120)
+    assert _lines_without_timing(tmp_path / "py.jsonl") == _lines_without_timing(cli_out)

@@ -2,7 +2,9 @@
 output guard of ``unforeseen batch --out`` (an input is never replaced, another
 program's file needs ``force``, lines are not appended to an earlier run's); arguments
 are bounded; conversions refuse recursive and over-deep values with ValueError instead
-of crashing the interpreter; endless iterables are refused."""
+of crashing the interpreter; endless iterables are refused; a float for a whole-number
+map field names the key; the long calls and the search stop on Ctrl-C within 2 s and
+leave no temporary file (issue 35)."""
 
 from __future__ import annotations
 
@@ -63,6 +65,9 @@ def test_evaluate_twice_into_one_file_is_refused(tmp_path):
 def test_summarize_a_missing_file_is_an_error(tmp_path):
     with pytest.raises(ValueError, match="no such file"):
         unforeseen.summarize(tmp_path / "nonexistent.jsonl")
+    # A folder is an input that is not a results file, not a problem writing results.
+    with pytest.raises(ValueError, match="not a results file"):
+        unforeseen.summarize(tmp_path)
 
 
 @pytest.mark.parametrize("episodes", [0, 10**7])
@@ -97,6 +102,41 @@ def test_recursive_and_deep_overrides_are_value_errors(value):
 def test_numpy_integers_are_override_values():
     env = unforeseen.make_env("jaywalk", max_steps=np.int64(60))
     assert env._env.max_steps == 60
+
+
+def test_an_endless_observation_is_refused_by_the_wrapper(agent):
+    wrapper = unforeseen.ScaledWrapper(agent=agent)
+    wrapper.begin_episode(1)
+    with pytest.raises(ValueError, match="factors"):
+        wrapper.act(None, {"observed": itertools.count()})
+
+
+def test_the_search_drivers_threads_are_capped(tmp_path):
+    # The distributed search passes jobs=max_failures; 20000 threads did not finish in 60 s.
+    import time
+
+    from unforeseen import _unforeseen
+
+    spec = json.dumps({"map": "jaywalk", "space": str(MAPS / "spaces" / "jaywalk.ron"), "method": "never-brake",
+                       "protocol": "zero-shot", "budget": 2, "episodes": 1, "seed": 3, "sobol_share": 0.5,
+                       "rounds": 1, "max_failures": 1, "train_seeds": None, "train_episodes": 1})
+
+    def evaluate(candidates):
+        return _unforeseen.evaluate_search_candidates(spec, [], candidates)
+
+    start = time.monotonic()
+    summary = json.loads(_unforeseen.drive_search(spec, [], evaluate, tmp_path / "out", jobs=20_000))
+    assert time.monotonic() - start < 30
+    assert summary["counts"]["sobol"] == 1
+
+
+def test_a_float_for_a_whole_number_override_names_the_key():
+    # It used to fail in the RON parser: "episode.?: Expected comma".
+    with pytest.raises(ValueError, match=r"max_steps: 1\.5 is not an integer.*give an int"):
+        unforeseen.make_env("jaywalk", max_steps=1.5)
+    with pytest.raises(ValueError, match="episode__max_steps: 60.0 is not an integer"):
+        gym.make("unforeseen/Jaywalk-v0", episode__max_steps=60.0)
+    assert unforeseen.make_env("jaywalk", max_steps=60)._env.max_steps == 60
 
 
 def test_an_endless_observation_is_refused(agent):
@@ -138,5 +178,91 @@ def test_long_calls_stop_on_ctrl_c(which, tmp_path):
                           timeout=120)
     assert "interrupted after" in done.stdout, done.stdout + done.stderr
     seconds = float(done.stdout.split("after ")[1].split(" s")[0])
-    assert seconds < 6.0, f"{which} took {seconds} s to stop after SIGINT (sent at 1 s)"
+    # The issue's bound: control returns within 2 s of SIGINT (sent at 1 s).
+    assert seconds < 3.0, f"{which} took {seconds - 1:.2f} s to stop after SIGINT (sent at 1 s)"
     assert not list(tmp_path.glob("unforeseen-python-batch-*")), "a temporary file was left"
+
+
+SEARCH_INTERRUPTED = """
+import json, os, signal, sys, threading, time, types
+import unforeseen
+from unforeseen import _unforeseen
+which, out, space = sys.argv[1], sys.argv[2], sys.argv[3]
+spec = json.dumps({"map": "jaywalk", "space": space, "method": "never-brake", "protocol": "zero-shot",
+                   "budget": 4, "episodes": 1_000_000, "seed": 3, "sobol_share": 0.5, "rounds": 1,
+                   "max_failures": 1, "train_seeds": None, "train_episodes": 1})
+
+class Ray(types.ModuleType):
+    # A cluster whose tasks never finish: run_search's own waiting is what Ctrl-C must stop.
+    class exceptions:
+        RayError = RuntimeError
+        RayTaskError = RuntimeError
+    def __init__(self):
+        super().__init__("ray")
+        self.cancelled = 0
+    def is_initialized(self):
+        return True
+    def cluster_resources(self):
+        return {"CPU": 2}
+    def get(self, refs):
+        return []
+    def remote(self, **options):
+        return lambda f: types.SimpleNamespace(remote=lambda *a, **k: object())
+    def wait(self, refs, num_returns, timeout):
+        time.sleep(timeout)
+        return [], refs
+    def cancel(self, ref, force):
+        self.cancelled += 1
+
+ray = Ray()
+if which == "run_search":
+    sys.modules["ray"] = ray
+    from unforeseen.distributed import run_search
+    call = lambda: run_search(space=space, method="never-brake", budget=4, episodes=1_000_000, seed=3, rounds=1,
+                              max_failures=1, out=out)
+else:
+    # The Sobol stage's candidates, as the driver hands them to its evaluator.
+    class Got(Exception):
+        pass
+    got = []
+    def capture(candidates):
+        got.extend(candidates)
+        raise Got
+    try:
+        _unforeseen.drive_search(spec, [], capture, os.path.join(out, "first"))
+    except Got:
+        pass
+    call = lambda: _unforeseen.evaluate_search_candidates(spec, [], got, threads=2)
+threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+start = time.monotonic()
+try:
+    call()
+    print("finished")
+except KeyboardInterrupt:
+    print(f"interrupted after {time.monotonic() - start:.2f} s; {ray.cancelled} task(s) cancelled")
+"""
+
+
+@pytest.mark.parametrize("which", ["run_search", "evaluate_search_candidates"])
+def test_search_stops_on_ctrl_c(which, tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", SEARCH_INTERRUPTED, which, str(out), str(MAPS / "spaces" / "jaywalk.ron")],
+                          capture_output=True, text=True, env=env, timeout=120)
+    assert "interrupted after" in done.stdout, done.stdout + done.stderr
+    seconds = float(done.stdout.split("after ")[1].split(" s")[0])
+    # The issue's bound: control returns within 2 s of SIGINT (sent at 1 s).
+    assert seconds < 3.0, f"{which} took {seconds - 1:.2f} s to stop after SIGINT (sent at 1 s)"
+    if which == "run_search":
+        # The waiting driver cancelled its pending tasks; the search wrote only its
+        # candidates file (the identity line, for resume=True), its lock and the
+        # (empty) folder of failure maps.
+        assert "0 task(s) cancelled" not in done.stdout, done.stdout
+        assert sorted(p.name for p in out.iterdir()) == [".lock", "candidates.jsonl", "failures"]
+        assert list((out / "failures").iterdir()) == []
+    temporary = [p for p in tmp_path.rglob("*") if p.name.startswith(".tmp") or p.name.startswith("unforeseen-")]
+    assert temporary == [], "a temporary file was left"

@@ -249,7 +249,8 @@ def evaluate_search_candidates(
     from_file: bool = False,
     threads: int = 1,
 ) -> list[list[str]]:
-    """The candidate lines (JSON text) of a block of candidates, with the GIL released."""
+    """The candidate lines (JSON text) of a block of candidates, with the GIL released; Ctrl-C raises
+    KeyboardInterrupt at the next episode."""
 def drive_search(
     spec: str,
     agents: Sequence[tuple[int | None, bytes]],
@@ -259,5 +260,7 @@ def drive_search(
     from_file: bool = False,
     jobs: int = 1,
     command: str = "",
+    stop: Any | None = None,
 ) -> str:
-    """Runs a search's stages in Rust with ``evaluate`` for its candidates; the summary (JSON text)."""
+    """Runs a search's stages in Rust with ``evaluate`` for its candidates; the summary (JSON text).
+    Ctrl-C raises KeyboardInterrupt, calling ``stop.set()`` so an ``evaluate`` under way can return early."""

@@ -52,7 +52,10 @@ each minimisation try hand their candidates to an evaluator, which here splits t
 blocks and runs them as Ray tasks through :func:`_drive` (the same retry and input-error
 rules as :func:`run_batch`; each training seed trained once and shared). The outputs are
 those of ``unforeseen search`` with the same arguments, timing aside. The search driver
-shows no progress bar and takes no output lock.
+shows no progress bar; it passes the output guard and takes the lock of ``unforeseen search``
+(``OUT/.lock``). Ctrl-C stops it within a fraction of a second (the binding sets an
+event the evaluator checks between waits; pending tasks are cancelled) and raises
+``KeyboardInterrupt``; the finished candidates stay for ``resume=True``.
 """
 
 from __future__ import annotations
@@ -63,6 +66,7 @@ import json
 import math
 import os
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
@@ -78,6 +82,10 @@ DEFAULT_MAX_RETRIES = 3
 #: Seconds between progress redraws; and the longest wait for any task before the
 #: driver checks again (it waits on task completion, never sleeps).
 _TICK = 1.0
+
+#: The longest wait for any task when a stop event is given (Ctrl-C in the search
+#: driver): it is checked between waits.
+_STOP_TICK = 0.2
 
 
 def _ray() -> Any:
@@ -167,14 +175,19 @@ def _drive(
     blocks: list[list[int]],
     submit: Callable[[list[int]], Any],
     sink: Callable[[list[int], list[str]], None],
+    stop: threading.Event | None = None,
 ) -> None:
     """Submits every block as a task and hands each finished block's lines to `sink`, in
     the order they finish. An input error of any task cancels the rest and raises it as
-    `ValueError`; a task lost after its retries raises `RuntimeError`."""
+    `ValueError`; a task lost after its retries raises `RuntimeError`; `stop` set (Ctrl-C
+    in the search driver, which waits on this from another thread) cancels the rest and
+    raises `KeyboardInterrupt` within ``_STOP_TICK`` seconds."""
     pending = {submit(b): b for b in blocks}
     try:
         while pending:
-            ready, _ = ray.wait(list(pending), num_returns=1, timeout=_TICK)
+            if stop is not None and stop.is_set():
+                raise KeyboardInterrupt
+            ready, _ = ray.wait(list(pending), num_returns=1, timeout=_TICK if stop is None else _STOP_TICK)
             for ref in ready:
                 block = pending.pop(ref)
                 try:
@@ -286,7 +299,8 @@ def run_batch(
         run = ray.remote(num_cpus=jobs, **options)(_units_task)
 
         def submit(block: list[int]) -> Any:
-            seeds = sorted({seed_of[u] for u in block}, key=lambda s: (s is None, s or 0))
+            # The block's agents (a scripted method's units need none: none is trained for them).
+            seeds = sorted({seed_of[u] for u in block} & agent_refs.keys(), key=lambda s: (s is None, s or 0))
             return run.remote(plan["spec"], seeds, *(agent_refs[s] for s in seeds), units=block, threads=jobs)
 
         progress = _Progress(plan["total"], plan["kept"], quiet)
@@ -381,6 +395,10 @@ def run_search(
     task = ray.remote(num_cpus=jobs, **options)(_search_task)
     cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // jobs)
 
+    # Set by the binding on Ctrl-C: `evaluate` runs on the driver's other threads, which
+    # never see the signal themselves.
+    stop = threading.Event()
+
     def evaluate(candidates: list[str]) -> list[list[str]]:
         per = candidates_per_task or max(1, math.ceil(len(candidates) / (4 * cpus)))
         blocks = [list(range(i, min(i + per, len(candidates)))) for i in range(0, len(candidates), per)]
@@ -395,7 +413,7 @@ def run_search(
             for i, g in zip(block, got, strict=True):
                 lines[i] = g
 
-        _drive(ray, blocks, submit, sink)
+        _drive(ray, blocks, submit, sink, stop)
         return [g for g in lines if g is not None]
 
     summary = _unforeseen.drive_search(
@@ -407,6 +425,7 @@ def run_search(
         from_file=from_file,
         jobs=max(1, max_failures),
         command=command if command is not None else f"unforeseen.distributed.run_search(space={str(space)!r}, ...)",
+        stop=stop,
     )
     return json.loads(summary)
 

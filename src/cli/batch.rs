@@ -14,9 +14,9 @@ use unforeseen_harness::episodes::survivability::{Witness, warnings};
 use unforeseen_harness::maps;
 use unforeseen_harness::reports::files::write_json;
 use unforeseen_harness::runs::batch::{
-    BatchConfig, DEFAULT_METHODS, ResultLine, Scenario, ScenarioKind, Shard, SummaryRow, agent_file_identity,
-    checked_sweep, load_scenarios, load_stream_scenario, run_plan, stream_learning, summarize, summary_path,
-    trained_agents_identity,
+    BatchConfig, DEFAULT_METHODS, ResultLine, SCRIPTED_ONLY, Scenario, ScenarioKind, Shard, SummaryRow,
+    agent_file_identity, checked_sweep, load_scenarios, load_stream_scenario, run_plan, stream_learning, summarize,
+    summary_path, trained_agents_identity,
 };
 use unforeseen_harness::runs::merge::summary_document;
 use unforeseen_harness::runs::outputs::Outputs;
@@ -124,8 +124,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs.max(1)).build()?;
     // Without --train-seeds, the one agent (loaded, or trained now) and what determines
     // it; with them, what determines the agents, trained once the plan says which the
-    // units still to run need.
+    // units still to run need. Scripted methods only, with neither: no agent at all.
+    let scripted_only = methods.iter().all(|m| m.is_scripted());
     let (single, axis, agents_identity) = match &args.seeds.train_seeds {
+        None if scripted_only && args.agent.is_none() => (None, vec![None], SCRIPTED_ONLY.to_string()),
         None => {
             let bundle = pool.install(|| {
                 super::load_or_train(
@@ -166,15 +168,13 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         agents_identity,
     };
     let plan = planning.plan(&args.out, args.resume)?;
+    let to_train = plan.train_seeds_to_run();
     let agents = match single {
         Some(agent) => vec![agent],
+        None if to_train.is_empty() => Vec::new(),
         None => pool.install(|| {
-            args.seeds.train(
-                &plan.train_seeds_to_run(),
-                &args.train_map,
-                args.train_episodes,
-                args.quiet,
-            )
+            args.seeds
+                .train(&to_train, &args.train_map, args.train_episodes, args.quiet)
         })?,
     };
     let states = agents.iter().map(|a| a.bundle.bayes_rl.n_states()).max().unwrap_or(0);
@@ -189,14 +189,18 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         }
         _ => format!("{} scenario(s)", scenarios.len()),
     };
+    let seeds = if scripted_only && cfg.agents.is_empty() {
+        "no agent (scripted methods only)".to_string()
+    } else {
+        format!("{} agent(s)", axis.len())
+    };
     progress::phase(
         args.quiet,
         format_args!(
-            "running {what} x {} method(s) x {} parameter set(s) x {} protocol(s) x {} agent(s) on {} thread(s), {} episodes each, into {}",
+            "running {what} x {} method(s) x {} parameter set(s) x {} protocol(s) x {seeds} on {} thread(s), {} episodes each, into {}",
             methods.len(),
             params.len(),
             protocols.len(),
-            axis.len(),
             cfg.jobs,
             args.episodes,
             args.out.display()

@@ -406,3 +406,65 @@ fn results_must_go_to_a_regular_file() {
     }
     assert!(dir.path().is_dir());
 }
+
+/// Issue 35, finding 12: `batch jaywalk --method never-brake` without an agent trained
+/// one (6000 episodes) that nothing used. A run of scripted methods only trains and
+/// loads none, with or without `--train-seeds`; its lines name no training episodes.
+#[test]
+fn scripted_methods_alone_train_no_agent() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let run = |out: &str, extra: &[&str]| {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "batch",
+            "maps/jaywalk.ron",
+            "--method",
+            "never-brake",
+            "--method",
+            "brake-on-pedestrian",
+            "--episodes",
+            "2",
+            "--train-episodes",
+            "50",
+            "--jobs",
+            "1",
+            "--cache",
+            cache.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let done = common::run_cli(&args);
+        let text = common::output_text(&done);
+        assert_eq!(done.status.code(), Some(0), "{text}");
+        assert!(
+            !text.contains("for 50 episodes") && !text.contains("training 50 episodes"),
+            "nothing is trained: {text}"
+        );
+        assert!(text.contains("no agent (scripted methods only)"), "{text}");
+        read_lines(&out).unwrap()
+    };
+    let lines = run("r.jsonl", &[]);
+    assert_eq!(lines.len(), 2);
+    assert!(
+        lines
+            .iter()
+            .all(|l| l.train_seed.is_none() && l.train_episodes.is_none())
+    );
+    let head = std::fs::read_to_string(dir.path().join("r.jsonl")).unwrap();
+    assert!(head.lines().next().unwrap().contains("none (scripted methods only)"));
+    // With training seeds, one line per seed, still no agent trained or cached.
+    let seeded = run("s.jsonl", &["--train-seeds", "1..2"]);
+    assert_eq!(seeded.len(), 4);
+    assert!(seeded.iter().all(|l| l.train_episodes.is_none()));
+    assert!(!cache.exists() || std::fs::read_dir(&cache).unwrap().next().is_none());
+    // The figures are those of the runs with an agent: scripted methods do not use one.
+    for l in &seeded {
+        let alone = lines.iter().find(|a| a.method == l.method).unwrap();
+        assert_eq!(
+            (l.success_rate, l.mean_reward, l.mean_ticks),
+            (alone.success_rate, alone.mean_reward, alone.mean_ticks)
+        );
+    }
+}

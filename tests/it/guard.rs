@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use super::common::{assert_exit, run_cli};
+use super::common::{assert_exit, output_text as common_text, run_cli};
 
 const SPACE: &str = "maps/spaces/jaywalk.ron";
 
@@ -62,6 +62,13 @@ fn search_never_replaces_an_input_inside_its_out() {
     std::fs::copy("maps/jaywalk.ron", &map).unwrap();
     assert_exit(&search(&out, &["--map", map.to_str().unwrap()]), 2, &["--map"]);
     assert_eq!(read(&map), read(Path::new("maps/jaywalk.ron")));
+    // An agent file at the summary's name.
+    let agent = out.join("summary.json");
+    unforeseen_harness::training::agent_file::save(&agent, super::common::bundle()).unwrap();
+    let before = read(&agent);
+    let r = search(&out, &["--agent", agent.to_str().unwrap()]);
+    assert_exit(&r, 2, &["--agent"]);
+    assert_eq!(read(&agent), before);
 }
 
 #[test]
@@ -137,12 +144,14 @@ fn search_resume_checks_every_kept_line() {
     assert_exit(&search(&out, &["--resume"]), 0, &[]);
     let line = text.lines().nth(1).expect("a candidate line");
     let value: serde_json::Value = serde_json::from_str(line).unwrap();
-    let edits: [(&str, serde_json::Value); 6] = [
+    let edits: [(&str, serde_json::Value); 8] = [
         ("success_rate", (-3.0).into()),
         ("mean_reward", 1e300.into()),
         ("unit", 99.into()),
         ("scenario", "other".into()),
         ("method", "scaled".into()),
+        ("protocol", "continual".into()),
+        ("train_seed", 3.into()),
         ("surprise", 1.into()),
     ];
     for (field, v) in edits {
@@ -228,6 +237,26 @@ fn a_streams_maps_are_inputs() {
     ]);
     assert_exit(&r, 2, &["--stream"]);
     assert_eq!(read(&out.join("eval.json")), read(Path::new("maps/crowd.ron")));
+    // learn --stream with a map at OUT/learn.csv (learn needs a real agent).
+    let agent = d.path().join("agent.ron");
+    unforeseen_harness::training::agent_file::save(&agent, super::common::bundle()).unwrap();
+    let out = d.path().join("le");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::copy("maps/crowd.ron", out.join("learn.csv")).unwrap();
+    let stream4 = stream_with(d.path(), "le/learn.csv");
+    let r = run_cli(&[
+        "learn",
+        "--stream",
+        stream4.to_str().unwrap(),
+        "--agent",
+        agent.to_str().unwrap(),
+        "--episodes",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_exit(&r, 2, &["--stream"]);
+    assert_eq!(read(&out.join("learn.csv")), read(Path::new("maps/crowd.ron")));
     assert_eq!(read(&map), before);
 }
 
@@ -303,9 +332,57 @@ fn merge_names_a_part_given_twice_or_not_a_file() {
         2,
         &["not a regular file", "shard files"],
     );
+    // A pipe is not read (it would block) and is named as the input it is.
+    let fifo = d.path().join("pipe.jsonl");
+    if std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        let r = run_cli(&["merge", p, fifo.to_str().unwrap(), "--out", o]);
+        assert_exit(&r, 2, &["pipe.jsonl", "not a regular file"]);
+        assert!(!common_text(&r).contains("write results"), "{}", common_text(&r));
+    }
     assert_exit(
         &run_cli(&["batch", "jaywalk", "--shard", " 1/2", "--out", o]),
         2,
         &["--shard"],
     );
+}
+
+/// Finding 12: a newline in `--out` (it is in the command written in each failure map's
+/// `// Found by:` comment) ended the comment and broke the map's RON.
+#[test]
+fn a_newline_in_out_leaves_the_failure_maps_valid() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("a\nb");
+    let r = run_cli(&[
+        "search",
+        "--space",
+        SPACE,
+        "--method",
+        "never-brake",
+        "--budget",
+        "6",
+        "--episodes",
+        "2",
+        "--seed",
+        "9",
+        "--max-failures",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_exit(&r, 0, &[]);
+    let maps: Vec<_> = std::fs::read_dir(out.join("failures"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert!(!maps.is_empty(), "never-brake fails on every fair candidate");
+    for m in maps {
+        let text = std::fs::read_to_string(&m).unwrap();
+        let found = text.lines().find(|l| l.starts_with("// Found by:")).unwrap();
+        assert!(found.contains("a\\nb"), "{found}");
+        unforeseen_harness::maps::load_file(&m).unwrap_or_else(|e| panic!("{}: {e}\n{text}", m.display()));
+    }
 }

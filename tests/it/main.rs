@@ -26,5 +26,6 @@ mod robustness;
 mod safety;
 mod search;
 mod stream;
+mod stream_memory;
 mod svg_text;
 mod train_seeds;

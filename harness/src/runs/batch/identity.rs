@@ -31,6 +31,11 @@ pub fn trained_agents_identity(train_map: &Map, seeds: &[Option<u64>], episodes:
     ))
 }
 
+/// The agents of a run of scripted methods only given neither an agent file nor
+/// training seeds, for its identity: none is trained or loaded (the units' training
+/// seed is none).
+pub const SCRIPTED_ONLY: &str = "none (scripted methods only)";
+
 /// What determines an agent read from a file, for a run's identity: its contents.
 pub fn agent_file_identity(bundle: &AgentBundle) -> String {
     format!(

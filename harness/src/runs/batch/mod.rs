@@ -41,7 +41,7 @@ pub mod sweep;
 pub mod units;
 
 pub use expectations::{Check, check_expectations};
-pub use identity::{RunIdentity, agent_file_identity, trained_agents_identity};
+pub use identity::{RunIdentity, SCRIPTED_ONLY, agent_file_identity, trained_agents_identity};
 pub use plan::{BatchConfig, Plan};
 pub use result_line::{MapFigures, ResultLine, UnitKey};
 pub use results_file::{KeptLine, MAX_FIGURE, ResultsFile, read_lines, read_results, resume_lines};

@@ -116,8 +116,9 @@ impl Plan {
             .collect()
     }
 
-    /// The training seeds of the units still to run, in the order of the run's training
-    /// seeds: the agents the run needs.
+    /// The training seeds of the units still to run that run an agent (not a scripted
+    /// method's), in the order of the run's training seeds: the agents the run needs. A
+    /// run of scripted methods only needs none.
     pub fn train_seeds_to_run(&self) -> Vec<u64> {
         let todo = self.todo();
         self.identity
@@ -125,7 +126,7 @@ impl Plan {
             .iter()
             .flatten()
             .copied()
-            .filter(|&s| todo.iter().any(|u| u.train_seed == Some(s)))
+            .filter(|&s| todo.iter().any(|u| u.train_seed == Some(s) && !u.method.is_scripted()))
             .collect()
     }
 }

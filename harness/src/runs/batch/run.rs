@@ -7,7 +7,7 @@ use std::path::Path;
 use std::sync::Mutex;
 use unforeseen_sim::Action;
 
-use crate::episodes::experiments::evaluate_under;
+use crate::episodes::experiments::{evaluate_scripted, evaluate_under};
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::runner::EpisodeResult;
 use crate::error::Error;
@@ -31,15 +31,17 @@ pub fn run_unit(cfg: &BatchConfig<'_>, unit: &Unit) -> Result<ResultLine, Error>
 }
 
 /// [`run_unit`], stopping between episodes ([`Error::Interrupted`]) when `cancel` asks.
+/// A scripted method's unit runs without an agent when the run has none for its
+/// training seed (a run of scripted methods only trains none: [`Plan::train_seeds_to_run`](super::Plan::train_seeds_to_run)).
 pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) -> Result<ResultLine, Error> {
     let scenario = &cfg.scenarios[unit.scenario];
-    let agent = cfg
-        .agents
-        .iter()
-        .find(|a| a.train_seed == unit.train_seed)
-        .ok_or(Error::MissingAgent {
+    let agent = cfg.agents.iter().find(|a| a.train_seed == unit.train_seed);
+    if agent.is_none() && !unit.method.is_scripted() {
+        return Err(Error::MissingAgent {
             train_seed: unit.train_seed,
-        })?;
+        });
+    }
+    let bundle = agent.map(|a| &a.bundle);
     let params = unit.params.scaled_params()?;
     let actions = Action::ALL.len();
     let tree: usize = (1..=params.planning.horizon).map(|k| actions.pow(k as u32)).sum();
@@ -53,22 +55,25 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
     };
     let (agg, per_map_figures) = match &scenario.kind {
         ScenarioKind::Map(map) => {
-            let results = evaluate_under(
-                unit.protocol,
-                map,
-                &agent.bundle,
-                &params,
-                unit.method,
-                cfg.episodes,
-                cfg.seed,
-                &CancelOnly(cancel),
-            )?;
+            let results = match bundle {
+                Some(bundle) => evaluate_under(
+                    unit.protocol,
+                    map,
+                    bundle,
+                    &params,
+                    unit.method,
+                    cfg.episodes,
+                    cfg.seed,
+                    &CancelOnly(cancel),
+                )?,
+                None => evaluate_scripted(map, unit.method, cfg.episodes, cfg.seed, &CancelOnly(cancel))?,
+            };
             (Aggregate::of(&results), Vec::new())
         }
         ScenarioKind::Stream(stream) => {
             let episodes = evaluate_stream(
                 stream,
-                Some(&agent.bundle),
+                bundle,
                 &params,
                 unit.method,
                 unit.protocol,
@@ -115,7 +120,7 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
         protocol: unit.protocol,
         covers: unit.covers.clone(),
         train_seed: unit.train_seed,
-        train_episodes: agent.train_episodes,
+        train_episodes: agent.and_then(|a| a.train_episodes),
         seed: cfg.seed,
         episodes: cfg.episodes,
         mean_reward: agg.mean_reward,

@@ -60,7 +60,7 @@ use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::{Protocol, covered};
 use crate::error::Error;
-use crate::progress::{NoProgress, Progress};
+use crate::progress::{CancelOnly, NoProgress, Progress};
 use crate::runs::batch::{ResultLine, Shard};
 use crate::training::seed_agents::Agent;
 
@@ -435,13 +435,23 @@ impl CandidateWire {
 /// The lines of a candidate sent as a [`CandidateWire`]: what [`evaluate`] writes for
 /// it, as JSON text (one line each, with its `\n`); an error when its map is not valid.
 pub fn evaluate_wire(cfg: &SearchConfig<'_>, wire: &CandidateWire) -> Result<Vec<String>, Error> {
+    evaluate_wire_with(cfg, wire, &NoProgress)
+}
+
+/// [`evaluate_wire`], stopping between episodes ([`Error::Interrupted`]) when `cancel`
+/// asks (the Python binding: a pending Ctrl-C).
+pub fn evaluate_wire_with(
+    cfg: &SearchConfig<'_>,
+    wire: &CandidateWire,
+    cancel: &dyn Progress,
+) -> Result<Vec<String>, Error> {
     let c = Candidate::new(cfg.space, wire.index, wire.stage, Vec::new(), Some(wire.values.clone()));
     let map = c.map.as_ref().map_err(|r| Error::Results {
         path: cfg.space.source.clone().into(),
         problem: format!("candidate {}: not a valid map ({r:?})", wire.index),
     })?;
     let named = c.named_values(cfg.space);
-    evaluate(cfg, &c, map, named)?
+    evaluate(cfg, &c, map, named, cancel)?
         .iter()
         .map(|l| {
             let mut raw = serde_json::to_string(l)?;
@@ -546,7 +556,7 @@ impl Runner<'_, '_> {
             }
             return self.write(candidate, raws, advance);
         }
-        let lines = evaluate(self.cfg, &candidate, map, named)?;
+        let lines = evaluate(self.cfg, &candidate, map, named, self.progress)?;
         let raws: Vec<RawLine> = lines
             .iter()
             .map(|l| {
@@ -580,6 +590,9 @@ impl Runner<'_, '_> {
         let Some(remote) = self.remote else { return Ok(()) };
         if candidates.is_empty() {
             return Ok(());
+        }
+        if self.progress.cancelled() {
+            return Err(Error::Interrupted);
         }
         let wires: Vec<CandidateWire> = candidates.iter().map(CandidateWire::of).collect();
         let got = remote.evaluate(&wires)?;
@@ -634,12 +647,16 @@ type Run<'a> = (Role, Method, Option<&'a Agent>, Option<u64>, Aggregate);
 
 /// Evaluates a candidate's map: the two witnesses, then the method for each training
 /// seed, `episodes` episodes each; its lines carry the fairness and failure verdicts.
+/// Stops between episodes ([`Error::Interrupted`]) when `cancel` asks; its phase is not
+/// advanced.
 pub fn evaluate(
     cfg: &SearchConfig<'_>,
     candidate: &Candidate,
     map: &Map,
     values: Vec<(String, Value)>,
+    cancel: &dyn Progress,
 ) -> Result<Vec<CandidateLine>, Error> {
+    let cancel = CancelOnly(cancel);
     let params = ScaledParams::default();
     let scripted = |m: Method| -> Result<Aggregate, Error> {
         Ok(Aggregate::of(&evaluate_scripted(
@@ -647,7 +664,7 @@ pub fn evaluate(
             m,
             cfg.episodes,
             cfg.seed,
-            &NoProgress,
+            &cancel,
         )?))
     };
     let brake = scripted(Method::BrakeOnPedestrian)?;
@@ -674,7 +691,7 @@ pub fn evaluate(
                 cfg.method,
                 cfg.episodes,
                 cfg.seed,
-                &NoProgress,
+                &cancel,
             )?;
             (Some(agent), Aggregate::of(&results))
         };
