@@ -102,6 +102,8 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     /// Whether each tick's trigger fired only because of test-time learning and the habit
     /// acted, the check finding it safe.
     hist_declined: Vec<bool>,
+    /// The competence check's scratch: one action per state, the held action's policy.
+    held_policy: Vec<usize>,
     final_obs: Option<usize>,
     /// One-hot index of the last posterior, if it was one-hot.
     prev_one_hot: Option<usize>,
@@ -243,6 +245,7 @@ impl<H: Habit> ScaledAgent<H> {
             hist_refused: Vec::with_capacity(256),
             hist_checked: Vec::with_capacity(256),
             hist_declined: Vec::with_capacity(256),
+            held_policy: vec![0; n],
             final_obs: None,
             prev_one_hot: None,
             last: ReasoningTrace::default(),
@@ -335,12 +338,11 @@ impl<H: Habit> ScaledAgent<H> {
         // horizon (crash_risk, as the hand-back checks), the habit keeps the tick.
         let held = self.competence.held();
         let best = (0..self.n_actions).fold(habit, |b, u| if held[u] < held[b] { u } else { b });
-        let mut hold = vec![0; self.n_states];
         let risk_horizon = self.params.gate.handback_horizon;
         let mut risk = |u: usize| {
-            hold.fill(u);
+            self.held_policy.fill(u);
             self.handback
-                .crash_risk(root, plan, &self.q_cur, u, &hold, risk_horizon)
+                .crash_risk(root, plan, &self.q_cur, u, &self.held_policy, risk_horizon)
         };
         let safer = risk(best) - risk(habit) <= self.params.gate.handback_risk;
         safer.then(|| th.max(theta(regret, self.params.gate.omega)))
