@@ -11,6 +11,7 @@ use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::maps;
 use unforeseen_harness::progress::Progress;
 use unforeseen_harness::reports::files::write_json;
+use unforeseen_harness::reports::tables;
 
 /// Arguments of `eval`.
 #[derive(Debug, Clone, Args)]
@@ -78,21 +79,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         &bars,
     )?;
     bars.finish();
-    let agg = &report.aggregate;
-    outln!(
-        "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, red lights {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
-        args.method,
-        map.name,
-        protocol_note(args.method, args.protocol, &params),
-        agg.mean_reward,
-        100.0 * agg.success_rate,
-        100.0 * agg.collision_rate,
-        100.0 * agg.red_light_rate,
-        100.0 * agg.timeout_rate,
-        100.0 * agg.inference_rate,
-        agg.us_per_tick,
-        agg.episodes
-    );
+    outln!("{}", tables::eval(&report));
     let dir = &args.out;
     warn_replacing(dir, &["eval.json"]);
     progress::phase(
@@ -102,15 +89,6 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     write_json(&dir.join("eval.json"), &report.document()?)?;
     outln!("wrote {}/eval.json", dir.display());
     Ok(())
-}
-
-/// The protocol in words, noting when the method does not learn across episodes.
-fn protocol_note(method: Method, protocol: Protocol, params: &unforeseen_agent::params::ScaledParams) -> String {
-    if method.learns_across_episodes(params) {
-        protocol.to_string()
-    } else {
-        format!("{protocol}; {method} does not learn across episodes, so both protocols give these results")
-    }
 }
 
 /// `eval --stream FILE`: the episodes over the stream's maps, one row per map.
@@ -154,7 +132,7 @@ fn run_stream(args: &EvalArgs, file: &std::path::Path) -> anyhow::Result<()> {
         "{} on stream '{}' ({}), per map:",
         args.method,
         stream.name,
-        protocol_note(args.method, args.protocol, &params)
+        tables::protocol_note(args.method, args.protocol, args.method.learns_across_episodes(&params))
     );
     for r in &rows {
         let a = &r.aggregate;
