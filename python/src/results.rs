@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::runs::batch::{BatchConfig, Scenario};
+use unforeseen_harness::runs::batch::{BatchConfig, ResultLine, Scenario};
 use unforeseen_harness::runs::compare::{CompareReport, StudySetup};
 use unforeseen_harness::runs::outputs::{Guarded, Outputs};
 use unforeseen_harness::training::seed_agents::Agent;
@@ -173,6 +173,16 @@ fn batch_report(
     BatchResult::new(&lines?)
 }
 
+/// The report of result lines a Python policy's evaluation wrote (`unforeseen.evaluate`),
+/// given as the JSON text of their list: summarized and printed as `unforeseen batch`
+/// summarizes and prints its own lines ([`BatchResult`]).
+#[pyfunction]
+fn batch_result(lines: &str) -> PyResult<BatchResult> {
+    let lines: Vec<ResultLine> =
+        serde_json::from_str(lines).map_err(|e| errors::value(format!("result lines: {e}")))?;
+    BatchResult::new(&lines)
+}
+
 /// The output guard of a results file `out` written from Python (`evaluate`): refuses,
 /// with a `ValueError`, an `out` that is one of `inputs` (map files) or holds something
 /// other than batch results (unless `force`), and holds the lock on it until
@@ -205,5 +215,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ResultsGuard>()?;
     m.add_function(wrap_pyfunction!(compare_report, m)?)?;
     m.add_function(wrap_pyfunction!(batch_report, m)?)?;
+    m.add_function(wrap_pyfunction!(batch_result, m)?)?;
     Ok(())
 }

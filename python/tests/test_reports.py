@@ -117,3 +117,17 @@ def test_to_pandas_gives_the_records_or_names_the_extra(agent, monkeypatch):
     monkeypatch.setitem(sys.modules, "pandas", None)
     with pytest.raises(ImportError, match=r"unforeseen\[pandas\]"):
         result.to_pandas()
+
+
+def test_a_python_policys_lines_print_as_the_batch_of_the_same_agent(agent, tmp_path):
+    # The scaled agent around its own Q-table habit, evaluated from Python, gives the
+    # built-in scaled agent's lines (test_wrapper.py), so the same summary table.
+    out = tmp_path / "results.jsonl"
+    lines = unforeseen.evaluate(unforeseen.ScaledWrapper(agent=agent, method="scaled"), ["jaywalk"], [7],
+                                episodes=4, seed=7, out=out)
+    assert isinstance(lines, unforeseen.EvaluateResult) and isinstance(lines, list) and len(lines) == 2
+    built_in = unforeseen.batch("jaywalk", agents=agent, episodes=4, seed=7, methods=["scaled"])
+    assert str(lines) == str(built_in)
+    assert lines.report.summary == unforeseen.summarize(out)
+    assert "| jaywalk | scaled | default | zero-shot | 1 |" in lines._repr_markdown_()
+    assert lines._repr_html_().count("<table>") == 1

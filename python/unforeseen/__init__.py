@@ -32,7 +32,7 @@ from ._unforeseen import (
     train_agents,
 )
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
-from .evaluate import evaluate, summarize
+from .evaluate import EvaluateResult, evaluate, summarize
 from .vector import VectorEnv
 from .wrapper import ScaledWrapper, q_table_habit
 
@@ -46,6 +46,7 @@ __all__ = [
     "CompareResult",
     "Controller",
     "EvalResult",
+    "EvaluateResult",
     "ScaledWrapper",
     "UnforeseenEnv",
     "VectorEnv",

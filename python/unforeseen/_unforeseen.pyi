@@ -22,6 +22,7 @@ __all__ = [
     "ScaledHabitAgent",
     "VectorEnv",
     "batch_report",
+    "batch_result",
     "compare_report",
     "embedded_maps",
     "eval_seeds",
@@ -207,6 +208,9 @@ def batch_report(
     jobs: int = 2,
 ) -> BatchResult:
     """``unforeseen batch``: its report (result lines and summary)."""
+def batch_result(lines: str) -> BatchResult:
+    """The report of result lines (the JSON text of their list) that ``evaluate`` wrote,
+    summarized and printed as ``unforeseen batch`` does its own."""
 
 @final
 class CompareResult:
