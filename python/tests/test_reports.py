@@ -131,3 +131,25 @@ def test_a_python_policys_lines_print_as_the_batch_of_the_same_agent(agent, tmp_
     assert lines.report.summary == unforeseen.summarize(out)
     assert "| jaywalk | scaled | default | zero-shot | 1 |" in lines._repr_markdown_()
     assert lines._repr_html_().count("<table>") == 1
+
+
+def test_the_ray_drivers_join_prints_the_batchs_table_and_failures(agent_file, tmp_path):
+    # finish_batch joins the file a Ray driver wrote; here the command line's own file,
+    # on a map whose expectations this small agent fails.
+    out = tmp_path / "b.jsonl"
+    binary = cli_binary()
+    if binary is None:
+        pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
+    maps = [str(REPO / "maps" / "red_light" / "two_pedestrians.ron"), str(REPO / "maps" / "jaywalk.ron")]
+    run = subprocess.run([str(binary), "batch", *maps, "--agent", str(agent_file), "--episodes", "2",
+                          "--method", "scaled", "--method", "never-brake", "--quiet", "--out", str(out)],
+                         capture_output=True, text=True)
+    printed = "\n".join(run.stdout.rstrip("\n").split("\n")[:-1])
+    failed = [l.removeprefix("expectation failed: ") for l in run.stderr.splitlines()
+              if l.startswith("expectation failed: ")]
+    assert failed, "the small agent should fail an expectation here"
+    import json
+    from unforeseen import _unforeseen
+    joined = json.loads(_unforeseen.finish_batch(str(out)))
+    assert joined["table"] == printed
+    assert joined["failures"] == failed

@@ -12,7 +12,7 @@ use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::survivability::{Witness, warnings};
 use unforeseen_harness::maps;
 use unforeseen_harness::reports::files::write_json;
-use unforeseen_harness::reports::tables::{self, seed_text};
+use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::batch::{
     BatchConfig, DEFAULT_METHODS, ResultLine, Scenario, ScenarioKind, Shard, SummaryRow, agent_file_identity,
     checked_sweep, load_scenarios, load_stream_scenario, run_plan, stream_learning, summarize, summary_path,
@@ -222,7 +222,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         errln!("{warning}");
     }
     let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
-    let failures = failures(&rows);
+    let failures = tables::expectation_failures(&rows);
     let shard = args.shard.map(|s| format!("{}/{}", s.index, s.count));
     write_json(
         &summary,
@@ -315,39 +315,6 @@ pub(super) fn print_summary(rows: &[SummaryRow]) {
             l.episodes
         );
     }
-}
-
-/// One message per expectation that fails on the mean, naming the worst seed.
-pub(super) fn failures(rows: &[SummaryRow]) -> Vec<String> {
-    let mut out = Vec::new();
-    for r in rows {
-        for c in r.checks.iter().filter(|c| !c.pass) {
-            let n = r.train_seeds.len();
-            let over = if n == 1 {
-                format!("training seed {}", seed_text(r.train_seeds[0]))
-            } else {
-                format!(
-                    "mean over {n} training seeds; worst seed {}: {:.4}",
-                    seed_text(c.worst_seed),
-                    c.worst_value
-                )
-            };
-            let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
-            out.push(format!(
-                "{} ({}): {} [{}] {} {} = {:.4} violates {} {} ({over})",
-                r.scenario,
-                r.source,
-                r.method,
-                r.param_set,
-                protocols.join("+"),
-                c.figure,
-                c.mean,
-                c.bound,
-                c.limit
-            ));
-        }
-    }
-    out
 }
 
 /// The survivability warnings of `check-map`, from the brake-on-pedestrian and

@@ -533,6 +533,40 @@ pub fn batch_summary(rows: &[SummaryRow]) -> Document {
     doc
 }
 
+/// One message per expectation of `batch`'s summary rows that fails on the mean, naming
+/// the worst seed (what `batch`, `merge` and the Ray driver report).
+pub fn expectation_failures(rows: &[SummaryRow]) -> Vec<String> {
+    let mut out = Vec::new();
+    for r in rows {
+        for c in r.checks.iter().filter(|c| !c.pass) {
+            let n = r.train_seeds.len();
+            let over = if n == 1 {
+                format!("training seed {}", seed_text(r.train_seeds[0]))
+            } else {
+                format!(
+                    "mean over {n} training seeds; worst seed {}: {:.4}",
+                    seed_text(c.worst_seed),
+                    c.worst_value
+                )
+            };
+            let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
+            out.push(format!(
+                "{} ({}): {} [{}] {} {} = {:.4} violates {} {} ({over})",
+                r.scenario,
+                r.source,
+                r.method,
+                r.param_set,
+                protocols.join("+"),
+                c.figure,
+                c.mean,
+                c.bound,
+                c.limit
+            ));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
