@@ -4,6 +4,7 @@ and notebooks get the same table as Markdown and HTML."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import subprocess
@@ -12,6 +13,7 @@ import sys
 import pytest
 
 import unforeseen
+from unforeseen import _unforeseen
 from conftest import REPO
 from test_agents import cli_binary
 
@@ -148,8 +150,6 @@ def test_the_ray_drivers_join_prints_the_batchs_table_and_failures(agent_file, t
     failed = [l.removeprefix("expectation failed: ") for l in run.stderr.splitlines()
               if l.startswith("expectation failed: ")]
     assert failed, "the small agent should fail an expectation here"
-    import json
-    from unforeseen import _unforeseen
     joined = json.loads(_unforeseen.finish_batch(str(out)))
     assert joined["table"] == printed
     assert joined["failures"] == failed

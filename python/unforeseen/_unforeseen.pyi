@@ -363,7 +363,9 @@ def train_agent(seed: int, episodes: int) -> bytes:
 def run_units(spec: str, agents: Sequence[tuple[int | None, bytes]], units: Sequence[int], threads: int = 1) -> list[str]:
     """The result lines (JSON text) of units of a planned run, with the GIL released."""
 def finish_batch(out: str) -> str:
-    """Rewrites a driver's results file in canonical order with its summary (JSON text)."""
+    """Rewrites a driver's results file in canonical order with its summary; JSON text of
+    ``lines``, ``summary`` (its path), ``checked``, ``failed``, ``failures`` and ``table``
+    (the summary table ``unforeseen batch`` prints)."""
 def check_search(spec: str) -> bool:
     """Checks a search's spec (JSON text: arguments, base map, space file) before any task;
     whether its method is scripted (needs no agents)."""
