@@ -5,7 +5,8 @@
 //!
 //! A [`Document`] is a sequence of headings, lines and grids; a [`Grid`] is rows of cells
 //! whose first column is left-aligned and the others right-aligned. Each report builds
-//! its document in one function: [`compare`], [`eval`] and [`batch_summary`].
+//! its document in one function: [`compare`], [`eval`], [`eval_stream`] and
+//! [`batch_summary`].
 
 use std::fmt::{self, Display, Write as _};
 
@@ -15,6 +16,7 @@ use crate::episodes::protocol::Protocol;
 use crate::reports::files::num;
 use crate::runs::batch::{SummaryRow, stream_learning};
 use crate::runs::compare::{CompareReport, MethodSummary, ProtocolTable};
+use crate::runs::stream::StreamEvalReport;
 use crate::stats::Stat;
 
 /// A summarized figure as a cell: `mean` with one value, `mean ± half-width` of the 95%
@@ -440,9 +442,34 @@ pub fn eval(report: &EvalReport) -> Document {
     doc
 }
 
+/// `eval --stream`'s lines: the method on the stream under its protocol, then one line
+/// per map within the stream.
+pub fn eval_stream(report: &StreamEvalReport) -> Document {
+    let mut doc = Document::default();
+    doc.line(format!(
+        "{} on stream '{}' ({}), per map:",
+        report.method,
+        report.stream,
+        protocol_note(report.method, report.protocol, report.learns_across_episodes)
+    ));
+    for r in &report.per_map {
+        let a = &r.aggregate;
+        doc.line(format!(
+            "  {:<20} {:>4} episodes: success {:.1}%, collisions {:.1}%, reward {:.2}, inference rate {:.1}%",
+            r.map,
+            a.episodes,
+            100.0 * a.success_rate,
+            100.0 * a.collision_rate,
+            a.mean_reward,
+            100.0 * a.inference_rate
+        ));
+    }
+    doc
+}
+
 /// The protocol in words, noting a method that does not learn across episodes (so both
 /// protocols give its results).
-pub fn protocol_note(method: Method, protocol: Protocol, learns_across_episodes: bool) -> String {
+fn protocol_note(method: Method, protocol: Protocol, learns_across_episodes: bool) -> String {
     if learns_across_episodes {
         protocol.to_string()
     } else {
