@@ -17,6 +17,7 @@ use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::limits::check_episodes;
 
 use crate::errors;
+use crate::reports::EvalResult;
 
 /// Every method, in the command line's order.
 pub fn all_methods() -> Vec<Method> {
@@ -364,12 +365,12 @@ fn eval_seeds(seed: u64, map: &str, method: &str, episode: u64) -> PyResult<(u64
     Ok((s.world, s.controller))
 }
 
-/// `unforeseen eval` in the library, with the GIL released: eval.json's JSON text, built by
-/// the one builder the command line uses ([`evaluate_map`]).
+/// `unforeseen eval` in the library, with the GIL released: its report
+/// ([`EvalResult`]), built by the one builder the command line uses ([`evaluate_map`]).
 #[pyfunction]
 #[pyo3(signature = (map, method, episodes, seed = 7, agent = None, protocol = "zero-shot", **params))]
 #[allow(clippy::too_many_arguments)]
-fn evaluate_json(
+fn evaluate_report(
     py: Python<'_>,
     map: &str,
     method: &str,
@@ -378,7 +379,7 @@ fn evaluate_json(
     agent: Option<&PyAgent>,
     protocol: &str,
     params: Option<&Bound<'_, PyDict>>,
-) -> PyResult<String> {
+) -> PyResult<EvalResult> {
     let m = self::method(method)?;
     let proto = self::protocol(protocol)?;
     let p = scaled_params(params)?;
@@ -390,7 +391,7 @@ fn evaluate_json(
     let report = crate::interrupt::interruptible(py, |progress| {
         evaluate_map(&map, m, proto, agent.map(|a| &a.bundle), &p, episodes, seed, progress)
     })?;
-    serde_json::to_string(&report.document().map_err(errors::to_py)?).map_err(errors::to_py)
+    EvalResult::new(&report)
 }
 
 /// Registers the classes and functions.
@@ -402,6 +403,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(train_agents, m)?)?;
     m.add_function(wrap_pyfunction!(scripted_controller, m)?)?;
     m.add_function(wrap_pyfunction!(eval_seeds, m)?)?;
-    m.add_function(wrap_pyfunction!(evaluate_json, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate_report, m)?)?;
     Ok(())
 }

@@ -11,7 +11,9 @@
 //! * [`vector`]: many envs stepped in Rust threads with the GIL released;
 //! * [`render`]: the top-down frame (tiny-skia) and the text line;
 //! * [`agent`]: training, agent files, every method's controller, evaluation;
-//! * [`results`]: `compare` and `batch` as the JSON data their files hold;
+//! * [`results`]: `compare` and `batch`, run as the command line runs them;
+//! * [`reports`]: the reports of `compare`, `eval` and `batch` as Python objects: their
+//!   files' data, and the command line's printed table as `str()`, Markdown and HTML;
 //! * [`wrapper`]: the scaled agent around any habit, and the batch summary of a results file;
 //! * [`units`]: a batch run as units of work for a distributed driver (plan, train a
 //!   seed, run a block of units with the GIL released, join the results);
@@ -23,6 +25,7 @@ mod errors;
 mod interrupt;
 mod maps;
 mod render;
+mod reports;
 mod results;
 mod search_units;
 mod units;
@@ -52,6 +55,7 @@ fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     vector::register(m)?;
     agent::register(m)?;
     results::register(m)?;
+    reports::register(m)?;
     wrapper::register(m)?;
     units::register(m)?;
     search_units::register(m)?;

@@ -1,7 +1,7 @@
 //! `compare` and `batch` from Python, through the library functions the command line
-//! runs ([`unforeseen_harness::runs::compare::run_study`], [`unforeseen_harness::runs::batch::run`]), returned as the
-//! JSON data their files hold (the caller `json.loads` it), built by the same library
-//! functions as the command line's files.
+//! runs ([`unforeseen_harness::runs::compare::run_study`], [`unforeseen_harness::runs::batch::run`]),
+//! returned as the report objects of [`crate::reports`]: the data the command line's files
+//! hold, built by the same library functions, and the table it prints.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -10,13 +10,14 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::runs::batch::{BatchConfig, Scenario};
+use unforeseen_harness::runs::batch::{BatchConfig, ResultLine, Scenario};
 use unforeseen_harness::runs::compare::{CompareReport, StudySetup};
 use unforeseen_harness::runs::outputs::{Guarded, Outputs};
 use unforeseen_harness::training::seed_agents::Agent;
 
 use crate::agent::{PyAgent, method, protocol, scaled_params};
 use crate::errors;
+use crate::reports::{BatchResult, CompareResult};
 
 fn agents_of(agents: &Bound<'_, PyAny>) -> PyResult<Vec<Agent>> {
     let list: Vec<PyRef<'_, PyAgent>> = if let Ok(one) = agents.extract::<PyRef<'_, PyAgent>>() {
@@ -36,12 +37,12 @@ fn protocols(names: Vec<String>) -> PyResult<Vec<Protocol>> {
     names.iter().map(|n| protocol(n)).collect()
 }
 
-/// `unforeseen compare`: compare.json's data as JSON text, built by the one builder the
+/// `unforeseen compare`: its report ([`CompareResult`]), built by the one builder the
 /// command line uses ([`CompareReport::new`]).
 #[pyfunction]
 #[pyo3(signature = (agents, train_map = "intersection", test_map = "jaywalk", episodes = 100, seed = 7, protocols = vec!["zero-shot".to_string(), "continual".to_string()], ablations = false, **params))]
 #[allow(clippy::too_many_arguments)]
-fn compare_json(
+fn compare_report(
     py: Python<'_>,
     agents: &Bound<'_, PyAny>,
     train_map: &str,
@@ -51,7 +52,7 @@ fn compare_json(
     protocols: Vec<String>,
     ablations: bool,
     params: Option<&Bound<'_, PyDict>>,
-) -> PyResult<String> {
+) -> PyResult<CompareResult> {
     let agents = agents_of(agents)?;
     let protocols = self::protocols(protocols)?;
     let p = scaled_params(params)?;
@@ -74,18 +75,18 @@ fn compare_json(
         unforeseen_harness::runs::compare::run_study(&setup, &agents, progress)
     })?;
     let report = CompareReport::new(&setup, &agents, tables, None, None).map_err(errors::to_py)?;
-    serde_json::to_string(&report).map_err(errors::to_py)
+    CompareResult::new(&report)
 }
 
 static RUN: AtomicU64 = AtomicU64::new(0);
 
-/// `unforeseen batch`: `{"lines": [...], "summary": [...]}` as JSON text, the result
-/// lines of the results file (after its `run` line) and the summary file's rows.
+/// `unforeseen batch`: its report ([`BatchResult`]): the result lines of the results
+/// file (after its `run` line) and the summary file's rows.
 /// `sweep` maps a `--set` key to a value or a list of values (their cross product).
 #[pyfunction]
 #[pyo3(signature = (maps, agents, episodes = 100, seed = 7, methods = None, protocols = vec!["zero-shot".to_string(), "continual".to_string()], sweep = None, jobs = 2))]
 #[allow(clippy::too_many_arguments)]
-fn batch_json(
+fn batch_report(
     py: Python<'_>,
     maps: Vec<String>,
     agents: &Bound<'_, PyAny>,
@@ -95,7 +96,7 @@ fn batch_json(
     protocols: Vec<String>,
     sweep: Option<&Bound<'_, PyDict>>,
     jobs: usize,
-) -> PyResult<String> {
+) -> PyResult<BatchResult> {
     crate::units::check_episodes("episodes", episodes)?;
     let agents = agents_of(agents)?;
     let protocols = self::protocols(protocols)?;
@@ -169,9 +170,17 @@ fn batch_json(
         unforeseen_harness::runs::batch::run(&cfg, &out, false, progress)
     });
     let _ = std::fs::remove_file(&out);
-    let lines = lines?;
-    let summary = unforeseen_harness::runs::batch::summarize(&lines);
-    serde_json::to_string(&serde_json::json!({"lines": lines, "summary": summary})).map_err(errors::to_py)
+    BatchResult::new(&lines?)
+}
+
+/// The report of result lines a Python policy's evaluation wrote (`unforeseen.evaluate`),
+/// given as the JSON text of their list: summarized and printed as `unforeseen batch`
+/// summarizes and prints its own lines ([`BatchResult`]).
+#[pyfunction]
+fn batch_result(lines: &str) -> PyResult<BatchResult> {
+    let lines: Vec<ResultLine> =
+        serde_json::from_str(lines).map_err(|e| errors::value(format!("result lines: {e}")))?;
+    BatchResult::new(&lines)
 }
 
 /// The output guard of a results file `out` written from Python (`evaluate`): refuses,
@@ -204,7 +213,8 @@ impl ResultsGuard {
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ResultsGuard>()?;
-    m.add_function(wrap_pyfunction!(compare_json, m)?)?;
-    m.add_function(wrap_pyfunction!(batch_json, m)?)?;
+    m.add_function(wrap_pyfunction!(compare_report, m)?)?;
+    m.add_function(wrap_pyfunction!(batch_report, m)?)?;
+    m.add_function(wrap_pyfunction!(batch_result, m)?)?;
     Ok(())
 }

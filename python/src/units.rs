@@ -21,6 +21,7 @@ use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::progress::NoProgress;
+use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::batch::{
     BatchConfig, DEFAULT_METHODS, RunIdentity, SCRIPTED_ONLY, Scenario, agent_file_identity, checked_sweep,
     load_scenarios, run_unit, trained_agents_identity,
@@ -329,7 +330,9 @@ fn run_units(
 /// the order they finished) into the file one machine writes: every unit once, in
 /// canonical order, and its summary beside it, both atomically ([`unforeseen_harness::runs::merge`]).
 /// Returns JSON text: `lines` (the result lines), `summary` (its path), `checked`,
-/// `failed` and `failures` (one message per expectation failed on the mean over seeds).
+/// `failed`, `failures` (one message per expectation failed on the mean over seeds) and
+/// `table` (the summary table `unforeseen batch` prints), both as the command line has them
+/// ([`unforeseen_harness::reports::tables`]).
 #[pyfunction]
 fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<String> {
     let parts = [out.clone()];
@@ -341,32 +344,14 @@ fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<String> {
         })
         .map_err(errors::to_py)?;
     let (merged, report) = report;
-    let failures: Vec<String> = report
-        .rows
-        .iter()
-        .flat_map(|r| {
-            r.checks.iter().filter(|c| !c.pass).map(move |c| {
-                format!(
-                    "{} ({}): {} [{}] {} = {:.4} violates {} {} (mean over {} training seed(s))",
-                    r.scenario,
-                    r.source,
-                    r.method,
-                    r.param_set,
-                    c.figure,
-                    c.mean,
-                    c.bound,
-                    c.limit,
-                    r.train_seeds.len()
-                )
-            })
-        })
-        .collect();
+    let failures = tables::expectation_failures(&report.rows);
     serde_json::to_string(&json!({
         "lines": merged.results(),
         "summary": report.summary.display().to_string(),
         "checked": report.checked,
         "failed": report.failed,
         "failures": failures,
+        "table": tables::batch_summary(&report.rows).to_string(),
     }))
     .map_err(errors::to_py)
 }

@@ -14,15 +14,25 @@ Every number comes from the Rust crates the ``unforeseen`` command line uses.
 
 from __future__ import annotations
 
-import json
-from typing import Any
+from typing import Any, Mapping, Sequence
 
 import gymnasium as gym
 
 from . import _unforeseen
-from ._unforeseen import Agent, Controller, embedded_maps, load_agent, scripted_controller, stream_seed, train_agents
+from ._unforeseen import (
+    Agent,
+    BatchResult,
+    CompareResult,
+    Controller,
+    EvalResult,
+    embedded_maps,
+    load_agent,
+    scripted_controller,
+    stream_seed,
+    train_agents,
+)
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
-from .evaluate import evaluate, summarize
+from .evaluate import EvaluateResult, evaluate, summarize
 from .vector import VectorEnv
 from .wrapper import ScaledWrapper, q_table_habit
 
@@ -32,7 +42,11 @@ __all__ = [
     "ACTIONS",
     "LIGHTS",
     "Agent",
+    "BatchResult",
+    "CompareResult",
     "Controller",
+    "EvalResult",
+    "EvaluateResult",
     "ScaledWrapper",
     "UnforeseenEnv",
     "VectorEnv",
@@ -105,10 +119,12 @@ def evaluate_builtin(
     agent: Agent | None = None,
     protocol: str = "zero-shot",
     **params: Any,
-) -> dict[str, Any]:
-    """``unforeseen eval`` run by the Rust library: eval.json's data (``aggregate`` and
-    the per-episode ``episodes``). ``params`` are the ``--set`` keys."""
-    return json.loads(_unforeseen.evaluate_json(map, method, episodes, seed, agent, protocol, **params))
+) -> EvalResult:
+    """``unforeseen eval`` run by the Rust library. Returns an :class:`EvalResult`:
+    ``print(result)`` gives the line ``eval`` prints, ``result["aggregate"]`` and
+    ``result["episodes"]`` (or ``to_dict()``) eval.json's data, and ``to_pandas()`` one
+    row per episode. ``params`` are the ``--set`` keys."""
+    return _unforeseen.evaluate_report(map, method, episodes, seed, agent, protocol, **params)
 
 
 def rollout(
@@ -165,11 +181,42 @@ def rollout(
     return results
 
 
-def compare(**kwargs: Any) -> dict[str, Any]:
-    """``unforeseen compare`` in the library: compare.json's data."""
-    return json.loads(_unforeseen.compare_json(**kwargs))
+def compare(
+    agents: Agent | Sequence[Agent],
+    train_map: str = "intersection",
+    test_map: str = "jaywalk",
+    episodes: int = 100,
+    seed: int = 7,
+    protocols: Sequence[str] = ("zero-shot", "continual"),
+    ablations: bool = False,
+    **params: Any,
+) -> CompareResult:
+    """``unforeseen compare`` in the library: the paper's table (§VI) of ``agents`` (one
+    agent, or several from :func:`train_agents`, summarized over them), trained on
+    ``train_map`` and tested on ``test_map``, one table per protocol. Returns a
+    :class:`CompareResult`: ``print(result)`` gives the tables ``compare`` prints,
+    ``result["tables"]`` (or ``to_dict()``) compare.json's data, and ``to_pandas()`` one
+    row per (protocol, method). ``params`` are the ``--set`` keys."""
+    return _unforeseen.compare_report(agents, train_map, test_map, episodes, seed, list(protocols), ablations,
+                                      **params)
 
 
-def batch(*maps: str, **kwargs: Any) -> list[dict[str, Any]]:
-    """``unforeseen batch`` in the library: the results file's lines (dicts)."""
-    return json.loads(_unforeseen.batch_json(list(maps), **kwargs))
+def batch(
+    *maps: str,
+    agents: Agent | Sequence[Agent],
+    episodes: int = 100,
+    seed: int = 7,
+    methods: Sequence[str] | None = None,
+    protocols: Sequence[str] = ("zero-shot", "continual"),
+    sweep: Mapping[str, Any] | None = None,
+    jobs: int = 2,
+) -> BatchResult:
+    """``unforeseen batch`` in the library: every (map, method, parameter set, protocol,
+    agent) as one unit (no maps: the embedded ones; ``methods`` default to the paper's
+    three and the scripted references; ``sweep`` maps a ``--set`` key to a value or a
+    list of values, their cross product). Returns a :class:`BatchResult`:
+    ``print(result)`` gives the summary table ``batch`` prints, ``result["lines"]`` the
+    results file's lines and ``result["summary"]`` the summary's rows, and
+    ``to_pandas()`` one row per summary row."""
+    return _unforeseen.batch_report(list(maps), agents, episodes, seed, None if methods is None else list(methods),
+                                    list(protocols), None if sweep is None else dict(sweep), jobs)

@@ -14,15 +14,19 @@ import numpy.typing as npt
 
 __all__ = [
     "Agent",
+    "BatchResult",
+    "CompareResult",
     "Controller",
     "Env",
+    "EvalResult",
     "ScaledHabitAgent",
     "VectorEnv",
-    "compare_json",
-    "batch_json",
+    "batch_report",
+    "batch_result",
+    "compare_report",
     "embedded_maps",
     "eval_seeds",
-    "evaluate_json",
+    "evaluate_report",
     "load_agent",
     "q_table_habit",
     "rust_loop",
@@ -172,7 +176,7 @@ def train_agents(
 ) -> list[Agent]: ...
 def scripted_controller(method: str, map: str = "jaywalk") -> Controller: ...
 def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int]: ...
-def evaluate_json(
+def evaluate_report(
     map: str,
     method: str,
     episodes: int,
@@ -180,12 +184,135 @@ def evaluate_json(
     agent: Agent | None = None,
     protocol: str = "zero-shot",
     **params: Any,
-) -> str:
-    """eval.json's data as JSON text."""
-def compare_json(**kwargs: Any) -> str:
-    """compare.json's data as JSON text."""
-def batch_json(maps: Sequence[str], **kwargs: Any) -> str:
-    """A batch run's result lines as a JSON list."""
+) -> EvalResult:
+    """``unforeseen eval``: its report."""
+def compare_report(
+    agents: Agent | Sequence[Agent],
+    train_map: str = "intersection",
+    test_map: str = "jaywalk",
+    episodes: int = 100,
+    seed: int = 7,
+    protocols: Sequence[str] = ("zero-shot", "continual"),
+    ablations: bool = False,
+    **params: Any,
+) -> CompareResult:
+    """``unforeseen compare``: its report."""
+def batch_report(
+    maps: Sequence[str],
+    agents: Agent | Sequence[Agent],
+    episodes: int = 100,
+    seed: int = 7,
+    methods: Sequence[str] | None = None,
+    protocols: Sequence[str] = ("zero-shot", "continual"),
+    sweep: dict[str, Any] | None = None,
+    jobs: int = 2,
+) -> BatchResult:
+    """``unforeseen batch``: its report (result lines and summary)."""
+def batch_result(lines: str) -> BatchResult:
+    """The report of result lines (the JSON text of their list) that ``evaluate`` wrote,
+    summarized and printed as ``unforeseen batch`` does its own."""
+
+@final
+class CompareResult:
+    """``compare``'s report: compare.json's data; ``str()`` is the tables ``compare``
+    prints (one per protocol). Rows: one per (protocol, method)."""
+
+    def __str__(self) -> str:
+        """The table the command line prints (also ``repr()``)."""
+    def _repr_markdown_(self) -> str:
+        """The table as Markdown (a notebook's rich display)."""
+    def _repr_html_(self) -> str:
+        """The table as an HTML fragment (a notebook's rich display)."""
+    def __getitem__(self, key: str) -> Any:
+        """The data under ``key`` (as ``to_dict()[key]``); ``KeyError`` if there is none."""
+    def __contains__(self, key: str) -> bool: ...
+    def keys(self) -> list[str]:
+        """The data's keys, sorted."""
+    def get(self, key: str, default: Any = None) -> Any: ...
+    def to_dict(self) -> dict[str, Any]:
+        """The whole data as a new dict (what ``json.load`` of the file gives)."""
+    def to_records(self) -> list[dict[str, Any]]:
+        """The table's rows as flat dicts: nested fields as ``outer_inner``, a summarized
+        figure's mean under the figure's name (``success_rate``, ``success_rate_ci95_low``,
+        ...)."""
+    def to_pandas(self) -> Any:
+        """``to_records()`` as a ``pandas.DataFrame``; ``ImportError`` naming the
+        ``pandas`` extra where pandas is not installed."""
+    @property
+    def tables(self) -> list[dict[str, Any]]:
+        """One table per protocol, each with its ``methods`` rows."""
+    @property
+    def protocols(self) -> list[str]: ...
+    @property
+    def train_map(self) -> str: ...
+    @property
+    def test_map(self) -> str: ...
+
+@final
+class EvalResult:
+    """``eval``'s report: eval.json's data; ``str()`` is the line ``eval`` prints. Rows:
+    one per episode."""
+
+    def __str__(self) -> str:
+        """The table the command line prints (also ``repr()``)."""
+    def _repr_markdown_(self) -> str:
+        """The table as Markdown (a notebook's rich display)."""
+    def _repr_html_(self) -> str:
+        """The table as an HTML fragment (a notebook's rich display)."""
+    def __getitem__(self, key: str) -> Any:
+        """The data under ``key`` (as ``to_dict()[key]``); ``KeyError`` if there is none."""
+    def __contains__(self, key: str) -> bool: ...
+    def keys(self) -> list[str]:
+        """The data's keys, sorted."""
+    def get(self, key: str, default: Any = None) -> Any: ...
+    def to_dict(self) -> dict[str, Any]:
+        """The whole data as a new dict (what ``json.load`` of the file gives)."""
+    def to_records(self) -> list[dict[str, Any]]:
+        """The table's rows as flat dicts: nested fields as ``outer_inner``, a summarized
+        figure's mean under the figure's name (``success_rate``, ``success_rate_ci95_low``,
+        ...)."""
+    def to_pandas(self) -> Any:
+        """``to_records()`` as a ``pandas.DataFrame``; ``ImportError`` naming the
+        ``pandas`` extra where pandas is not installed."""
+    @property
+    def aggregate(self) -> dict[str, Any]:
+        """The figures over every episode."""
+    @property
+    def episodes(self) -> list[dict[str, Any]]:
+        """Every episode, in order."""
+
+@final
+class BatchResult:
+    """``batch``'s report: the results file's ``lines`` and the ``summary`` over training
+    seeds; ``str()`` is the summary table ``batch`` prints. Rows: one per summary row."""
+
+    def __str__(self) -> str:
+        """The table the command line prints (also ``repr()``)."""
+    def _repr_markdown_(self) -> str:
+        """The table as Markdown (a notebook's rich display)."""
+    def _repr_html_(self) -> str:
+        """The table as an HTML fragment (a notebook's rich display)."""
+    def __getitem__(self, key: str) -> Any:
+        """The data under ``key`` (as ``to_dict()[key]``); ``KeyError`` if there is none."""
+    def __contains__(self, key: str) -> bool: ...
+    def keys(self) -> list[str]:
+        """The data's keys, sorted."""
+    def get(self, key: str, default: Any = None) -> Any: ...
+    def to_dict(self) -> dict[str, Any]:
+        """The whole data as a new dict (what ``json.load`` of the file gives)."""
+    def to_records(self) -> list[dict[str, Any]]:
+        """The table's rows as flat dicts: nested fields as ``outer_inner``, a summarized
+        figure's mean under the figure's name (``success_rate``, ``success_rate_ci95_low``,
+        ...)."""
+    def to_pandas(self) -> Any:
+        """``to_records()`` as a ``pandas.DataFrame``; ``ImportError`` naming the
+        ``pandas`` extra where pandas is not installed."""
+    @property
+    def lines(self) -> list[dict[str, Any]]:
+        """The result lines, one per unit."""
+    @property
+    def summary(self) -> list[dict[str, Any]]:
+        """The summary's rows over training seeds."""
 
 @final
 class ScaledHabitAgent:
@@ -236,7 +363,9 @@ def train_agent(seed: int, episodes: int) -> bytes:
 def run_units(spec: str, agents: Sequence[tuple[int | None, bytes]], units: Sequence[int], threads: int = 1) -> list[str]:
     """The result lines (JSON text) of units of a planned run, with the GIL released."""
 def finish_batch(out: str) -> str:
-    """Rewrites a driver's results file in canonical order with its summary (JSON text)."""
+    """Rewrites a driver's results file in canonical order with its summary; JSON text of
+    ``lines``, ``summary`` (its path), ``checked``, ``failed``, ``failures`` and ``table``
+    (the summary table ``unforeseen batch`` prints)."""
 def check_search(spec: str) -> bool:
     """Checks a search's spec (JSON text: arguments, base map, space file) before any task;
     whether its method is scripted (needs no agents)."""

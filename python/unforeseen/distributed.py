@@ -255,9 +255,10 @@ def run_batch(
     The arguments are the command line's (``sets`` are ``--set`` texts such as
     ``"horizon=1,2"``; ``jobs`` is the threads, and CPUs, of each task). Connects with
     ``ray.init(address)`` unless Ray is connected already. Returns the finished file's
-    ``lines`` (dicts), ``summary`` (its path), ``checked``, ``failed`` and ``failures``
-    (the expectations failed on the mean over training seeds; the command exits 1 on
-    any, as ``batch`` does).
+    ``lines`` (dicts), ``summary`` (its path), ``checked``, ``failed``, ``failures``
+    (the expectations failed on the mean over training seeds, in ``batch``'s words; the
+    command exits 1 on any, as ``batch`` does) and ``table`` (the summary table ``batch``
+    prints, which the command prints too).
     """
     out = Path(out)
     _check_task_options(jobs, "units_per_task", units_per_task, max_retries)
@@ -584,6 +585,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (RuntimeError, ConnectionError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
+    print(report["table"])
     print(
         f"wrote {args.out} ({len(report['lines'])} lines) and {report['summary']}; "
         f"{report['checked']} expectation(s) checked on the mean over training seeds, {report['failed']} failed"

@@ -22,7 +22,7 @@ from typing import Any, Callable, Iterable, Mapping
 from . import _unforeseen
 from .envs import UnforeseenEnv
 
-__all__ = ["evaluate", "evaluate_policy", "summarize", "PROTOCOLS"]
+__all__ = ["EvaluateResult", "evaluate", "evaluate_policy", "summarize", "PROTOCOLS"]
 
 PROTOCOLS = ("zero-shot", "continual")
 
@@ -139,6 +139,34 @@ def _line(
     }
 
 
+class EvaluateResult(list):
+    """The result lines :func:`evaluate` returns: a list of dicts, one per unit, as
+    before, that also prints as the summary table ``unforeseen batch`` prints for these
+    lines (summarized and rendered by the Rust code of the command line: ``str()``,
+    ``_repr_markdown_`` and ``_repr_html_``); :attr:`report` is that
+    :class:`~unforeseen.BatchResult` (``report.summary``: the summary's rows) and
+    :meth:`to_pandas` its rows as a DataFrame."""
+
+    @property
+    def report(self) -> _unforeseen.BatchResult:
+        """The batch report of these lines: ``lines`` and the ``summary`` over training seeds."""
+        return _unforeseen.batch_result(json.dumps(list(self)))
+
+    def __str__(self) -> str:
+        return str(self.report)
+
+    def _repr_markdown_(self) -> str:
+        return self.report._repr_markdown_()
+
+    def _repr_html_(self) -> str:
+        return self.report._repr_html_()
+
+    def to_pandas(self) -> Any:
+        """The summary's rows as a pandas DataFrame (``ImportError`` naming the ``pandas``
+        extra where pandas is not installed)."""
+        return self.report.to_pandas()
+
+
 def evaluate(
     policy: Any,
     maps: Iterable[str],
@@ -150,9 +178,10 @@ def evaluate(
     seed: int = 7,
     train_episodes: int | None = None,
     force: bool = False,
-) -> list[dict[str, Any]]:
+) -> EvaluateResult:
     """Evaluates a policy per training seed on every map under every protocol and
-    returns the batch result lines (dicts); with ``out``, appends them to that JSON Lines
+    returns the batch result lines (dicts, in an :class:`EvaluateResult`: ``print()`` it
+    for the summary table ``unforeseen batch`` prints); with ``out``, appends them to that JSON Lines
     file (one line per unit as it finishes), beside the lines of other methods. ``out``
     is checked first as ``unforeseen batch --out`` is: a ``ValueError`` if it is one of
     the map files, if it holds something other than batch results (unless ``force``:
@@ -216,7 +245,7 @@ def evaluate(
             fh.close()
         if guard is not None:
             guard.release()
-    return lines
+    return EvaluateResult(lines)
 
 
 def _refuse_repeats(out: Any, maps: list[str], seeds: list[int | None], method: str | None, guard: Any) -> None:

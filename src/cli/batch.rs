@@ -7,12 +7,12 @@ use std::path::PathBuf;
 
 use super::ProtocolChoice;
 use super::progress::{self, Bars};
-use super::table::{cell, print_grid, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::survivability::{Witness, warnings};
 use unforeseen_harness::maps;
 use unforeseen_harness::reports::files::write_json;
+use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::batch::{
     BatchConfig, DEFAULT_METHODS, ResultLine, SCRIPTED_ONLY, Scenario, ScenarioKind, Shard, SummaryRow,
     agent_file_identity, checked_sweep, load_scenarios, load_stream_scenario, run_plan, stream_learning, summarize,
@@ -226,7 +226,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         errln!("{warning}");
     }
     let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
-    let failures = failures(&rows);
+    let failures = tables::expectation_failures(&rows);
     let shard = args.shard.map(|s| format!("{}/{}", s.index, s.count));
     write_json(
         &summary,
@@ -303,86 +303,11 @@ fn guard(args: &BatchArgs, scenarios: &[Scenario]) -> anyhow::Result<unforeseen_
     Ok(guard.guard(args.force || args.resume)?)
 }
 
-/// Prints one row per (scenario, method, parameters, protocol) over its training seeds
-/// (a stream's row followed by one per map within it, `STREAM/MAP`, with its episodes),
-/// then, for a stream run under both protocols, what learning does to each map within
-/// it, warning on stderr about each map it makes worse.
+/// Prints the summary table ([`tables::batch_summary`]), then warns on stderr about each
+/// map within a stream that learning makes worse.
 pub(super) fn print_summary(rows: &[SummaryRow]) {
-    let many = rows.iter().any(|r| r.train_seeds.len() > 1);
-    let streams = rows.iter().any(|r| r.stream.is_some());
-    let mut head = vec!["scenario", "method", "parameters", "protocol", "seeds"];
-    if streams {
-        head.push("episodes");
-    }
-    head.extend(["success", "collision", "red light", "reward", "inference", "worst seed"]);
-    let mut grid = vec![head.into_iter().map(String::from).collect::<Vec<_>>()];
-    for r in rows {
-        let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
-        let w = &r.worst_seed;
-        let mut row = vec![
-            match &r.stream {
-                Some(stream) => format!("{stream}/{}", r.scenario),
-                None => r.scenario.clone(),
-            },
-            r.method.clone(),
-            r.param_set.clone(),
-            protocols.join("+"),
-            r.train_seeds.len().to_string(),
-        ];
-        if streams {
-            row.push(r.episodes.to_string());
-        }
-        row.extend([
-            cell(&r.success_rate, 1, true),
-            cell(&r.collision_rate, 1, true),
-            cell(&r.red_light_rate, 1, true),
-            cell(&r.mean_reward, 2, false),
-            cell(&r.inference_rate, 1, true),
-            format!("{} ({:.0}%)", seed_text(w.train_seed), 100.0 * w.success_rate),
-        ]);
-        grid.push(row);
-    }
-    if many {
-        outln!("each figure: mean ± half-width of the 95% interval over training seeds (Student t)");
-    }
-    print_grid(&grid);
-    let learning = stream_learning(rows);
-    if learning.is_empty() {
-        return;
-    }
-    outln!(
-        "learning within the stream, per map: continual against zero-shot on the same episodes (means over training seeds)"
-    );
-    let mut grid = vec![
-        [
-            "map",
-            "method",
-            "parameters",
-            "episodes",
-            "success zero-shot",
-            "continual",
-            "reward zero-shot",
-            "continual",
-            "",
-        ]
-        .map(String::from)
-        .to_vec(),
-    ];
-    for l in &learning {
-        grid.push(vec![
-            format!("{}/{}", l.stream, l.map),
-            l.method.clone(),
-            l.param_set.clone(),
-            l.episodes.to_string(),
-            format!("{:.1}%", 100.0 * l.zero_shot_success),
-            format!("{:.1}%", 100.0 * l.continual_success),
-            format!("{:.2}", l.zero_shot_reward),
-            format!("{:.2}", l.continual_reward),
-            if l.worse { "worse".into() } else { String::new() },
-        ]);
-    }
-    print_grid(&grid);
-    for l in learning.iter().filter(|l| l.worse) {
+    outln!("{}", tables::batch_summary(rows));
+    for l in stream_learning(rows).iter().filter(|l| l.worse) {
         errln!(
             "warning: stream '{}': learning makes map '{}' worse for {} [{}]: success {:.1}% continual, {:.1}% zero-shot over its {} episodes",
             l.stream,
@@ -394,39 +319,6 @@ pub(super) fn print_summary(rows: &[SummaryRow]) {
             l.episodes
         );
     }
-}
-
-/// One message per expectation that fails on the mean, naming the worst seed.
-pub(super) fn failures(rows: &[SummaryRow]) -> Vec<String> {
-    let mut out = Vec::new();
-    for r in rows {
-        for c in r.checks.iter().filter(|c| !c.pass) {
-            let n = r.train_seeds.len();
-            let over = if n == 1 {
-                format!("training seed {}", seed_text(r.train_seeds[0]))
-            } else {
-                format!(
-                    "mean over {n} training seeds; worst seed {}: {:.4}",
-                    seed_text(c.worst_seed),
-                    c.worst_value
-                )
-            };
-            let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
-            out.push(format!(
-                "{} ({}): {} [{}] {} {} = {:.4} violates {} {} ({over})",
-                r.scenario,
-                r.source,
-                r.method,
-                r.param_set,
-                protocols.join("+"),
-                c.figure,
-                c.mean,
-                c.bound,
-                c.limit
-            ));
-        }
-    }
-    out
 }
 
 /// The survivability warnings of `check-map`, from the brake-on-pedestrian and

@@ -4,19 +4,17 @@
 
 use clap::Args;
 use std::path::{Path, PathBuf};
-use unforeseen_sim::Map;
 
 use super::ProtocolChoice;
-use super::table::{cell, print_grid, range_cell, seed_text};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::methods::{Method, PaperFigures};
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::episodes::rewards;
 use unforeseen_harness::maps;
 use unforeseen_harness::reports::figures::{BarPanel, BarRow, bar_key, grouped_bars};
 use unforeseen_harness::reports::files::{Csv, num, write_json};
-use unforeseen_harness::runs::compare::{CompareReport, METRICS, MethodSummary, ProtocolTable, StudySetup, run_study};
+use unforeseen_harness::reports::tables::{self, seed_text};
+use unforeseen_harness::runs::compare::{CompareReport, METRICS, ProtocolTable, StudySetup, run_study};
 use unforeseen_harness::training::seed_agents::Agent;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
@@ -115,15 +113,12 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         seed: args.agent.seed,
     };
     let tables = run_study(&setup, &agents, &super::progress::Bars::new(args.agent.quiet))?;
-    for table in &tables {
-        print_table(table, &train_map, &test_map);
-    }
-
     let agent_cache = (args.seeds.train_seeds.is_some())
         .then(|| args.seeds.cache_dir().map(|p| p.display().to_string()))
         .flatten();
     let agent_file = args.agent.agent.as_ref().map(|p| p.display().to_string());
     let report = CompareReport::new(&setup, &agents, tables, agent_file, agent_cache)?;
+    outln!("{}", tables::compare(&report));
     let dir = &args.out;
     let files = ["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"];
     warn_replacing(dir, &files);
@@ -142,169 +137,6 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         dir.display()
     );
     Ok(())
-}
-
-/// The paper's figures for a method, if it reports them.
-fn paper_of(method: &str) -> Option<PaperFigures> {
-    Method::PAPER
-        .iter()
-        .chain(&Method::ABLATIONS)
-        .find(|m| m.name() == method)
-        .and_then(|m| m.paper())
-}
-
-/// Who the agents are, in words.
-fn agents_line(m: &MethodSummary) -> String {
-    let n = m.train_seeds.len();
-    let episodes = m.train_episodes.map_or("?".into(), |e| e.to_string());
-    let seeds: Vec<String> = m.train_seeds.iter().map(|&s| seed_text(s)).collect();
-    let agents = if n == 1 {
-        "1 agent".into()
-    } else {
-        format!("{n} agents")
-    };
-    format!(
-        "{agents} (training seed{} {}, {episodes} training episodes each), {} evaluation episodes per method, map and agent, evaluation seed {}",
-        if n == 1 { "" } else { "s" },
-        seeds.join(","),
-        m.episodes,
-        m.seed
-    )
-}
-
-/// Prints one protocol's table: the figures (paper's in parentheses), then, over
-/// several agents, their range and the worst seed. A second header line names the map
-/// each column was measured on.
-fn print_table(table: &ProtocolTable, train_map: &Map, test_map: &Map) {
-    let Some(first) = table.methods.first() else { return };
-    let n = first.train_seeds.len();
-    outln!();
-    outln!("== {} protocol: {}", table.protocol, table.meaning);
-    outln!("{}", agents_line(first));
-    outln!(
-        "train reward: on the training map '{}'; every other column: on the test map '{}'",
-        train_map.name,
-        test_map.name
-    );
-    let (train_reward, test_reward) = (rewards::describe(train_map), rewards::describe(test_map));
-    if train_reward == test_reward {
-        outln!("reward on both maps: {train_reward}");
-    } else {
-        outln!("reward: training map {train_reward}; test map {test_reward}");
-    }
-    if n > 1 {
-        outln!(
-            "each figure: mean ± half-width of the 95% interval over the {n} agents (Student t, {} df)",
-            n - 1
-        );
-    }
-    let mut rows = vec![
-        header("µs/tick"),
-        maps_row(&train_map.name, &test_map.name, &format!("({})", test_map.name)),
-    ];
-    let with_paper = |ours: String, paper: Option<String>| match paper {
-        Some(p) if table.protocol == Protocol::ZeroShot => format!("{ours} ({p})"),
-        _ => ours,
-    };
-    for m in &table.methods {
-        let p = paper_of(&m.method);
-        let mark = if m.computed_under != m.protocol { "*" } else { "" };
-        rows.push(vec![
-            format!("{}{mark}", m.method),
-            with_paper(cell(&m.train_reward, 1, false), p.map(|p| num(p.train_reward, 1))),
-            with_paper(cell(&m.test_reward, 1, false), p.map(|p| num(p.test_reward, 1))),
-            with_paper(
-                cell(&m.success_rate, if n > 1 { 1 } else { 0 }, true),
-                p.map(|p| format!("{:.0}%", 100.0 * p.success_rate)),
-            ),
-            with_paper(
-                cell(&m.collision_rate, if n > 1 { 1 } else { 0 }, true),
-                p.map(|_| "n/a".to_string()),
-            ),
-            cell(&m.red_light_rate, if n > 1 { 1 } else { 0 }, true),
-            cell(&m.inference_rate, 1, true),
-            cell(&m.reasoning_us_per_tick, 2, false),
-        ]);
-    }
-    print_grid(&rows);
-    if table.protocol == Protocol::ZeroShot {
-        outln!(
-            "(paper's values in parentheses, §VI; n/a: the paper gives no collision rate; red lights: episodes entering the crosswalk on red, not in the paper; its inference rate is relative, below)"
-        );
-    }
-    let copied: Vec<&str> = table
-        .methods
-        .iter()
-        .filter(|m| m.computed_under != m.protocol)
-        .map(|m| m.method.as_str())
-        .collect();
-    if !copied.is_empty() {
-        let verb = if copied.len() == 1 { "does" } else { "do" };
-        outln!(
-            "* {} {verb} not learn across episodes: identical under both protocols, run once ({}) and repeated here",
-            copied.join(", "),
-            Protocol::ZeroShot
-        );
-    }
-    if let Some(rel) = &table.scaled_inference_relative_to_bayes_rl {
-        outln!(
-            "scaled reasons on {} of the ticks Bayesian RL does (paper: 63.3%)",
-            cell(rel, 1, true)
-        );
-    }
-    if n > 1 {
-        print_spread(table, &train_map.name, &test_map.name);
-    }
-}
-
-/// The header of compare's printed tables: the method, the table's figures, then `last`.
-fn header(last: &str) -> Vec<String> {
-    let figures = [
-        "train reward",
-        "test reward",
-        "success",
-        "collisions",
-        "red lights",
-        "inference rate",
-    ];
-    std::iter::once("method")
-        .chain(figures)
-        .chain([last])
-        .map(String::from)
-        .collect()
-}
-
-/// The second header line: the map each figure was measured on, then `last`.
-fn maps_row(train_map: &str, test_map: &str, last: &str) -> Vec<String> {
-    let test = format!("({test_map})");
-    ["", &format!("({train_map})"), &test, &test, &test, &test, &test, last]
-        .map(String::from)
-        .to_vec()
-}
-
-/// The range over agents of each figure and the worst seed (lowest test success).
-fn print_spread(table: &ProtocolTable, train_map: &str, test_map: &str) {
-    outln!("over the agents: min .. max, and the worst seed (lowest test success; its success and test reward)");
-    let mut rows = vec![header("worst seed"), maps_row(train_map, test_map, "")];
-    for m in &table.methods {
-        let w = &m.worst_seed;
-        rows.push(vec![
-            m.method.clone(),
-            range_cell(&m.train_reward, 1, false),
-            range_cell(&m.test_reward, 1, false),
-            range_cell(&m.success_rate, 0, true),
-            range_cell(&m.collision_rate, 0, true),
-            range_cell(&m.red_light_rate, 0, true),
-            range_cell(&m.inference_rate, 1, true),
-            format!(
-                "{} ({:.0}%, {})",
-                seed_text(w.train_seed),
-                100.0 * w.success_rate,
-                num(w.test_reward, 1)
-            ),
-        ]);
-    }
-    print_grid(&rows);
 }
 
 /// Formats an optional number for CSV (empty when absent).
@@ -441,7 +273,12 @@ fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
                             .methods
                             .iter()
                             .map(|m| {
-                                let p = paper_of(&m.method).filter(|_| t.protocol == Protocol::ZeroShot);
+                                let p = m
+                                    .method
+                                    .parse::<Method>()
+                                    .ok()
+                                    .and_then(Method::paper)
+                                    .filter(|_| t.protocol == Protocol::ZeroShot);
                                 p.as_ref().map(paper)
                             })
                             .collect(),

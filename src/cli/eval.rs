@@ -11,6 +11,7 @@ use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::maps;
 use unforeseen_harness::progress::Progress;
 use unforeseen_harness::reports::files::write_json;
+use unforeseen_harness::reports::tables;
 
 /// Arguments of `eval`.
 #[derive(Debug, Clone, Args)]
@@ -78,21 +79,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         &bars,
     )?;
     bars.finish();
-    let agg = &report.aggregate;
-    outln!(
-        "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, red lights {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
-        args.method,
-        map.name,
-        protocol_note(args.method, args.protocol, &params),
-        agg.mean_reward,
-        100.0 * agg.success_rate,
-        100.0 * agg.collision_rate,
-        100.0 * agg.red_light_rate,
-        100.0 * agg.timeout_rate,
-        100.0 * agg.inference_rate,
-        agg.us_per_tick,
-        agg.episodes
-    );
+    outln!("{}", tables::eval(&report));
     let dir = &args.out;
     warn_replacing(dir, &["eval.json"]);
     progress::phase(
@@ -104,18 +91,9 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The protocol in words, noting when the method does not learn across episodes.
-fn protocol_note(method: Method, protocol: Protocol, params: &unforeseen_agent::params::ScaledParams) -> String {
-    if method.learns_across_episodes(params) {
-        protocol.to_string()
-    } else {
-        format!("{protocol}; {method} does not learn across episodes, so both protocols give these results")
-    }
-}
-
 /// `eval --stream FILE`: the episodes over the stream's maps, one row per map.
 fn run_stream(args: &EvalArgs, file: &std::path::Path) -> anyhow::Result<()> {
-    use unforeseen_harness::runs::stream::{Stream, evaluate_stream, per_map};
+    use unforeseen_harness::runs::stream::{Stream, StreamEvalReport, evaluate_stream};
     let stream = Stream::load(file)?;
     let inputs = unforeseen_harness::runs::outputs::Outputs::new().stream("--stream", file, &stream);
     args.agent.check_out_dir(&args.out, &["eval.json"], &[], Some(inputs))?;
@@ -149,41 +127,20 @@ fn run_stream(args: &EvalArgs, file: &std::path::Path) -> anyhow::Result<()> {
         &bars,
     )?;
     bars.finish();
-    let rows = per_map(&stream, &episodes);
-    outln!(
-        "{} on stream '{}' ({}), per map:",
+    let report = StreamEvalReport::new(
+        &stream,
+        file,
         args.method,
-        stream.name,
-        protocol_note(args.method, args.protocol, &params)
+        args.protocol,
+        &params,
+        args.agent.seed,
+        bundle.as_ref(),
+        episodes,
     );
-    for r in &rows {
-        let a = &r.aggregate;
-        outln!(
-            "  {:<20} {:>4} episodes: success {:.1}%, collisions {:.1}%, reward {:.2}, inference rate {:.1}%",
-            r.map,
-            a.episodes,
-            100.0 * a.success_rate,
-            100.0 * a.collision_rate,
-            a.mean_reward,
-            100.0 * a.inference_rate
-        );
-    }
+    outln!("{}", tables::eval_stream(&report));
     let dir = &args.out;
     warn_replacing(dir, &["eval.json"]);
-    write_json(
-        &dir.join("eval.json"),
-        &serde_json::json!({
-            "method": args.method,
-            "stream": stream.name,
-            "stream_file": file.display().to_string(),
-            "protocol": args.protocol,
-            "computed_under": args.protocol.effective(args.method, &params),
-            "seed": args.agent.seed,
-            "train_seed": bundle.as_ref().and_then(|b| b.meta.get("seed").cloned()),
-            "per_map": rows,
-            "episodes": episodes,
-        }),
-    )?;
+    write_json(&dir.join("eval.json"), &report.document()?)?;
     outln!("wrote {}/eval.json", dir.display());
     Ok(())
 }

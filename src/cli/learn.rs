@@ -10,6 +10,7 @@ use unforeseen_harness::episodes::experiments::{LearnPoint, learn};
 use unforeseen_harness::maps;
 use unforeseen_harness::reports::figures::{Series, line_panels};
 use unforeseen_harness::reports::files::{Csv, num, write_json};
+use unforeseen_harness::reports::tables::Grid;
 use unforeseen_harness::runs::outputs::Outputs;
 use unforeseen_harness::runs::stream::{Stream, learn_stream};
 
@@ -239,5 +240,11 @@ fn print_per_map(stream: &Stream, points: &[LearnPoint]) {
             format!("{} -> {}", first.reasoning_ticks, last.reasoning_ticks),
         ]);
     }
-    super::table::print_grid(&grid);
+    outln!(
+        "{}",
+        Grid {
+            header_rows: 1,
+            rows: grid
+        }
+    );
 }

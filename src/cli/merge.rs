@@ -4,7 +4,8 @@
 use clap::Args;
 use std::path::PathBuf;
 
-use super::batch::{failures, print_summary};
+use super::batch::print_summary;
+use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::merge::{merge, write_merged};
 use unforeseen_harness::runs::outputs::Outputs;
 
@@ -46,7 +47,7 @@ pub fn run(args: MergeArgs) -> anyhow::Result<()> {
         report.checked,
         report.failed
     );
-    let failures = failures(&report.rows);
+    let failures = tables::expectation_failures(&report.rows);
     if !failures.is_empty() {
         for f in &failures {
             errln!("expectation failed: {f}");

@@ -70,7 +70,6 @@ pub mod plot_sweep;
 pub mod progress;
 pub mod search;
 pub mod signals;
-pub mod table;
 pub mod trace;
 pub mod train;
 pub mod train_seeds;

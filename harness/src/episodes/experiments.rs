@@ -358,6 +358,10 @@ pub struct EvalReport {
     /// The protocol the results hold for: zero-shot for a method that does not learn
     /// across episodes, whatever was asked ([`Protocol::effective`]).
     pub computed_under: Protocol,
+    /// Whether the method learns across episodes with these parameters (the printed line
+    /// says so when it does not, [`crate::reports::tables::eval`]); not in the file.
+    #[serde(skip)]
+    pub learns_across_episodes: bool,
     /// Evaluation seed (episode seeds derive from it).
     pub seed: u64,
     /// The training seed the agent file records (null for a scripted method, or an
@@ -413,6 +417,7 @@ pub fn evaluate_map(
         map: map.name.clone(),
         protocol,
         computed_under: protocol.effective(method, params),
+        learns_across_episodes: method.learns_across_episodes(params),
         seed,
         train_seed,
         reward: map.reward.clone(),

@@ -13,6 +13,7 @@ use crate::episodes::experiments::{MethodRow, evaluate_under, method_row};
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::Protocol;
+use crate::episodes::rewards;
 use crate::error::Error;
 use crate::progress::{Message, Progress};
 use crate::stats::Stat;
@@ -197,6 +198,10 @@ pub struct CompareReport {
     pub test_map: String,
     /// The reward settings of both maps (`train_map`, `test_map`).
     pub reward: RewardPair,
+    /// Each map's reward in words (`rewards::describe`: training map, test map), as the
+    /// printed tables give it ([`crate::reports::tables::compare`]); not in the file.
+    #[serde(skip)]
+    pub reward_described: (String, String),
     /// Evaluation seed (episode seeds derive from it, the same for every agent).
     pub seed: u64,
     /// Training seeds of the agents (null for an agent file that does not say).
@@ -236,6 +241,7 @@ impl CompareReport {
             train_map: setup.train_map.name.clone(),
             test_map: setup.test_map.name.clone(),
             reward: RewardPair::of(setup.train_map, setup.test_map),
+            reward_described: (rewards::describe(setup.train_map), rewards::describe(setup.test_map)),
             seed: setup.seed,
             train_seeds: agents.iter().map(|a| a.train_seed).collect(),
             agent_file,

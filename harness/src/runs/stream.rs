@@ -260,6 +260,70 @@ pub struct StreamRow {
     pub aggregate: Aggregate,
 }
 
+/// The report of a method run over a stream (`eval --stream`'s eval.json), built by
+/// [`StreamEvalReport::new`] alone; printed by [`crate::reports::tables::eval_stream`].
+#[derive(Debug, Clone, Serialize)]
+pub struct StreamEvalReport {
+    /// The method.
+    pub method: Method,
+    /// The stream's name.
+    pub stream: String,
+    /// The stream file, as given.
+    pub stream_file: String,
+    /// The protocol asked.
+    pub protocol: Protocol,
+    /// The protocol the results hold for ([`Protocol::effective`]).
+    pub computed_under: Protocol,
+    /// Whether the method learns across episodes with these parameters (the printed line
+    /// says so when it does not); not in the file.
+    #[serde(skip)]
+    pub learns_across_episodes: bool,
+    /// Evaluation seed.
+    pub seed: u64,
+    /// The training seed the agent file records (null for a scripted method, or an
+    /// agent file that does not say).
+    pub train_seed: Option<String>,
+    /// The figures per map within the stream ([`per_map`]).
+    pub per_map: Vec<StreamRow>,
+    /// Every episode, in order.
+    pub episodes: Vec<StreamEpisode>,
+}
+
+impl StreamEvalReport {
+    /// The report of `episodes`, the run of `method` under `protocol` (with the scaled
+    /// agent's parameters `params`) over `stream`, read from `file`, from `seed` with the
+    /// agent `bundle` (none for a scripted reference).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        stream: &Stream,
+        file: &Path,
+        method: Method,
+        protocol: Protocol,
+        params: &ScaledParams,
+        seed: u64,
+        bundle: Option<&AgentBundle>,
+        episodes: Vec<StreamEpisode>,
+    ) -> Self {
+        StreamEvalReport {
+            method,
+            stream: stream.name.clone(),
+            stream_file: file.display().to_string(),
+            protocol,
+            computed_under: protocol.effective(method, params),
+            learns_across_episodes: method.learns_across_episodes(params),
+            seed,
+            train_seed: bundle.and_then(|b| b.meta.get("seed").cloned()),
+            per_map: per_map(stream, &episodes),
+            episodes,
+        }
+    }
+
+    /// The report as eval.json holds it: a JSON object with its keys sorted at every level.
+    pub fn document(&self) -> Result<serde_json::Value, crate::error::Error> {
+        Ok(serde_json::to_value(self)?)
+    }
+}
+
 /// Runs `episodes` episodes of the stream with `method` under `protocol`: zero-shot, each
 /// episode from the trained agent (episodes in parallel, rayon); continual, one controller
 /// learning across the stream in order. Episode `k` on map `m` uses the world seed of
