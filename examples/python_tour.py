@@ -11,6 +11,9 @@
 5. The paper's table (unforeseen.compare) over independently trained agents (shared
    with the command line's agent cache, out/agents/), printed as the command line prints
    it, and one figure of it read from its records.
+6. A search (unforeseen.search) over a space of jaywalk variations for the fair
+   scenarios where Q-learning fails: the failure probability with its interval, and the
+   minimised failing maps it writes (search/failures/*.ron), ready for `unforeseen batch`.
 
 It writes into the current folder.
 """
@@ -19,6 +22,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -117,3 +121,13 @@ print(report)  # in a notebook, report alone shows it as an HTML table
 scaled = next(r for r in report.to_records() if r["method"] == "scaled")
 print(f"   scaled: success {scaled['success_rate']:.0%} (95% interval {scaled['success_rate_ci95_low']:.0%}"
       f" .. {scaled['success_rate_ci95_high']:.0%} over the agents)")
+
+# 6. A search: where does a method fail on scenarios nobody wrote by hand?
+space = Path(__file__).resolve().parents[1] / "maps" / "spaces" / "jaywalk.ron"  # a space file of this repository
+summary = unforeseen.search(space=space, method="q-learning", budget=8 if SMALL else 200,
+                            episodes=3 if SMALL else 20, train_episodes=TRAIN_EPISODES, rounds=2 if SMALL else 5,
+                            max_failures=1 if SMALL else 5, out="search")
+p = summary["failure_probability"][0]["failure_probability"]
+print(f"6. search: {summary['counts']['fair']} fair candidates of {summary['counts']['evaluated']}; q-learning fails in"
+      f" {p['p']:.0%} of the fair Sobol points (95% interval {p['ci95_low']:.0%} .. {p['ci95_high']:.0%});"
+      f" {len(summary['failures'])} minimised failure map(s) in search/failures/")

@@ -33,6 +33,7 @@ from ._unforeseen import (
 )
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
 from .evaluate import EvaluateResult, evaluate, summarize
+from .search import search
 from .vector import VectorEnv
 from .wrapper import ScaledWrapper, q_table_habit
 
@@ -62,6 +63,7 @@ __all__ = [
     "q_table_habit",
     "rollout",
     "scripted_controller",
+    "search",
     "stream_seed",
     "summarize",
     "train",

@@ -73,6 +73,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _unforeseen
+from .search import search_spec
 
 __all__ = ["DEFAULT_MAX_RETRIES", "main", "parse_train_seeds", "run_batch", "run_search"]
 
@@ -360,21 +361,10 @@ def run_search(
     seeds = None if train_seeds is None else list(train_seeds)
     if seeds is not None and agent is not None:
         raise ValueError("--train-seeds and --agent: give one (train agents per seed, or search with one agent file)")
-    spec = json.dumps(
-        {
-            "map": str(map),
-            "space": str(space),
-            "method": method,
-            "protocol": protocol,
-            "budget": budget,
-            "episodes": episodes,
-            "seed": seed,
-            "sobol_share": sobol_share,
-            "rounds": rounds,
-            "max_failures": max_failures,
-            "train_seeds": seeds,
-            "train_episodes": train_episodes,
-        }
+    spec = search_spec(
+        space=space, map=map, method=method, protocol=protocol, budget=budget, episodes=episodes, seed=seed,
+        sobol_share=sobol_share, rounds=rounds, max_failures=max_failures, train_seeds=seeds,
+        train_episodes=train_episodes,
     )
     # The arguments, maps and space checked before any task runs.
     scripted = _unforeseen.check_search(spec)
