@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use std::io::Write;
-use unforeseen::cli::{Cli, exit_code, run};
+use unforeseen::cli::{Cli, error_message, exit_code, run};
 
 fn main() {
     // Rust ignores SIGPIPE, so writing into a closed pipe (`unforeseen ... | head`) fails
@@ -25,7 +25,7 @@ fn main() {
             _ => 0,
         },
         Err(err) => {
-            let _ = writeln!(std::io::stderr(), "error: {err:#}");
+            let _ = writeln!(std::io::stderr(), "error: {}", error_message(&err));
             exit_code(&*err)
         }
     };

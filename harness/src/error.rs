@@ -48,6 +48,16 @@ pub enum Error {
         /// What is allowed, e.g. `1..=1000000`.
         expected: String,
     },
+    /// A parameter override, named by its setting (`epsilon=2`), whichever front it came
+    /// from: the command line spells it as its flag (`--set epsilon=2`), Python as the
+    /// keyword argument it was.
+    #[error("{setting}: {problem}")]
+    Override {
+        /// The setting as given, `key=value` (or `key` where the key is unknown).
+        setting: String,
+        /// What is wrong and what is allowed.
+        problem: String,
+    },
     /// A command-line value: `--set`, `--obs` and the like.
     #[error("{flag}: {problem}")]
     Flag {
@@ -169,6 +179,7 @@ impl Error {
             Error::AgentFile { .. }
             | Error::Agent { .. }
             | Error::Flag { .. }
+            | Error::Override { .. }
             | Error::OutOfRange { .. }
             | Error::Results { .. }
             | Error::NotRegularFile { .. }

@@ -2,8 +2,9 @@
 //! and by sweeps ([`crate::runs::batch::sweep()`]). Keys and values go through the agent's one
 //! table of parameters ([`unforeseen_agent::param_table`]): every field of
 //! [`ScaledParams`] is a key (flat, e.g. `epsilon`, or dotted, e.g. `gate.epsilon`). A bad
-//! key or value is an [`Error::Flag`] naming the flag and what is allowed (an enum's
-//! values, a number's range and its reason).
+//! key or value is an [`Error::Override`] naming the setting and what is allowed (an
+//! enum's values, a number's range and its reason); the command line spells the setting
+//! as its flag, `--set`.
 
 use unforeseen_agent::error::SetError;
 use unforeseen_agent::param_table;
@@ -43,11 +44,15 @@ pub fn help() -> String {
     )
 }
 
-/// The [`Error::Flag`] of a `--set` that [`ScaledParams::set_str`] refused.
-pub fn flag_error(key: &str, value: &str, e: SetError) -> Error {
-    match e {
-        SetError::UnknownKey { .. } => Error::flag(format!("--set {key}"), e.to_string()),
-        SetError::BadValue { .. } => Error::flag(format!("--set {key}={value}"), e.to_string()),
+/// The [`Error::Override`] of a setting that [`ScaledParams::set_str`] refused.
+pub fn override_error(key: &str, value: &str, e: SetError) -> Error {
+    let setting = match e {
+        SetError::UnknownKey { .. } => key.to_string(),
+        SetError::BadValue { .. } => format!("{key}={value}"),
+    };
+    Error::Override {
+        setting,
+        problem: e.to_string(),
     }
 }
 
@@ -66,19 +71,21 @@ pub fn apply(mut p: ScaledParams, sets: &[String]) -> Result<ScaledParams, Error
         })?;
         set_one(&mut p, key.trim(), value.trim())?;
     }
-    p.check_ref()
-        .map_err(|e| Error::flag(format!("--set {}", e.name), e.to_string()))?;
+    p.check_ref().map_err(|e| Error::Override {
+        setting: e.name.to_string(),
+        problem: e.to_string(),
+    })?;
     Ok(p)
 }
 
 /// Sets one parameter by name (as [`ScaledParams::set_str`]).
 pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), Error> {
-    p.set_str(key, value).map_err(|e| flag_error(key, value, e))
+    p.set_str(key, value).map_err(|e| override_error(key, value, e))
 }
 
 /// Sets one parameter by name to a typed value (as [`ScaledParams::set_value`]; for
 /// keyword arguments of other front ends). The same path as [`set_one`].
 pub fn set_value(p: &mut ScaledParams, key: &str, value: serde_json::Value) -> Result<(), Error> {
     let shown = value.to_string();
-    p.set_value(key, value).map_err(|e| flag_error(key, &shown, e))
+    p.set_value(key, value).map_err(|e| override_error(key, &shown, e))
 }

@@ -165,6 +165,15 @@ pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
     }
 }
 
+/// A failed command's message: the error and its causes (`outer: inner: ...`), with a
+/// parameter override spelt as the flag it came from (`--set epsilon=2: ...`).
+pub fn error_message(err: &anyhow::Error) -> String {
+    match err.downcast_ref::<unforeseen_harness::error::Error>() {
+        Some(unforeseen_harness::error::Error::Override { .. }) => format!("--set {err:#}"),
+        _ => format!("{err:#}"),
+    }
+}
+
 /// Parses a method by name (`--method`), listing every name with its summary.
 pub fn method_parser() -> impl TypedValueParser<Value = Method> {
     let names = Method::ALL.map(|m| PossibleValue::new(m.name()).help(m.summary()));

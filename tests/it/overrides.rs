@@ -63,9 +63,17 @@ fn unknown_keys_and_bad_values_name_the_key_and_the_allowed_values() {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         apply(ScaledParams::default(), &sets).unwrap_err().to_string()
     };
+    // The library names the setting; the command line adds its flag's spelling.
     let e = err(&["colour=red"]);
     assert!(
-        e.contains("--set colour") && e.contains("omega") && e.contains("vmp_max_iters"),
+        e.starts_with("colour: ") && !e.contains("--set") && e.contains("omega") && e.contains("vmp_max_iters"),
+        "{e}"
+    );
+    let out = crate::common::run_cli(&["batch", "jaywalk", "--method", "never-brake", "--set", "colour=red"]);
+    crate::common::assert_exit(&out, 2, &["error: --set colour: unknown parameter `colour`"]);
+    let e = err(&["epsilon=2"]);
+    assert!(
+        e.starts_with("epsilon=2: parameter `epsilon`") && !e.contains("--set"),
         "{e}"
     );
     let e = err(&["scaling_mode=closed"]);
