@@ -52,7 +52,7 @@ class UnforeseenEnv(gym.Env):
     | Num | Factor | Meaning                                                              |
     |-----|--------|----------------------------------------------------------------------|
     | 0   | d      | distance to the destination bin (0 arrived, 1 within 30 m, 2 30–60 m, 3 beyond 60 m by default) |
-    | 1   | v      | speed bin (edges 1.5, 4.5, 7.5 m/s by default)                       |
+    | 1   | v      | speed bin (edges 0.5, 4.5, 7.5 m/s by default)                       |
     | 2   | L      | light: 0 red or amber, 1 green                                       |
     | 3   | p      | a pedestrian on the crosswalk: 0 no, 1 yes                           |
 

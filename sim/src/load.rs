@@ -684,7 +684,7 @@ mod doc_tests {
             "distance to goal 26..22 m",
             "green 12 s, amber 2 s, red 10 s",
             "within 4.8 s",
-            "speed [1.5, 4.5, 7.5]",
+            "speed [0.5, 4.5, 7.5]",
             "expect Scaled: min_success 0.9",
         ] {
             assert!(s.contains(needle), "summary lacks {needle:?}:\n{s}");

@@ -276,8 +276,9 @@ config_struct! {
         /// fixed edges on the distance to the goal (`[0.0, 30.0, 60.0]`); see [`DistanceEdges`].
         distance_edges: DistanceEdges = DistanceEdges::default(),
         /// Edges on speed, m/s, strictly increasing; v = number of edges e with speed >= e.
-        /// Default [1.5, 4.5, 7.5].
-        speed_edges: Vec<f64> = vec![1.5, 4.5, 7.5],
+        /// Default [0.5, 4.5, 7.5] (the paper's are [1.5, 4.5, 7.5]; `v = 0` is a car
+        /// that stands, below 0.5 m/s, not one that still rolls).
+        speed_edges: Vec<f64> = vec![0.5, 4.5, 7.5],
         /// Probability in [0, 1) that an observed factor is misreported. Default 0.
         observation_noise: f64 = 0.0,
     }

@@ -26,11 +26,13 @@ pub fn bundle() -> &'static AgentBundle {
     })
 }
 
-/// An embedded map with the paper's distance edges `[0, 30, 60]` m to the goal (§VI) in
-/// place of the default crosswalk-anchored ones (`[0, 26, 60]` on the intersection).
+/// An embedded map with the paper's bins (§VI): distance edges `[0, 30, 60]` m to the goal
+/// in place of the default crosswalk-anchored ones (`[0, 26, 60]` on the intersection),
+/// and speed edges `[1.5, 4.5, 7.5]` m/s in place of the default `[0.5, 4.5, 7.5]`.
 pub fn papers_bins(name: &str) -> unforeseen_sim::Map {
     let mut map = unforeseen_harness::maps::load(name).expect("embedded map");
     map.bins.distance_edges = unforeseen_sim::DistanceEdges::Goal(vec![0.0, 30.0, 60.0]);
+    map.bins.speed_edges = vec![1.5, 4.5, 7.5];
     map
 }
 

@@ -9,8 +9,8 @@ use unforeseen_discretizer::{Discretizer, State};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::rewards::crash_model;
 
-/// Hazards of the default map by hand: speed bins [0, 1.5), [1.5, 4.5), [4.5, 7.5),
-/// [7.5, 9] have middles 0.75, 3, 6, 8.25 m/s; one tick at top speed covers 9 m.
+/// Hazards of the default map by hand: speed bins [0, 0.5), [0.5, 4.5), [4.5, 7.5),
+/// [7.5, 9] have middles 0.25, 2.5, 6, 8.25 m/s; one tick at top speed covers 9 m.
 #[test]
 fn hazards_by_hand() {
     let map = unforeseen_harness::maps::load("intersection").unwrap();
@@ -24,9 +24,10 @@ fn hazards_by_hand() {
         ((1, 3, speed_up), (8.25 + 9.0) / 2.0),
         ((1, 3, slow_down), (8.25 + 5.25) / 2.0),
         ((1, 2, slow_down), (6.0 + 3.0) / 2.0),
-        ((1, 0, slow_down), 0.75 * 0.75 / 6.0), // stops within the tick
-        ((1, 0, maintain), 0.75),
-        ((1, 0, speed_up), (0.75 + 3.75) / 2.0),
+        ((1, 1, slow_down), 2.5 * 2.5 / 6.0), // stops within the tick
+        ((1, 0, slow_down), 0.25 * 0.25 / 6.0),
+        ((1, 0, maintain), 0.25),
+        ((1, 0, speed_up), (0.25 + 3.25) / 2.0),
     ];
     for ((d, v, u), metres) in cases {
         let got = crash.hazard[u][s(d, v, 1)];
