@@ -79,13 +79,20 @@ def cli_binary() -> Path | None:
     return max(built, key=lambda p: p.stat().st_mtime, default=None)
 
 
-@pytest.mark.parametrize("map_name,protocol", [("jaywalk", "continual"), ("jaywalk", "zero-shot"), ("two_pedestrians", "continual")])
-def test_python_rollout_equals_the_command_line(agent_file, tmp_path, map_name, protocol):
+def required_cli() -> Path:
+    """The command line's binary for a test that compares against it: skipped without
+    one, failed under CI (whose `cargo test` builds it)."""
     cli = cli_binary()
     if cli is None:
         if os.environ.get("CI"):
             pytest.fail("CI must build the unforeseen binary before the Python tests (cargo test does)")
         pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
+    return cli
+
+
+@pytest.mark.parametrize("map_name,protocol", [("jaywalk", "continual"), ("jaywalk", "zero-shot"), ("two_pedestrians", "continual")])
+def test_python_rollout_equals_the_command_line(agent_file, tmp_path, map_name, protocol):
+    cli = required_cli()
     out = tmp_path / "eval"
     subprocess.run(
         [str(cli), "eval", "--agent", str(agent_file), "--map", map_name, "--method", "scaled",

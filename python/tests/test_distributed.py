@@ -26,7 +26,7 @@ import pytest
 
 from unforeseen.distributed import parse_train_seeds
 
-from test_agents import cli_binary
+from test_agents import required_cli
 
 REPO = Path(__file__).resolve().parents[2]
 PORT = 6379
@@ -296,11 +296,7 @@ def _search_outputs(out: Path) -> dict[str, object]:
 
 
 def test_a_search_on_the_cluster_equals_one_machine(cluster: Cluster, tmp_path: Path):
-    cli = cli_binary()
-    if cli is None:
-        if os.environ.get("CI"):
-            pytest.fail("CI must build the unforeseen binary before the Python tests (cargo test does)")
-        pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
+    cli = required_cli()
     one, two = tmp_path / "one", tmp_path / "cluster"
     done = subprocess.run([str(cli), "search", *SEARCH, "--no-cache", "--quiet", "--jobs", "1", "--out", str(one)],
                           capture_output=True, text=True, timeout=RUN_TIMEOUT)
@@ -353,11 +349,7 @@ def _wait_for(what: str, found, proc: subprocess.Popen[str], timeout: float):
 @pytest.fixture(scope="module")
 def one_machine(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The sweep run by the command line on this machine."""
-    cli = cli_binary()
-    if cli is None:
-        if os.environ.get("CI"):
-            pytest.fail("CI must build the unforeseen binary before the Python tests (cargo test does)")
-        pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
+    cli = required_cli()
     one = tmp_path_factory.mktemp("one") / "one.jsonl"
     subprocess.run([str(cli), *SWEEP, "--no-cache", "--quiet", "--out", str(one)], check=False,
                    capture_output=True, timeout=RUN_TIMEOUT)
@@ -489,9 +481,7 @@ class _InlineRay:
 def test_a_batch_of_scripted_methods_trains_no_agent_and_equals_the_command_line(tmp_path: Path, monkeypatch):
     """Issue 35, finding 12: scripted methods alone need no agent; the driver's plan
     (its identity: no agent) and lines are the command line's."""
-    cli = cli_binary()
-    if cli is None:
-        pytest.skip("no unforeseen binary: cargo build (or set UNFORESEEN_CLI)")
+    cli = required_cli()
     ray = _InlineRay()
     monkeypatch.setitem(sys.modules, "ray", ray)
     from unforeseen.distributed import run_batch

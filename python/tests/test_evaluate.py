@@ -10,7 +10,7 @@ import subprocess
 import pytest
 
 import unforeseen
-from test_agents import cli_binary
+from test_agents import required_cli
 
 
 class AlwaysFast:
@@ -48,9 +48,7 @@ def test_lines_are_read_by_the_batch_summary_beside_builtin_methods(agent, tmp_p
 
 
 def test_plot_sweep_reads_the_lines(tmp_path):
-    cli = cli_binary()
-    if cli is None:
-        pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
+    cli = required_cli()
     out = tmp_path / "results.jsonl"
     unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=3, protocol="zero-shot", out=out)
     subprocess.run([str(cli), "plot-sweep", str(out), "--out", str(tmp_path / "sweep.svg")],

@@ -7,7 +7,6 @@ all cross each front; the search runs every stage (Sobol, adaptive, minimisation
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -16,7 +15,7 @@ import pytest
 
 import unforeseen
 from conftest import REPO
-from test_agents import cli_binary
+from test_agents import required_cli
 from test_distributed import _InlineRay, _search_outputs
 
 MAPS = [str(REPO / "maps" / "jaywalk.ron"), str(REPO / "maps" / "stop_midway.ron")]
@@ -24,11 +23,7 @@ METHODS = ["scaled", "q-learning", "brake-on-pedestrian"]
 
 
 def _cli(*args: str) -> None:
-    cli = cli_binary()
-    if cli is None:
-        if os.environ.get("CI"):
-            pytest.fail("CI must build the unforeseen binary before the Python tests (cargo test does)")
-        pytest.skip("no unforeseen binary: cargo build (or set UNFORESEEN_CLI)")
+    cli = required_cli()
     subprocess.run([str(cli), *args], check=True, capture_output=True, timeout=300)
 
 

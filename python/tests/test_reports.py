@@ -5,7 +5,6 @@ and notebooks get the same table as Markdown and HTML."""
 from __future__ import annotations
 
 import json
-import os
 import re
 import subprocess
 import sys
@@ -15,16 +14,12 @@ import pytest
 import unforeseen
 from unforeseen import _unforeseen
 from conftest import REPO
-from test_agents import cli_binary
+from test_agents import required_cli
 
 
 def cli(*args: str) -> str:
     """The command line's stdout for ``args``, without its last line (``wrote ...``)."""
-    binary = cli_binary()
-    if binary is None:
-        if os.environ.get("CI"):
-            pytest.fail("CI must build the unforeseen binary before the Python tests (cargo test does)")
-        pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
+    binary = required_cli()
     out = subprocess.run([str(binary), *args], check=True, capture_output=True, text=True).stdout
     lines = out.rstrip("\n").split("\n")
     assert lines[-1].startswith("wrote "), out
@@ -139,9 +134,7 @@ def test_the_ray_drivers_join_prints_the_batchs_table_and_failures(agent_file, t
     # finish_batch joins the file a Ray driver wrote; here the command line's own file,
     # on a map whose expectations this small agent fails.
     out = tmp_path / "b.jsonl"
-    binary = cli_binary()
-    if binary is None:
-        pytest.skip("no unforeseen binary: cargo build --release (or set UNFORESEEN_CLI)")
+    binary = required_cli()
     maps = [str(REPO / "maps" / "red_light" / "two_pedestrians.ron"), str(REPO / "maps" / "jaywalk.ron")]
     run = subprocess.run([str(binary), "batch", *maps, "--agent", str(agent_file), "--episodes", "2",
                           "--method", "scaled", "--method", "never-brake", "--quiet", "--out", str(out)],

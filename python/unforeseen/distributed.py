@@ -73,7 +73,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _unforeseen
-from .search import search_spec
+from .search import plan_search
 
 __all__ = ["DEFAULT_MAX_RETRIES", "main", "parse_train_seeds", "run_batch", "run_search"]
 
@@ -358,28 +358,23 @@ def run_search(
     Returns ``summary.json``'s contents.
     """
     _check_task_options(jobs, "candidates_per_task", candidates_per_task, max_retries)
-    seeds = None if train_seeds is None else list(train_seeds)
-    if seeds is not None and agent is not None:
-        raise ValueError("--train-seeds and --agent: give one (train agents per seed, or search with one agent file)")
-    spec = search_spec(
-        space=space, map=map, method=method, protocol=protocol, budget=budget, episodes=episodes, seed=seed,
-        sobol_share=sobol_share, rounds=rounds, max_failures=max_failures, train_seeds=seeds,
-        train_episodes=train_episodes,
-    )
     # The arguments, maps and space checked before any task runs.
-    scripted = _unforeseen.check_search(spec)
+    plan = plan_search(
+        space=space, map=map, method=method, protocol=protocol, budget=budget, episodes=episodes, seed=seed,
+        sobol_share=sobol_share, rounds=rounds, max_failures=max_failures, train_seeds=train_seeds,
+        train_episodes=train_episodes, agent=agent,
+    )
+    spec, from_file = plan.spec, plan.from_file
     ray = _ray()
     if not ray.is_initialized():
         ray.init(address=address, include_dashboard=False, log_to_driver=False)
     options = _task_options(max_retries)
-    from_file = agent is not None and not scripted
-    if scripted:
-        pairs: list[tuple[int | None, Any]] = []
-    elif from_file:
+    pairs: list[tuple[int | None, Any]]
+    if from_file:
         pairs = [(None, ray.put(_unforeseen.search_agent_text(str(agent))))]
     else:
         train = ray.remote(num_cpus=1, **options)(_train_task)
-        pairs = [(s, train.remote(s, train_episodes)) for s in (seeds if seeds is not None else [seed])]
+        pairs = [(s, train.remote(s, train_episodes)) for s in plan.train]
     agent_seeds = [s for s, _ in pairs]
     refs = [r for _, r in pairs]
     texts = ray.get(refs) if refs else []

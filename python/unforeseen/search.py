@@ -11,12 +11,24 @@ import json
 import os
 import threading
 from collections.abc import Iterable
-from typing import Any
+from typing import Any, NamedTuple
 
 from . import _unforeseen
 
 
-def search_spec(
+class SearchPlan(NamedTuple):
+    """A checked search request: what :func:`search` and
+    :func:`unforeseen.distributed.run_search` both run."""
+
+    spec: str
+    """The request as the binding reads it (JSON text)."""
+    from_file: bool
+    """Whether the agent is one file (``agent``) rather than trained per seed."""
+    train: list[int]
+    """The training seeds of the agents to train (empty for a scripted method or a file)."""
+
+
+def plan_search(
     *,
     space: str | os.PathLike[str],
     map: str | os.PathLike[str],
@@ -28,12 +40,17 @@ def search_spec(
     sobol_share: float,
     rounds: int,
     max_failures: int,
-    train_seeds: list[int] | None,
+    train_seeds: Iterable[int] | None,
     train_episodes: int,
-) -> str:
-    """The search request as the binding reads it (JSON text), shared by :func:`search` and
-    :func:`unforeseen.distributed.run_search`."""
-    return json.dumps(
+    agent: str | os.PathLike[str] | None,
+) -> SearchPlan:
+    """Checks a search request (arguments, map, space) with the binding's checks, before
+    any work, and says which agents it needs: a file (``agent``), one per training seed,
+    or, with neither, one trained with ``seed``. ``ValueError`` names what is wrong."""
+    seeds = None if train_seeds is None else list(train_seeds)
+    if seeds is not None and agent is not None:
+        raise ValueError("train_seeds and agent: give one (train agents per seed, or search with one agent file)")
+    spec = json.dumps(
         {
             "map": str(map),
             "space": str(space),
@@ -45,10 +62,14 @@ def search_spec(
             "sobol_share": sobol_share,
             "rounds": rounds,
             "max_failures": max_failures,
-            "train_seeds": train_seeds,
+            "train_seeds": seeds,
             "train_episodes": train_episodes,
         }
     )
+    scripted = _unforeseen.check_search(spec)
+    from_file = agent is not None and not scripted
+    train = [] if scripted or from_file else (seeds if seeds is not None else [seed])
+    return SearchPlan(spec, from_file, train)
 
 
 def search(
@@ -80,22 +101,17 @@ def search(
     map or space before any work; Ctrl-C raises ``KeyboardInterrupt``."""
     if not 1 <= jobs <= 256:
         raise ValueError(f"jobs={jobs}: expected 1 to 256 worker threads")
-    seeds = None if train_seeds is None else list(train_seeds)
-    if seeds is not None and agent is not None:
-        raise ValueError("train_seeds and agent: give one (train agents per seed, or search with one agent file)")
-    spec = search_spec(
+    plan = plan_search(
         space=space, map=map, method=method, protocol=protocol, budget=budget, episodes=episodes, seed=seed,
-        sobol_share=sobol_share, rounds=rounds, max_failures=max_failures, train_seeds=seeds,
-        train_episodes=train_episodes,
+        sobol_share=sobol_share, rounds=rounds, max_failures=max_failures, train_seeds=train_seeds,
+        train_episodes=train_episodes, agent=agent,
     )
-    scripted = _unforeseen.check_search(spec)
-    from_file = agent is not None and not scripted
-    if scripted:
-        agents: list[tuple[int | None, bytes]] = []
-    elif from_file:
+    spec, from_file = plan.spec, plan.from_file
+    agents: list[tuple[int | None, bytes]]
+    if from_file:
         agents = [(None, _unforeseen.search_agent_text(str(agent)))]
     else:
-        agents = [(s, _unforeseen.train_agent(s, train_episodes)) for s in (seeds if seeds is not None else [seed])]
+        agents = [(s, _unforeseen.train_agent(s, train_episodes)) for s in plan.train]
     # Set by the binding on Ctrl-C: `evaluate` runs on the driver's other threads.
     stop = threading.Event()
 
