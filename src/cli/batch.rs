@@ -335,6 +335,7 @@ fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<S
                 success_rate: l.success_rate,
                 collision_rate: l.collision_rate,
                 timeout_rate: l.timeout_rate,
+                cruise: 1.0,
             })
     };
     scenarios

@@ -5,7 +5,7 @@
 use std::path::Path;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::episodes::survivability::witness;
+use unforeseen_harness::episodes::survivability::{careful_witness, witness};
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::Shard;
 use unforeseen_harness::runs::search::{self, Fairness, SearchConfig, Space, Value, sobol_candidates};
@@ -313,6 +313,23 @@ fn fairness_of_known_maps() {
     let mut empty = jaywalk();
     empty.pedestrians.clear();
     assert_eq!(of(&empty), Fairness::NotDangerous);
+}
+
+/// A map that brake-on-pedestrian survives only at the car's exact top speed (found by a
+/// search, maps/search/knife_edge/) is not survivable: cruising at 95% of that speed the
+/// same driver dies in most episodes, so the search does not count a failure there.
+#[test]
+fn a_map_survivable_only_at_top_speed_is_not_fair() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps/search/knife_edge/wide_c0787.ron");
+    let map = unforeseen_harness::maps::load_file(&file).expect("a shipped map");
+    let at_top = witness(&map, Method::BrakeOnPedestrian, 20, 7).expect("runs");
+    assert!(at_top.success_rate >= 0.99, "{at_top:?}");
+    let (careful, agg) = careful_witness(&map, 20, 7, &NoProgress).expect("runs");
+    assert!(careful.success_rate < 0.5 && careful.cruise < 1.0, "{careful:?}");
+    assert_eq!(agg.success_rate, careful.success_rate);
+    // The shipped jaywalk is survivable at every careful cruise.
+    let (jay, _) = careful_witness(&jaywalk(), 20, 7, &NoProgress).expect("runs");
+    assert!(jay.success_rate >= 0.99, "{jay:?}");
 }
 
 #[test]

@@ -3,11 +3,19 @@
 //! ([`crate::episodes::reference`]) answer that without any trained agent:
 //!
 //! * **survivable**: [`Method::BrakeOnPedestrian`] succeeds in at least
-//!   [`SURVIVABLE_MIN_SUCCESS`] (99%) of the episodes;
+//!   [`SURVIVABLE_MIN_SUCCESS`] (99%) of the episodes, cruising at the car's top speed
+//!   and at each slower cruise of [`CAREFUL_CRUISE`] ([`careful_witness`]);
 //! * **dangerous**: [`Method::NeverBrake`] succeeds in at most [`DANGEROUS_MAX_SUCCESS`]
 //!   (20%) of the episodes, the same bound the shipped maps put on Q-learning
 //!   (`(method: QLearning, max_success: 0.2)`): if a car that drives on gets through
 //!   more often than that, the map cannot show that the habit is fooled.
+//!
+//! Why several cruise speeds: brake-on-pedestrian speeds up to the car's top speed, and
+//! pedestrians that step out by the car's time to arrival meet it at one timing. Searches
+//! found maps that it survives at the top speed and not 5 or 10% slower (in 16% to 78% of
+//! the episodes, EXPERIMENTS.md, "Fair or knife-edge"): such a map tests when the car
+//! happens to arrive, not whether it brakes for what it sees, and a careful driver that
+//! cruises a little slower dies there. A map is survivable when care alone suffices.
 //!
 //! `check-map` measures both on every map with pedestrian rules; `batch` checks its
 //! brake-on-pedestrian and never-brake units. Both report the same warnings (returned
@@ -20,13 +28,17 @@ use crate::episodes::experiments::evaluate_scripted;
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::error::Error;
-use crate::progress::NoProgress;
+use crate::progress::{NoProgress, Progress};
 
 /// Lowest success rate of brake-on-pedestrian for a map to count as survivable.
 pub const SURVIVABLE_MIN_SUCCESS: f64 = 0.99;
 
 /// Highest success rate of never-brake for a map to count as dangerous.
 pub const DANGEROUS_MAX_SUCCESS: f64 = 0.2;
+
+/// The cruise speeds, as fractions of the car's top speed, at which brake-on-pedestrian
+/// must survive a map for it to count as survivable.
+pub const CAREFUL_CRUISE: [f64; 3] = [1.0, 0.95, 0.9];
 
 /// Default episodes per witness in `check-map`.
 pub const DEFAULT_EPISODES: u64 = 100;
@@ -42,6 +54,9 @@ pub struct Witness {
     pub collision_rate: f64,
     /// Time-out rate.
     pub timeout_rate: f64,
+    /// The cruise speed it drove at, as a fraction of the car's top speed (1 for the map
+    /// as written).
+    pub cruise: f64,
 }
 
 impl Witness {
@@ -52,12 +67,18 @@ impl Witness {
             success_rate: agg.success_rate,
             collision_rate: agg.collision_rate,
             timeout_rate: agg.timeout_rate,
+            cruise: 1.0,
         }
     }
 
     fn figures(&self) -> String {
+        let cruise = if self.cruise < 1.0 {
+            format!(" cruising at {:.0}% of the car's top speed", 100.0 * self.cruise)
+        } else {
+            String::new()
+        };
         format!(
-            "{:.1}% of {} episodes (collisions {:.1}%, time-outs {:.1}%)",
+            "{:.1}% of {} episodes{cruise} (collisions {:.1}%, time-outs {:.1}%)",
             100.0 * self.success_rate,
             self.episodes,
             100.0 * self.collision_rate,
@@ -73,6 +94,47 @@ pub fn witness(map: &Map, method: Method, episodes: u64, seed: u64) -> Result<Wi
     Ok(Witness::of(&Aggregate::of(&results)))
 }
 
+/// The map a driver cruising at `fraction` of the car's top speed meets: the same map
+/// (and name, so the same pedestrians) with that top speed, never below the start speed.
+/// brake-on-pedestrian speeds up until the top speed, so this is its cruise.
+pub fn at_cruise(map: &Map, fraction: f64) -> Map {
+    let mut slower = map.clone();
+    let v = &mut slower.vehicle;
+    v.max_speed = (fraction * v.max_speed).max(v.start_speed);
+    slower
+}
+
+/// brake-on-pedestrian's [`aggregate`](Aggregate) on `map` at each cruise of
+/// [`CAREFUL_CRUISE`], and the worst of them (the lowest success; the fastest cruise on a
+/// tie): a map is survivable when this witness succeeds in at least
+/// [`SURVIVABLE_MIN_SUCCESS`]. Each cruise's episodes derive from `seed` as
+/// [`witness`]'s do.
+pub fn careful_witness(
+    map: &Map,
+    episodes: u64,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<(Witness, Aggregate), Error> {
+    let mut worst: Option<(Witness, Aggregate)> = None;
+    for fraction in CAREFUL_CRUISE {
+        let agg = Aggregate::of(&evaluate_scripted(
+            &at_cruise(map, fraction),
+            Method::BrakeOnPedestrian,
+            episodes,
+            seed,
+            progress,
+        )?);
+        let w = Witness {
+            cruise: fraction,
+            ..Witness::of(&agg)
+        };
+        if worst.as_ref().is_none_or(|(b, _)| w.success_rate < b.success_rate) {
+            worst = Some((w, agg));
+        }
+    }
+    Ok(worst.expect("CAREFUL_CRUISE is not empty"))
+}
+
 /// The warnings for map `name` given what the witnesses measured (`None`: not run).
 pub fn warnings(name: &str, brake: Option<&Witness>, never_brake: Option<&Witness>) -> Vec<String> {
     let mut out = Vec::new();
@@ -80,7 +142,8 @@ pub fn warnings(name: &str, brake: Option<&Witness>, never_brake: Option<&Witnes
         out.push(format!(
             "WARNING: map '{name}' may not be survivable: {} (brakes from the first tick a pedestrian is on the \
              crosswalk) succeeds in {}, under {:.0}%; in a fair unforeseen test a car that brakes as soon as \
-             it sees the pedestrian can stop in time (let them step out when the car is farther away)",
+             it sees the pedestrian can stop in time, at its top speed or a little slower (let them step out \
+             when the car is farther away)",
             Method::BrakeOnPedestrian,
             w.figures(),
             100.0 * SURVIVABLE_MIN_SUCCESS
@@ -104,7 +167,7 @@ pub fn check(map: &Map, episodes: u64, seed: u64) -> Result<Vec<String>, Error> 
     if episodes == 0 || map.pedestrians.is_empty() {
         return Ok(Vec::new());
     }
-    let brake = witness(map, Method::BrakeOnPedestrian, episodes, seed)?;
+    let (brake, _) = careful_witness(map, episodes, seed, &NoProgress)?;
     let never = witness(map, Method::NeverBrake, episodes, seed)?;
     Ok(warnings(&map.name, Some(&brake), Some(&never)))
 }
@@ -119,6 +182,7 @@ mod tests {
             success_rate,
             collision_rate: 1.0 - success_rate,
             timeout_rate: 0.0,
+            cruise: 1.0,
         }
     }
 
@@ -130,5 +194,19 @@ mod tests {
         assert!(both[0].contains("not be survivable") && both[0].contains("98.0% of 100 episodes"));
         assert!(both[1].contains("not be dangerous") && both[1].contains("21.0% of 100 episodes"));
         assert!(warnings("m", None, None).is_empty());
+        let slower = Witness { cruise: 0.9, ..w(0.5) };
+        assert!(
+            warnings("m", Some(&slower), None)[0]
+                .contains("50.0% of 100 episodes cruising at 90% of the car's top speed")
+        );
+    }
+
+    #[test]
+    fn a_slower_cruise_is_the_same_map_with_a_lower_top_speed_never_below_the_start() {
+        let map = Map::default();
+        let slow = at_cruise(&map, 0.9);
+        assert_eq!(slow.vehicle.max_speed, 0.9 * map.vehicle.max_speed);
+        assert_eq!((&slow.name, &slow.pedestrians), (&map.name, &map.pedestrians));
+        assert_eq!(at_cruise(&map, 1e-6).vehicle.max_speed, map.vehicle.start_speed);
     }
 }

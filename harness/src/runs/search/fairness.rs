@@ -2,7 +2,9 @@
 //! driver survives and a careless one does not (the two scripted witnesses of
 //! [`crate::episodes::survivability`], with its thresholds):
 //!
-//! * **survivable**: brake-on-pedestrian succeeds in at least 99% of the K episodes;
+//! * **survivable**: brake-on-pedestrian succeeds in at least 99% of the K episodes, at
+//!   the car's top speed and at each slower careful cruise (the worst of them,
+//!   [`careful_witness`](crate::episodes::survivability::careful_witness));
 //! * **dangerous**: never-brake fails in at least 80% of them (succeeds in at most 20%).
 //!
 //! A candidate that is both is *fair*; the others are reported as unfair and never
@@ -23,7 +25,7 @@ pub const FAILURE_SUCCESS: f64 = 0.5;
 pub enum Fairness {
     /// Survivable and dangerous: a failure here counts.
     Fair,
-    /// brake-on-pedestrian succeeds in under 99%: not survivable.
+    /// brake-on-pedestrian succeeds in under 99% at some careful cruise: not survivable.
     NotSurvivable,
     /// never-brake succeeds in over 20%: not dangerous.
     NotDangerous,

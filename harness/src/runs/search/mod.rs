@@ -4,7 +4,8 @@
 //!
 //! A [`Space`] names which fields of a base map vary and over what ([`space`]). The
 //! search evaluates *candidates*, points of the space laid over the base map, each with
-//! K episodes of the two fairness witnesses and of the method (for each training seed),
+//! K episodes of the two fairness witnesses (brake-on-pedestrian's line is the worst of
+//! its careful cruises, [`careful_witness`]) and of the method (for each training seed),
 //! in three stages. A fair candidate is a *failure* of the method when at least one of its
 //! trained agents (training seeds) succeeds in under 50% of the episodes: each agent is
 //! one draw of the method.
@@ -59,6 +60,7 @@ use crate::episodes::experiments::{evaluate_scripted, evaluate_under};
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::{Protocol, covered};
+use crate::episodes::survivability::careful_witness;
 use crate::error::Error;
 use crate::progress::{CancelOnly, NoProgress, Progress};
 use crate::runs::batch::{ResultLine, Shard};
@@ -667,7 +669,7 @@ pub fn evaluate(
             &cancel,
         )?))
     };
-    let brake = scripted(Method::BrakeOnPedestrian)?;
+    let (_, brake) = careful_witness(map, cfg.episodes, cfg.seed, &cancel)?;
     let never = scripted(Method::NeverBrake)?;
     let fair = Fairness::of(brake.success_rate, never.success_rate);
     let mut runs: Vec<Run<'_>> = vec![
