@@ -1,6 +1,7 @@
 //! Audits the scaled agent over a long continual run on one map (issue 20, EXPERIMENTS.md
 //! "The safe hand-back"): reasoning ticks with and without a pedestrian on the crosswalk,
-//! ticks the hand-back check refused, learned triggers it declined, reasoning per block of 50 episodes, and what drifts:
+//! how many of the former the competence check made, ticks the hand-back check refused,
+//! learned triggers it declined, reasoning per block of 50 episodes, and what drifts:
 //! the gate's table `P(p = 1 | L, d)`, the habit's total counts `Σ ν` and its largest
 //! state's `Σ_u ν[s, u]`, and the largest off-diagonal `P(o | s)` of `A`, every 50 episodes.
 //!
@@ -36,6 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut env = Env::new(&map, EnvConfig::default())?;
     let (mut ticks, mut reasoning, mut reasoning_no_pedestrian, mut refused, mut successes) =
         (0u64, 0u64, 0u64, 0u64, 0u64);
+    let mut checked_no_pedestrian = 0u64;
     let mut declined = 0u64;
     let mut empty_reasoning = Vec::new();
     let mut per_episode = Vec::new();
@@ -63,9 +65,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for t in trace.iter().filter(|t| t.reasoned && t.state.p == 0) {
             reasoning_no_pedestrian += 1;
             let refused = agent.refused_history()[t.step as usize];
+            let checked = agent.checked_history()[t.step as usize];
+            checked_no_pedestrian += u64::from(checked);
             empty_reasoning.push(serde_json::json!({
                 "episode": ep, "step": t.step, "state": [t.state.d, t.state.v, t.state.l, t.state.p],
-                "theta": t.theta, "policy": t.policy, "refused_handback": refused,
+                "theta": t.theta, "policy": t.policy, "refused_handback": refused, "competence_check": checked,
             }));
         }
         refused += agent.refused_history().iter().filter(|r| **r).count() as u64;
@@ -83,6 +87,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         serde_json::json!({
             "map": map.name, "episodes": episodes, "successes": successes, "ticks": ticks,
             "reasoning_ticks": reasoning, "reasoning_ticks_without_pedestrian": reasoning_no_pedestrian,
+            "of_them_by_the_competence_check": checked_no_pedestrian,
             "reasoning_without_pedestrian": empty_reasoning, "refused_handbacks": refused, "declined_triggers": declined, "reasoning_per_episode_by_50": blocks, "drift": drift,
         })
     );
