@@ -141,3 +141,129 @@ pub fn evaluate_external(
     progress.finish();
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::episodes::experiments::evaluate_scripted;
+    use crate::episodes::methods::Method;
+    use crate::episodes::reference::NeverBrake;
+    use crate::progress::NoProgress;
+    use unforeseen_agent::controller::{Controller, Decision};
+    use unforeseen_env::ObservationForm;
+
+    fn untimed(mut results: Vec<EpisodeResult>) -> Vec<EpisodeResult> {
+        for r in &mut results {
+            (r.decide_ns, r.reasoning_ns) = (0, 0);
+        }
+        results
+    }
+
+    fn jaywalk() -> Scenario {
+        Scenario::of_map(unforeseen_sim::embedded::load("jaywalk").unwrap(), "embedded:jaywalk")
+    }
+
+    fn method(name: &str, observation: ObservationForm) -> ExternalMethod<'_> {
+        ExternalMethod {
+            name,
+            config: EnvConfig {
+                observation,
+                ..EnvConfig::default()
+            },
+            learns: false,
+            planning: None,
+        }
+    }
+
+    #[test]
+    fn a_controller_given_under_a_built_in_name_runs_that_methods_episodes() {
+        let scenario = jaywalk();
+        let mut make = || Ok(Box::new(NeverBrake) as Box<dyn Controller>);
+        let protocols = [Protocol::Continual, Protocol::ZeroShot];
+        let method = method("never-brake", ObservationForm::Discrete);
+        let place = LinePlace {
+            first_unit: 4,
+            ..LinePlace::default()
+        };
+        let runs = evaluate_external(&scenario, &method, &mut make, &protocols, place, 6, 3, &NoProgress).unwrap();
+        // It does not learn: one run, covering both protocols, named by the first.
+        assert_eq!(runs.len(), 1);
+        let run = &runs[0];
+        assert_eq!((run.line.unit, run.line.protocol), (4, Protocol::Continual));
+        assert_eq!(run.line.covers, protocols);
+        let map = scenario.map().unwrap();
+        let built_in = evaluate_scripted(map, Method::NeverBrake, 6, 3, &NoProgress).unwrap();
+        assert_eq!(untimed(run.episodes.clone()), untimed(built_in.clone()));
+        let agg = Aggregate::of(&built_in);
+        assert_eq!(run.line.collision_rate, agg.collision_rate);
+        assert!(agg.collision_rate > 0.0);
+        // Under another name, the same world (never-brake ignores its seed).
+        let other = method("careless", ObservationForm::Discrete);
+        let runs = evaluate_external(&scenario, &other, &mut make, &protocols, place, 6, 3, &NoProgress).unwrap();
+        assert_eq!(untimed(runs[0].episodes.clone()), untimed(built_in));
+    }
+
+    /// Records the length of each vector it is handed, and checks one comes before each act.
+    struct Sees<'a> {
+        lens: &'a std::sync::Mutex<Vec<usize>>,
+        seen: usize,
+        acted: usize,
+    }
+
+    impl Controller for Sees<'_> {
+        fn name(&self) -> &'static str {
+            "sees"
+        }
+        fn begin_episode(&mut self, _seed: u64) {}
+        fn see_features(&mut self, features: &[f32]) {
+            self.seen += 1;
+            self.lens.lock().unwrap().push(features.len());
+        }
+        fn act(&mut self, _obs: usize) -> Decision {
+            self.acted += 1;
+            Decision {
+                // An action the env refuses if no vector came first.
+                action: if self.seen == self.acted { 1 } else { 3 },
+                ..Decision::default()
+            }
+        }
+    }
+
+    #[test]
+    fn a_kinematic_env_hands_the_controller_its_vector_before_each_act() {
+        let scenario = jaywalk();
+        for (form, len) in [
+            (ObservationForm::Kinematic, Some(unforeseen_env::kinematic::len(4))),
+            (ObservationForm::Discrete, None),
+        ] {
+            let lens = std::sync::Mutex::new(Vec::new());
+            let mut make = || {
+                Ok(Box::new(Sees {
+                    lens: &lens,
+                    seen: 0,
+                    acted: 0,
+                }) as Box<dyn Controller + '_>)
+            };
+            let method = method("sees", form);
+            let one = LinePlace::default();
+            let result = evaluate_external(&scenario, &method, &mut make, &[Protocol::ZeroShot], one, 1, 1, &NoProgress);
+            let lens = lens.into_inner().unwrap();
+            match len {
+                Some(len) => {
+                    let ticks = result.unwrap()[0].line.mean_ticks as usize;
+                    assert!(ticks > 0);
+                    assert_eq!(lens, vec![len; ticks]);
+                }
+                // No vector: the controller answers with an action the env refuses.
+                None => assert!(result.is_err() && lens.is_empty()),
+            }
+        }
+    }
+
+    #[test]
+    fn the_planning_tree_counts_every_prefix() {
+        let mut p = ScaledParams::default();
+        p.planning.horizon = 3;
+        assert_eq!(efe_prefix_tree(&p), 3 + 9 + 27);
+    }
+}

@@ -6,7 +6,11 @@ policy's name, and the policy's exceptions raised as they were."""
 from __future__ import annotations
 
 import json
+import os
+import signal
 import subprocess
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -144,6 +148,21 @@ def test_keyboard_interrupt_in_the_policy_stops_the_evaluation():
     with pytest.raises(KeyboardInterrupt):
         evaluate_policy(policy, "jaywalk", episodes=50, method="ctrl-c")
     assert len(calls) == 5
+
+
+def test_ctrl_c_stops_an_evaluation_that_calls_no_python(agent):
+    # The scaled agent around its Q-table calls no Python each tick: the episodes run with
+    # the GIL released (the timer's thread runs meanwhile), and the signal is seen at the
+    # end of the episode it arrives in.
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    started = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            evaluate_policy(unforeseen.ScaledWrapper(agent=agent), "jaywalk", episodes=20_000)
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - started < 60
 
 
 @pytest.mark.parametrize("answer", [3, -1, "1", 1.0, (1, {})])
