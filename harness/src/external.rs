@@ -136,7 +136,10 @@ pub fn evaluate_external(
             timing_us_per_tick: agg.us_per_tick,
             per_map: Vec::new(),
         };
-        out.push(ExternalRun { line, episodes: results });
+        out.push(ExternalRun {
+            line,
+            episodes: results,
+        });
     }
     progress.finish();
     Ok(out)
@@ -246,7 +249,16 @@ mod tests {
             };
             let method = method("sees", form);
             let one = LinePlace::default();
-            let result = evaluate_external(&scenario, &method, &mut make, &[Protocol::ZeroShot], one, 1, 1, &NoProgress);
+            let result = evaluate_external(
+                &scenario,
+                &method,
+                &mut make,
+                &[Protocol::ZeroShot],
+                one,
+                1,
+                1,
+                &NoProgress,
+            );
             let lens = lens.into_inner().unwrap();
             match len {
                 Some(len) => {

@@ -92,7 +92,10 @@ impl PythonCall {
 
     /// Whether the run already failed.
     fn failed(&self) -> bool {
-        self.failure.lock().unwrap_or_else(std::sync::PoisonError::into_inner).is_some()
+        self.failure
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .is_some()
     }
 
     /// Keeps the run's first failure.
@@ -103,7 +106,10 @@ impl PythonCall {
 
     /// The run's first failure, taken.
     fn take_failure(&self) -> Option<PyErr> {
-        self.failure.lock().unwrap_or_else(std::sync::PoisonError::into_inner).take()
+        self.failure
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take()
     }
 
     /// Calls `reset(seed)`, if the object has one (a failure is kept).
@@ -309,7 +315,9 @@ pub fn evaluate_policy<'py>(
 ) -> PyResult<Vec<(Bound<'py, PyAny>, Bound<'py, PyAny>)>> {
     check_episodes("episodes", episodes).map_err(errors::to_py)?;
     if method.is_empty() {
-        return Err(errors::value("method: name the method its lines carry, e.g. 'my-policy'"));
+        return Err(errors::value(
+            "method: name the method its lines carry, e.g. 'my-policy'",
+        ));
     }
     let protocols = protocols
         .iter()
@@ -324,9 +332,10 @@ pub fn evaluate_policy<'py>(
         Ok(wrapper) => {
             let wrapper = wrapper.get();
             let call = match &wrapper.habit {
-                Habit::External { object: Some(object), form } => {
-                    Some(PythonCall::resolve(object.bind(py), "probs", "habit", *form, disc()?)?)
-                }
+                Habit::External {
+                    object: Some(object),
+                    form,
+                } => Some(PythonCall::resolve(object.bind(py), "probs", "habit", *form, disc()?)?),
                 Habit::External { object: None, .. } => {
                     return Err(errors::value(
                         "this ScaledHabitAgent has no habit to ask each tick: build it with habit=",
@@ -375,13 +384,19 @@ pub fn evaluate_policy<'py>(
     };
     let runs = py.detach(|| -> Result<Vec<ExternalRun>, Error> {
         let mut make = || fresh_controller(&evaluated);
-        evaluate_external(scenario, &external, &mut make, &protocols, place, episodes, seed, &watch)
+        evaluate_external(
+            scenario, &external, &mut make, &protocols, place, episodes, seed, &watch,
+        )
     });
     // A Python failure (the policy's exception, a bad answer, a signal) is raised as it
     // was, before the library's error it caused.
-    let failure = call
-        .and_then(PythonCall::take_failure)
-        .or_else(|| watch.signal.lock().unwrap_or_else(std::sync::PoisonError::into_inner).take());
+    let failure = call.and_then(PythonCall::take_failure).or_else(|| {
+        watch
+            .signal
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take()
+    });
     if let Some(e) = failure {
         return Err(e);
     }

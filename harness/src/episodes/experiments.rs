@@ -149,7 +149,13 @@ pub fn evaluate_in_order(
             if protocol == Protocol::ZeroShot && ep > 0 {
                 controller = make()?;
             }
-            let result = run_episode(&mut env, controller.as_mut(), eval_seeds_named(seed, map, method, ep), false)?.0;
+            let result = run_episode(
+                &mut env,
+                controller.as_mut(),
+                eval_seeds_named(seed, map, method, ep),
+                false,
+            )?
+            .0;
             crate::progress::step(progress)?;
             Ok(result)
         })
