@@ -70,9 +70,6 @@ def _runs(
     first_unit: int = 0,
 ) -> list[tuple[dict[str, Any], list[dict[str, Any]]]]:
     """``(line, episodes)`` of each run of ``policy`` on ``map``, by the library."""
-    for p in protocols:
-        if p not in PROTOCOLS:
-            raise ValueError(f"protocol {p!r}: expected one of {PROTOCOLS}")
     if isinstance(policy, ScaledWrapper):
         target, observation = policy._inner, policy.observation
     else:
