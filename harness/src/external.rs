@@ -5,7 +5,8 @@
 //! methods and the batch summary reads them alike. The fronts only make the controller.
 //!
 //! A method given from outside is known by its name alone: the name its lines carry, from
-//! which its episodes' controller seeds derive ([`eval_seeds_named`]; the world seeds
+//! which its episodes' controller seeds derive
+//! ([`eval_seeds_named`](crate::episodes::experiments::eval_seeds_named); the world seeds
 //! depend on the map and the episode only, so every method meets the same pedestrians).
 //! A policy given under a built-in method's name, and acting as it does, gives that
 //! method's line (timing aside); its line carries no expectation checks (a map's

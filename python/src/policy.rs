@@ -289,7 +289,7 @@ enum Evaluated<'a> {
 }
 
 /// Evaluates `policy` on `map` by the library's episode loop and reports it in the batch
-/// results schema: a list of `(line, episodes)`, one per run (one per protocol of
+/// results schema: a list of [`PolicyRun`]s, one per run (one per protocol of
 /// `protocols` for a policy that learns across episodes, the scaled agent around a habit
 /// with learning on; else one run whose line covers them all). `policy` follows the
 /// protocol of the module docs, or is a `ScaledHabitAgent`; `observation` is the form a
@@ -300,9 +300,9 @@ enum Evaluated<'a> {
 #[pyfunction]
 #[pyo3(signature = (policy, map, method, protocols, episodes = 100, seed = 7, train_seed = None, train_episodes = None, first_unit = 0, observation = "discrete"))]
 #[allow(clippy::too_many_arguments)]
-pub fn evaluate_policy<'py>(
-    py: Python<'py>,
-    policy: &Bound<'py, PyAny>,
+pub fn evaluate_policy(
+    py: Python<'_>,
+    policy: &Bound<'_, PyAny>,
     map: PathBuf,
     method: &str,
     protocols: Vec<String>,
@@ -312,7 +312,7 @@ pub fn evaluate_policy<'py>(
     train_episodes: Option<u64>,
     first_unit: usize,
     observation: &str,
-) -> PyResult<Vec<(Bound<'py, PyAny>, Bound<'py, PyAny>)>> {
+) -> PyResult<Vec<PolicyRun>> {
     check_episodes("episodes", episodes).map_err(errors::to_py)?;
     if method.is_empty() {
         return Err(errors::value(
@@ -400,14 +400,51 @@ pub fn evaluate_policy<'py>(
     if let Some(e) = failure {
         return Err(e);
     }
-    let runs = runs.map_err(errors::to_py)?;
-    runs.iter()
-        .map(|run| {
-            let line = serde_json::to_value(&run.line).map_err(errors::to_py)?;
-            let episodes = serde_json::to_value(&run.episodes).map_err(errors::to_py)?;
-            Ok((crate::reports::to_py(py, &line)?, crate::reports::to_py(py, &episodes)?))
-        })
-        .collect()
+    Ok(runs
+        .map_err(errors::to_py)?
+        .into_iter()
+        .map(|run| PolicyRun { run })
+        .collect())
+}
+
+/// One run of a Python policy (`evaluate_policy`): its result line, as data and as the
+/// results file's line, and its episodes.
+#[pyclass(name = "PolicyRun", module = "unforeseen._unforeseen", frozen)]
+pub struct PolicyRun {
+    run: ExternalRun,
+}
+
+#[pymethods]
+impl PolicyRun {
+    /// The result line as a dict (the batch results schema).
+    #[getter]
+    fn line<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        crate::reports::to_py(py, &serde_json::to_value(&self.run.line).map_err(errors::to_py)?)
+    }
+
+    /// The result line as the results file holds it (JSON, without the newline): the
+    /// bytes `unforeseen batch` writes for a line of the same figures.
+    #[getter]
+    fn line_text(&self) -> PyResult<String> {
+        serde_json::to_string(&self.run.line).map_err(errors::to_py)
+    }
+
+    /// Every episode, in order, as eval.json holds them (dicts).
+    #[getter]
+    fn episodes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        crate::reports::to_py(py, &serde_json::to_value(&self.run.episodes).map_err(errors::to_py)?)
+    }
+
+    fn __repr__(&self) -> String {
+        let l = &self.run.line;
+        format!(
+            "PolicyRun(method={}, scenario={}, protocol={}, episodes={})",
+            l.method,
+            l.scenario,
+            l.protocol.name(),
+            l.episodes
+        )
+    }
 }
 
 /// A fresh controller of what is evaluated: the scaled agent as built, for a wrapper.
@@ -437,8 +474,9 @@ fn env_config(form: ObservationForm) -> EnvConfig {
     }
 }
 
-/// Registers the functions.
+/// Registers the class and the function.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PolicyRun>()?;
     m.add_function(wrap_pyfunction!(evaluate_policy, m)?)?;
     Ok(())
 }

@@ -51,15 +51,21 @@ def test_a_python_never_brake_gives_the_librarys_never_brake_line(agent):
     assert mine["collision_rate"] > 0  # the jaywalker is met: the comparison covers collisions
 
 
-def test_a_python_never_brake_gives_the_command_lines_never_brake_line(tmp_path):
+def test_a_python_never_brake_writes_the_command_lines_never_brake_line(tmp_path):
+    # The results file's bytes, up to the clock (the line's last field).
     cli = required_cli()
-    out = tmp_path / "results.jsonl"
+    out = tmp_path / "cli.jsonl"
     subprocess.run([str(cli), "batch", "jaywalk", "--method", "never-brake", "--episodes", "6", "--seed", "5",
                     "--quiet", "--out", str(out)], check=True, capture_output=True)
-    [line] = [json.loads(t) for t in out.read_text().splitlines() if not t.startswith('{"run":')]
-    [mine] = unforeseen.evaluate(NeverBrake(), ["jaywalk"], [line["train_seed"]], episodes=6, seed=5,
-                                 train_episodes=line["train_episodes"])
-    assert json.dumps(untimed(mine)) == json.dumps(untimed(line))
+    [text] = [t for t in out.read_text().splitlines() if not t.startswith('{"run":')]
+    line = json.loads(text)
+    mine = tmp_path / "python.jsonl"
+    unforeseen.evaluate(NeverBrake(), ["jaywalk"], [line["train_seed"]], episodes=6, seed=5,
+                        train_episodes=line["train_episodes"], out=mine)
+    [my_text] = mine.read_text().splitlines()
+    clock = f',"{UNTIMED}":'
+    assert text.count(clock) == 1 and text.endswith("}")
+    assert my_text.split(clock)[0] == text.split(clock)[0]
 
 
 def test_a_policy_under_another_name_meets_the_same_pedestrians_with_its_own_controller_seeds():

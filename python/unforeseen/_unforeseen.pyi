@@ -19,6 +19,7 @@ __all__ = [
     "Controller",
     "Env",
     "EvalResult",
+    "PolicyRun",
     "ScaledHabitAgent",
     "VectorEnv",
     "batch_report",
@@ -190,14 +191,28 @@ def evaluate_policy(
     train_episodes: int | None = None,
     first_unit: int = 0,
     observation: str = "discrete",
-) -> list[tuple[dict[str, Any], list[dict[str, Any]]]]:
+) -> list[PolicyRun]:
     """Evaluates a Python policy (``act(obs) -> action`` or a callable, optional
     ``reset(seed)``; observations of form ``observation``) or a :class:`ScaledHabitAgent`
     (built with ``habit=`` or a habit table) on ``map`` by the library's episode loop,
-    which calls it each tick with the GIL taken for the call only: ``(result line,
-    episodes)`` per run, one per protocol for a wrapper that learns, else one covering
-    them all; lines numbered from ``first_unit``, episodes of the method named
-    ``method``. The policy's exceptions (and ``KeyboardInterrupt``) propagate."""
+    which calls it each tick with the GIL taken for the call only: a :class:`PolicyRun`
+    per run, one per protocol for a wrapper that learns, else one covering them all;
+    lines numbered from ``first_unit``, episodes of the method named ``method``. The
+    policy's exceptions (and ``KeyboardInterrupt``) propagate."""
+
+@final
+class PolicyRun:
+    """One run of :func:`evaluate_policy`: its result line and its episodes."""
+
+    @property
+    def line(self) -> dict[str, Any]:
+        """The result line (the batch results schema)."""
+    @property
+    def line_text(self) -> str:
+        """The line as the results file holds it (the bytes ``unforeseen batch`` writes)."""
+    @property
+    def episodes(self) -> list[dict[str, Any]]:
+        """Every episode, in order, as eval.json holds them."""
 def evaluate_report(
     map: str,
     method: str,

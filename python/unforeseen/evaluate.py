@@ -68,8 +68,8 @@ def _runs(
     train_seed: int | None = None,
     train_episodes: int | None = None,
     first_unit: int = 0,
-) -> list[tuple[dict[str, Any], list[dict[str, Any]]]]:
-    """``(line, episodes)`` of each run of ``policy`` on ``map``, by the library."""
+) -> list[_unforeseen.PolicyRun]:
+    """Each run of ``policy`` on ``map``, by the library: its line and episodes."""
     if isinstance(policy, ScaledWrapper):
         target, observation = policy._inner, policy.observation
     else:
@@ -95,8 +95,8 @@ def evaluate_policy(
     ``decide_ns`` and ``reasoning_ns`` (nanoseconds inside the controller) and
     ``jaywalk_surprise``."""
     name = method or getattr(policy, "method", None) or "policy"
-    [(_, results)] = _runs(policy, map, name, [protocol], episodes, seed)
-    return results
+    [run] = _runs(policy, map, name, [protocol], episodes, seed)
+    return run.episodes
 
 
 class EvaluateResult(list):
@@ -191,11 +191,11 @@ def evaluate(
                 name = method or getattr(pol, "method", None)
                 if not name:
                     raise ValueError("evaluate: name the method (method='dqn-kinematic' or a policy.method)")
-                for line, _ in _runs(pol, m, name, protocols, episodes, seed, s, train_episodes, unit):
+                for run in _runs(pol, m, name, protocols, episodes, seed, s, train_episodes, unit):
                     unit += 1
-                    lines.append(line)
+                    lines.append(run.line)
                     if fh is not None:
-                        fh.write(json.dumps(line) + "\n")
+                        fh.write(run.line_text + "\n")
                         fh.flush()
     finally:
         if fh is not None:
