@@ -167,7 +167,7 @@ mod tests {
         Scenario::of_map(unforeseen_sim::embedded::load("jaywalk").unwrap(), "embedded:jaywalk")
     }
 
-    fn method(name: &str, observation: ObservationForm) -> ExternalMethod<'_> {
+    fn named(name: &str, observation: ObservationForm) -> ExternalMethod<'_> {
         ExternalMethod {
             name,
             config: EnvConfig {
@@ -184,7 +184,7 @@ mod tests {
         let scenario = jaywalk();
         let mut make = || Ok(Box::new(NeverBrake) as Box<dyn Controller>);
         let protocols = [Protocol::Continual, Protocol::ZeroShot];
-        let method = method("never-brake", ObservationForm::Discrete);
+        let method = named("never-brake", ObservationForm::Discrete);
         let place = LinePlace {
             first_unit: 4,
             ..LinePlace::default()
@@ -202,7 +202,7 @@ mod tests {
         assert_eq!(run.line.collision_rate, agg.collision_rate);
         assert!(agg.collision_rate > 0.0);
         // Under another name, the same world (never-brake ignores its seed).
-        let other = method("careless", ObservationForm::Discrete);
+        let other = named("careless", ObservationForm::Discrete);
         let runs = evaluate_external(&scenario, &other, &mut make, &protocols, place, 6, 3, &NoProgress).unwrap();
         assert_eq!(untimed(runs[0].episodes.clone()), untimed(built_in));
     }
@@ -248,7 +248,7 @@ mod tests {
                     acted: 0,
                 }) as Box<dyn Controller + '_>)
             };
-            let method = method("sees", form);
+            let method = named("sees", form);
             let one = LinePlace::default();
             let result = evaluate_external(
                 &scenario,
