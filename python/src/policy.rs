@@ -40,7 +40,7 @@ use crate::wrapper::{Habit, PyScaledHabitAgent, Wrapped};
 const STOP: usize = usize::MAX;
 
 /// A Python callable asked each tick, and the run's first failure.
-pub struct PythonCall {
+struct PythonCall {
     /// `act` (or `probs`), or the object itself where it is the callable.
     call: Py<PyAny>,
     /// The object's `reset(seed)`, if it has one.
@@ -56,7 +56,7 @@ pub struct PythonCall {
 impl PythonCall {
     /// `object.<method>` if it has that method, else `object` itself if it is callable
     /// (a `TypeError` naming `what` otherwise); its `reset` if it has one.
-    pub fn resolve(
+    fn resolve(
         object: &Bound<'_, PyAny>,
         method: &str,
         what: &str,
