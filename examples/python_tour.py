@@ -87,7 +87,7 @@ if have("stable_baselines3"):
 
         method, observation = "sb3-dqn-kinematic", "kinematic"
 
-        def act(self, obs, info):
+        def act(self, obs):
             return int(model.predict(obs, deterministic=True)[0])
 
         def probs(self, obs):

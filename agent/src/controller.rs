@@ -62,6 +62,12 @@ pub trait Controller: Send {
     fn name(&self) -> &'static str;
     /// Clear beliefs and history; seed any sampling RNG (ChaCha8).
     fn begin_episode(&mut self, seed: u64);
+    /// The observation of the coming tick as features (the env's kinematic vector,
+    /// docs/ARCHITECTURE.md §3), given just before [`Controller::act`] when the episode's
+    /// env observes in that form: for a controller that reads more than the discrete
+    /// observation (a policy given from outside, e.g. from Python). The methods of the
+    /// paper read the discrete observation alone and ignore it.
+    fn see_features(&mut self, _features: &[f32]) {}
     /// Decide the action for observation `obs`.
     fn act(&mut self, obs: usize) -> Decision;
     /// Online evidence after acting: the reward, the next observation, and whether the

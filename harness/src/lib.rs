@@ -30,6 +30,8 @@
 //!   [`compare`](runs::compare) study (the paper's table over agents and protocols),
 //!   [`merge`](runs::merge) of shard files and the [`search`](runs::search) for fair
 //!   failing scenarios;
+//! * [`external`]: methods given from outside the library (a Python policy), evaluated
+//!   by the same runner and reported as the batch's result lines;
 //! * [`reports`]: result [`files`](reports::files) written atomically, SVG
 //!   [`figures`](reports::figures) and the HTML [`replay_page`](reports::replay_page) of
 //!   an episode.
@@ -48,6 +50,7 @@
 
 pub mod episodes;
 pub mod error;
+pub mod external;
 pub mod limits;
 pub mod maps;
 pub mod overrides;

@@ -356,12 +356,17 @@ impl PyController {
     }
 }
 
-/// `(world, controller)` seeds of evaluation episode `episode` of `method` on `map`, as
-/// `unforeseen eval` uses them ([`unforeseen_harness::episodes::experiments::eval_seeds`]).
+/// `(world, controller)` seeds of evaluation episode `episode` of the method named
+/// `method` on `map`, as `unforeseen eval` uses them: a built-in method's, or a Python
+/// policy's under the name its lines carry
+/// ([`unforeseen_harness::episodes::experiments::eval_seeds_named`]).
 #[pyfunction]
 fn eval_seeds(seed: u64, map: &str, method: &str, episode: u64) -> PyResult<(u64, u64)> {
+    if method.is_empty() {
+        return Err(errors::value("method: give a method's name, e.g. 'scaled'"));
+    }
     let map = crate::maps::load(map, None)?;
-    let s = unforeseen_harness::episodes::experiments::eval_seeds(seed, &map, self::method(method)?, episode);
+    let s = unforeseen_harness::episodes::experiments::eval_seeds_named(seed, &map, method, episode);
     Ok((s.world, s.controller))
 }
 

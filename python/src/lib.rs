@@ -15,6 +15,8 @@
 //! * [`reports`]: the reports of `compare`, `eval` and `batch` as Python objects: their
 //!   files' data, and the command line's printed table as `str()`, Markdown and HTML;
 //! * [`wrapper`]: the scaled agent around any habit, and the batch summary of a results file;
+//! * [`policy`]: Python policies (and the scaled agent around a Python habit) evaluated by
+//!   the library's episode loop, reported as the batch's result lines;
 //! * [`units`]: a batch run as units of work for a distributed driver (plan, train a
 //!   seed, run a block of units with the GIL released, join the results);
 //! * [`errors`]: Rust errors as Python exceptions (`ValueError` for what the user can fix).
@@ -24,6 +26,7 @@ mod env;
 mod errors;
 mod interrupt;
 mod maps;
+mod policy;
 mod render;
 mod reports;
 mod results;
@@ -57,6 +60,7 @@ fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     results::register(m)?;
     reports::register(m)?;
     wrapper::register(m)?;
+    policy::register(m)?;
     units::register(m)?;
     search_units::register(m)?;
     Ok(())

@@ -14,15 +14,20 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_agent::habit::{PolicyHabit, TableHabit};
+use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::scaled_agent::ScaledAgent;
+use unforeseen_env::ObservationForm;
 use unforeseen_harness::episodes::methods::Method;
 
 use crate::agent::{PyAgent, decision_dict, scaled_params};
 use crate::errors;
 
 /// The agent, with either kind of habit.
-enum Wrapped {
+#[derive(Clone)]
+pub enum Wrapped {
+    /// Around a table of probabilities per state.
     Table(Box<ScaledAgent<TableHabit>>),
+    /// Around probabilities given each tick.
     Policy(Box<ScaledAgent<PolicyHabit>>),
 }
 
@@ -33,21 +38,62 @@ impl Wrapped {
             Wrapped::Policy(a) => a.as_mut(),
         }
     }
+
+    /// The agent as the runner's controller (its habit's probabilities, for an external
+    /// habit, as the last tick left them: [`crate::policy`] asks the habit instead).
+    pub fn into_controller(self) -> Box<dyn Controller> {
+        match self {
+            Wrapped::Table(a) => a,
+            Wrapped::Policy(a) => a,
+        }
+    }
 }
 
-fn agent_error(e: unforeseen_agent::error::AgentError) -> PyErr {
+/// Where the habit's probabilities come from.
+pub enum Habit {
+    /// The habit table given at construction.
+    Table,
+    /// A Python habit asked each tick (`probs(obs)` or a callable obs -> probabilities,
+    /// [`crate::policy`]) with observations of `form`; without an object, the
+    /// probabilities come with each `act`.
+    External {
+        /// The habit, if given.
+        object: Option<Py<PyAny>>,
+        /// The form of the observations it reads.
+        form: ObservationForm,
+    },
+}
+
+/// The wrapper's refusal of `e` as a `ValueError`.
+pub fn agent_error(e: unforeseen_agent::error::AgentError) -> PyErr {
     errors::value(format!("scaled wrapper: {e}"))
 }
 
 /// The scaled agent of `agent` around a habit: `habit_table` (an `(n_states, n_actions)`
-/// array of probabilities per state), or, without one, the probabilities passed to `act`
-/// each tick. Keywords are the scaled agent's parameters (the keys of `--set`).
-#[pyclass(name = "ScaledHabitAgent", module = "unforeseen._unforeseen")]
+/// array of probabilities per state), or, without one, an external habit: the
+/// probabilities passed to `act` each tick, and `habit` (a callable obs -> probabilities,
+/// or an object with `probs(obs)`; observations of form `observation`), which
+/// `evaluate_policy` asks each tick. Keywords are the scaled agent's parameters (the keys
+/// of `--set`).
+#[pyclass(name = "ScaledHabitAgent", module = "unforeseen._unforeseen", frozen)]
 pub struct PyScaledHabitAgent {
     inner: Mutex<Wrapped>,
+    /// The agent as built, before any episode: each evaluation starts from a copy.
+    pristine: Wrapped,
     sizes: Vec<usize>,
-    external: bool,
-    learns: bool,
+    /// The scaled agent's parameters (the planning tree of its lines' reasoning compute).
+    pub params: ScaledParams,
+    /// Where the habit's probabilities come from.
+    pub habit: Habit,
+    /// Whether test-time learning carries over between episodes.
+    pub learns: bool,
+}
+
+impl PyScaledHabitAgent {
+    /// A fresh copy of the agent as built (nothing learned at test time).
+    pub fn fresh(&self) -> Wrapped {
+        self.pristine.clone()
+    }
 }
 
 impl PyScaledHabitAgent {
@@ -64,15 +110,21 @@ impl PyScaledHabitAgent {
 #[pymethods]
 impl PyScaledHabitAgent {
     #[new]
-    #[pyo3(signature = (agent, habit_table = None, **params))]
+    #[pyo3(signature = (agent, habit_table = None, habit = None, observation = "discrete", **params))]
     fn new(
         agent: &PyAgent,
         habit_table: Option<PyReadonlyArray2<'_, f64>>,
+        habit: Option<Py<PyAny>>,
+        observation: &str,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         let p = scaled_params(params)?;
         let learns = Method::Scaled.learns_across_episodes(&p);
-        let checked = p.check().map_err(|e| errors::value(e.to_string()))?;
+        let form = crate::env::observation_form(observation)?;
+        if habit_table.is_some() && habit.is_some() {
+            return Err(errors::value("habit_table and habit: give one or the other"));
+        }
+        let checked = p.clone().check().map_err(|e| errors::value(e.to_string()))?;
         let model = agent.bundle.world_model.clone();
         let (n, na) = (model.n_states(), model.n_actions());
         let nu0 = checked.learning.nu0;
@@ -97,9 +149,15 @@ impl PyScaledHabitAgent {
             }
         };
         Ok(PyScaledHabitAgent {
+            pristine: inner.clone(),
             inner: Mutex::new(inner),
             sizes: agent.bundle.world_model.structure().sizes(),
-            external,
+            params: p,
+            habit: if external {
+                Habit::External { object: habit, form }
+            } else {
+                Habit::Table
+            },
             learns,
         })
     }
@@ -107,7 +165,20 @@ impl PyScaledHabitAgent {
     /// Whether the habit's probabilities come with each `act` (no habit table).
     #[getter]
     fn external(&self) -> bool {
-        self.external
+        matches!(self.habit, Habit::External { .. })
+    }
+
+    /// The form of the observations the external habit reads (`"discrete"` with a
+    /// habit table).
+    #[getter]
+    fn observation(&self) -> &'static str {
+        match self.habit {
+            Habit::External {
+                form: ObservationForm::Kinematic,
+                ..
+            } => "kinematic",
+            _ => "discrete",
+        }
     }
 
     /// Whether test-time learning carries over between episodes, as the library decides
@@ -188,7 +259,7 @@ impl PyScaledHabitAgent {
     fn __repr__(&self) -> String {
         format!(
             "ScaledHabitAgent(habit={})",
-            if self.external { "external policy" } else { "table" }
+            if self.external() { "external policy" } else { "table" }
         )
     }
 }

@@ -19,7 +19,7 @@ class AlwaysFast:
     method = "always-fast"
     observation = "kinematic"
 
-    def act(self, obs, info):
+    def act(self, obs):
         return 1
 
 
@@ -69,6 +69,6 @@ def test_bad_arguments_say_what_to_fix():
     with pytest.raises(ValueError, match="at least one"):
         unforeseen.evaluate(AlwaysFast(), [], [None], episodes=1)
     with pytest.raises(ValueError, match="name the method"):
-        unforeseen.evaluate(lambda s: type("P", (), {"act": lambda self, o, i: 0})(), ["jaywalk"], [None], episodes=1)
+        unforeseen.evaluate(lambda s: type("P", (), {"act": lambda self, o: 0})(), ["jaywalk"], [None], episodes=1)
     with pytest.raises(ValueError, match="episodes 0"):
         unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=0)

@@ -24,7 +24,7 @@ MAPS = Path(__file__).resolve().parents[2] / "maps"
 class AlwaysFast:
     method = "always-fast"
 
-    def act(self, obs, info):
+    def act(self, obs):
         return 1
 
 

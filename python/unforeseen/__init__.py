@@ -32,7 +32,7 @@ from ._unforeseen import (
     train_agents,
 )
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
-from .evaluate import EvaluateResult, evaluate, summarize
+from .evaluate import EvaluateResult, evaluate, evaluate_policy, summarize
 from .search import search
 from .vector import VectorEnv
 from .wrapper import ScaledWrapper, q_table_habit
@@ -58,6 +58,7 @@ __all__ = [
     "eval_seeds",
     "evaluate",
     "evaluate_builtin",
+    "evaluate_policy",
     "load_agent",
     "make_env",
     "q_table_habit",
@@ -109,7 +110,10 @@ def train(map: str = "intersection", episodes: int = 6000, seed: int = 7) -> Age
 
 
 def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int]:
-    """``(world, controller)`` seeds of evaluation episode ``episode`` (as ``unforeseen eval``)."""
+    """``(world, controller)`` seeds of evaluation episode ``episode`` of the method named
+    ``method`` on ``map`` (as ``unforeseen eval`` uses them): the world seed depends on
+    ``seed``, the map and the episode only; the controller seed on the name too (a
+    built-in method's, or the name a Python policy's lines carry, :func:`evaluate`)."""
     return _unforeseen.eval_seeds(seed, map, method, episode)
 
 
@@ -138,49 +142,13 @@ def rollout(
     protocol: str = "zero-shot",
     **params: Any,
 ) -> list[dict[str, Any]]:
-    """The same evaluation as :func:`evaluate_builtin`, driven from Python: a loop over
-    :class:`UnforeseenEnv` and a :class:`Controller`, with the per-episode seeds of
-    ``unforeseen eval`` (:func:`eval_seeds`). Under ``zero-shot`` every episode gets a
-    fresh controller; under ``continual`` one controller learns across episodes. The
-    controller is built for ``map``, as the library builds it (the scripted
-    ``brake-on-pedestrian`` follows the map's red-light rule).
-    Returns per episode ``ret``, ``success``, ``collision``, ``timeout``, ``ticks``,
-    ``reasoning_ticks`` and ``jaywalk_surprise`` (the fields of eval.json's episodes
-    that do not measure time)."""
-    env = UnforeseenEnv(map)
-
-    def make() -> Controller:
-        if agent is None:
-            return scripted_controller(method, map)
-        return agent.controller(method, map, **params)
-
-    controller = make()
-    results = []
-    for ep in range(episodes):
-        world, ctrl_seed = eval_seeds(seed, map, method, ep)
-        if protocol == "zero-shot" and ep > 0:
-            controller = make()
-        obs, info = env.reset(options={"world_seed": world})
-        controller.begin_episode(ctrl_seed)
-        r = {"ret": 0.0, "success": False, "collision": False, "timeout": False, "ticks": 0,
-             "reasoning_ticks": 0, "jaywalk_surprise": None}
-        while True:
-            action, decision = controller.act(obs)
-            r["reasoning_ticks"] += decision["reasoned"]
-            if r["jaywalk_surprise"] is None and info["state"][3] == 1 and info["state"][2] == 1:
-                r["jaywalk_surprise"] = decision["surprise"]
-            obs, reward, terminated, truncated, info = env.step(action)
-            r["ret"] += reward
-            r["ticks"] += 1
-            controller.observe(reward, obs, terminated, truncated)
-            if terminated or truncated:
-                r["collision"] = info["collision"]
-                r["success"] = info["goal"] and not info["collision"]
-                r["timeout"] = info["timeout"]
-                break
-        controller.end_episode()
-        results.append(r)
-    return results
+    """The episodes of :func:`evaluate_builtin` (the library's evaluation, as ``unforeseen
+    eval`` runs it) without the fields that measure time: per episode ``ret``,
+    ``success``, ``collision``, ``timeout``, ``ticks``, ``reasoning_ticks`` and
+    ``jaywalk_surprise``. To evaluate a Python policy, see :func:`evaluate`."""
+    report = evaluate_builtin(map, method, episodes, seed, agent, protocol, **params)
+    keys = ("ret", "success", "collision", "timeout", "ticks", "reasoning_ticks", "jaywalk_surprise")
+    return [{k: e[k] for k in keys} for e in report["episodes"]]
 
 
 def compare(

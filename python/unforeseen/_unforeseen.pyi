@@ -19,6 +19,7 @@ __all__ = [
     "Controller",
     "Env",
     "EvalResult",
+    "PolicyRun",
     "ScaledHabitAgent",
     "VectorEnv",
     "batch_report",
@@ -26,6 +27,7 @@ __all__ = [
     "compare_report",
     "embedded_maps",
     "eval_seeds",
+    "evaluate_policy",
     "evaluate_report",
     "load_agent",
     "q_table_habit",
@@ -175,7 +177,42 @@ def train_agents(
     timeout_as: str = "truncation",
 ) -> list[Agent]: ...
 def scripted_controller(method: str, map: str = "jaywalk") -> Controller: ...
-def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int]: ...
+def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int]:
+    """``(world, controller)`` seeds of evaluation episode ``episode`` of the method named
+    ``method`` (a built-in method's name, or the name a Python policy's lines carry)."""
+def evaluate_policy(
+    policy: Any,
+    map: str,
+    method: str,
+    protocols: Sequence[str],
+    episodes: int = 100,
+    seed: int = 7,
+    train_seed: int | None = None,
+    train_episodes: int | None = None,
+    first_unit: int = 0,
+    observation: str = "discrete",
+) -> list[PolicyRun]:
+    """Evaluates a Python policy (``act(obs) -> action`` or a callable, optional
+    ``reset(seed)``; observations of form ``observation``) or a :class:`ScaledHabitAgent`
+    (built with ``habit=`` or a habit table) on ``map`` by the library's episode loop,
+    which calls it each tick with the GIL taken for the call only: a :class:`PolicyRun`
+    per run, one per protocol for a wrapper that learns, else one covering them all;
+    lines numbered from ``first_unit``, episodes of the method named ``method``. The
+    policy's exceptions (and ``KeyboardInterrupt``) propagate."""
+
+@final
+class PolicyRun:
+    """One run of :func:`evaluate_policy`: its result line and its episodes."""
+
+    @property
+    def line(self) -> dict[str, Any]:
+        """The result line (the batch results schema)."""
+    @property
+    def line_text(self) -> str:
+        """The line as the results file holds it (the bytes ``unforeseen batch`` writes)."""
+    @property
+    def episodes(self) -> list[dict[str, Any]]:
+        """Every episode, in order, as eval.json holds them."""
 def evaluate_report(
     map: str,
     method: str,
@@ -317,12 +354,23 @@ class BatchResult:
 @final
 class ScaledHabitAgent:
     """The scaled agent of ``agent`` around a habit: ``habit_table`` (``(n_states,
-    n_actions)`` probabilities per state) or, without one, the probabilities given to
-    ``act`` each tick (``unforeseen_agent::habit``)."""
+    n_actions)`` probabilities per state) or, without one, an external habit: the
+    probabilities given to ``act`` each tick, and ``habit`` (``probs(obs)`` or a callable
+    ``obs -> probabilities``, observations of form ``observation``), which
+    :func:`evaluate_policy` asks each tick (``unforeseen_agent::habit``)."""
 
-    def __init__(self, agent: Agent, habit_table: npt.NDArray[np.float64] | None = None, **params: Any) -> None: ...
+    def __init__(
+        self,
+        agent: Agent,
+        habit_table: npt.NDArray[np.float64] | None = None,
+        habit: Any = None,
+        observation: str = "discrete",
+        **params: Any,
+    ) -> None: ...
     @property
     def external(self) -> bool: ...
+    @property
+    def observation(self) -> str: ...
     @property
     def learns(self) -> bool: ...
     def begin_episode(self, seed: int) -> None: ...

@@ -80,8 +80,8 @@ class TrainConfig:
 
 
 class DeepPolicy:
-    """A trained network as a policy: ``act(obs, info)`` (greedy), ``probs(obs)`` (the
-    habit's probabilities), numpy only."""
+    """A trained network as a policy (the protocol of :mod:`unforeseen.evaluate`):
+    ``act(obs)`` (greedy), ``probs(obs)`` (the habit's probabilities), numpy only."""
 
     def __init__(self, weights: list[tuple[np.ndarray, np.ndarray]], mean: np.ndarray, var: np.ndarray,
                  algo: str, observation: str, temperature: float = 1.0, meta: dict[str, Any] | None = None):
@@ -92,7 +92,6 @@ class DeepPolicy:
         self.observation = observation
         self.temperature = temperature
         self.method = f"{algo}-{observation}"
-        self.learns = False
         self.meta = meta or {}
 
     def logits(self, obs: Any) -> np.ndarray:
@@ -112,7 +111,7 @@ class DeepPolicy:
         z = np.exp(z - z.max())
         return z / z.sum()
 
-    def act(self, obs: Any, info: dict[str, Any] | None = None) -> int:
+    def act(self, obs: Any) -> int:
         """The greedy action (ties to the lowest index)."""
         return int(np.argmax(self.logits(obs)))
 
@@ -296,7 +295,8 @@ def train(cfg: TrainConfig, seed: int, progress: bool = False) -> tuple[DeepPoli
 
 
 def success_on(policy: Any, map: str = "intersection", episodes: int = 100, seed: int = 7) -> float:
-    """Success rate of ``policy`` on ``map`` over the evaluation episodes."""
+    """Success rate of ``policy`` on ``map`` over the evaluation episodes (zero-shot), by
+    the library's episode loop."""
     from .evaluate import evaluate_policy
 
     rs = evaluate_policy(policy, map, episodes, "zero-shot", seed)

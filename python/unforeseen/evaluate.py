@@ -1,26 +1,48 @@
 """Python policies as methods in the tables: :func:`evaluate` runs any policy on the
-maps with the evaluation episodes of ``unforeseen eval`` / ``unforeseen batch`` (the
-same world seeds: every method meets the same pedestrians) and writes lines of the
-batch results schema (``unforeseen::batch::ResultLine``), which the batch summary
-(:func:`summarize`) and ``unforeseen plot-sweep`` read beside the built-in methods.
+maps by the library's episode loop (the Rust runner of ``unforeseen eval`` and
+``unforeseen batch``, which calls the policy each tick) and returns lines of the batch
+results schema (``unforeseen_harness::runs::batch::ResultLine``), built by the library
+from the same figures as the built-in methods' lines; the batch summary
+(:func:`summarize`) and ``unforeseen plot-sweep`` read them beside the built-in methods.
+Python computes no figure.
 
-A policy is any object with ``act(obs, info)`` returning an action or
-``(action, decision)`` (a decision dict with ``reasoned``, as :class:`unforeseen.Controller`
-gives); optional: ``observation`` (``"discrete"`` or ``"kinematic"``, the env form it
-reads), ``method`` (its name in the lines), ``learns`` (whether it learns across
-episodes), ``begin_episode(seed)``, ``observe(reward, obs, info, terminated, truncated)``,
-``end_episode()`` and ``reset_learning()`` (called before every zero-shot episode).
+**The policy protocol** (the one way a Python policy is given, to :func:`evaluate`,
+:func:`evaluate_policy` and, as a habit, to :class:`~unforeseen.ScaledWrapper`):
+
+* ``act(obs) -> action``: an object with this method (a function ``obs -> action`` is
+  accepted where a policy alone is expected: :func:`evaluate_policy`; in
+  :func:`evaluate` a callable without ``act`` is a factory ``train_seed -> policy``).
+  ``obs`` is the observation the Gymnasium env (:class:`~unforeseen.UnforeseenEnv`)
+  gives: int64 ``(d, v, L, p)`` as observed, or the float32 kinematic vector; ``action``
+  an integer 0 (maintain), 1 (speed up) or 2 (slow down);
+* optional ``reset(seed)``: called at the start of every episode, with the episode's
+  controller seed (for a policy that samples);
+* optional attributes ``observation`` (``"discrete"``, the default, or ``"kinematic"``:
+  the form ``obs`` takes) and ``method`` (its name in the lines).
+
+A habit of :class:`~unforeseen.ScaledWrapper` follows the same protocol with
+``probs(obs) -> probabilities`` (or a callable ``obs -> probabilities``) in place of
+``act``. A plain policy does not learn across episodes (nothing but ``obs`` reaches it),
+so it runs once and its line covers every protocol asked; the scaled agent around a
+habit learns (unless ``learning=False``) and runs once per protocol, each run from the
+agent as built (zero-shot: afresh every episode).
+
+The episodes are those of ``unforeseen eval`` for a method of the policy's name: the
+world seeds derive from the evaluation seed, the map and the episode (every method meets
+the same pedestrians), the controller seeds (``reset(seed)``) from the method's name too
+(:func:`unforeseen.eval_seeds`). So a policy named after a built-in method that acts as
+it does (``never-brake``: always speed up) gives that method's line, timing aside.
+Exceptions raised by the policy (and ``KeyboardInterrupt``) propagate as they were.
 """
 
 from __future__ import annotations
 
 import json
 import os
-import time
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Iterable, Mapping
 
 from . import _unforeseen
-from .envs import UnforeseenEnv
+from .wrapper import ScaledWrapper
 
 __all__ = ["EvaluateResult", "evaluate", "evaluate_policy", "summarize", "PROTOCOLS"]
 
@@ -36,10 +58,24 @@ def _source(map: str) -> tuple[str, str]:
     return name, f"embedded:{map}"
 
 
-def _efe_tree(params: Mapping[str, Any]) -> int:
-    """U + U^2 + ... + U^H, the prefix-tree size of a plan (3 actions)."""
-    h = int(params.get("horizon", 3))
-    return sum(3**k for k in range(1, h + 1))
+def _runs(
+    policy: Any,
+    map: str,
+    method: str,
+    protocols: list[str],
+    episodes: int,
+    seed: int,
+    train_seed: int | None = None,
+    train_episodes: int | None = None,
+    first_unit: int = 0,
+) -> list[_unforeseen.PolicyRun]:
+    """Each run of ``policy`` on ``map``, by the library: its line and episodes."""
+    if isinstance(policy, ScaledWrapper):
+        target, observation = policy._inner, policy.observation
+    else:
+        target, observation = policy, getattr(policy, "observation", "discrete")
+    return _unforeseen.evaluate_policy(target, os.fspath(map), method, protocols, episodes, seed, train_seed,
+                                       train_episodes, first_unit, observation)
 
 
 def evaluate_policy(
@@ -48,95 +84,19 @@ def evaluate_policy(
     episodes: int = 100,
     protocol: str = "zero-shot",
     seed: int = 7,
+    method: str | None = None,
 ) -> list[dict[str, Any]]:
-    """Runs ``policy`` for ``episodes`` evaluation episodes of ``map`` under
-    ``protocol``: per episode ``ret``, ``success``, ``collision``, ``timeout``,
-    ``red_lights``, ``ticks``, ``reasoning_ticks`` and ``decide_s`` (seconds inside the
-    policy)."""
-    if protocol not in PROTOCOLS:
-        raise ValueError(f"protocol {protocol!r}: expected one of {PROTOCOLS}")
-    if episodes < 1:
-        raise ValueError(f"episodes {episodes}: expected at least 1")
-    env = UnforeseenEnv(map, getattr(policy, "observation", "discrete"))
-    out = []
-    for ep in range(episodes):
-        # The world seed depends on the map and episode only; the controller seed is the
-        # scaled agent's (so a wrapper around the Q-table is the built-in agent).
-        world, ctrl = _unforeseen.eval_seeds(seed, map, "scaled", ep)
-        if protocol == "zero-shot" and hasattr(policy, "reset_learning"):
-            policy.reset_learning()
-        obs, info = env.reset(options={"world_seed": world})
-        if hasattr(policy, "begin_episode"):
-            policy.begin_episode(ctrl)
-        r = {"ret": 0.0, "success": False, "collision": False, "timeout": False, "red_lights": 0,
-             "ticks": 0, "reasoning_ticks": 0, "decide_s": 0.0}
-        while True:
-            t0 = time.perf_counter()
-            decided = policy.act(obs, info)
-            r["decide_s"] += time.perf_counter() - t0
-            if isinstance(decided, tuple):
-                action, decision = decided
-                r["reasoning_ticks"] += bool(decision.get("reasoned", False))
-            else:
-                action = decided
-            obs, reward, terminated, truncated, info = env.step(int(action))
-            r["ret"] += float(reward)
-            r["ticks"] += 1
-            r["red_lights"] += bool(info["red_light"])
-            if hasattr(policy, "observe"):
-                policy.observe(reward, obs, info, terminated, truncated)
-            if terminated or truncated:
-                r["collision"] = bool(info["collision"])
-                r["success"] = bool(info["goal"]) and not r["collision"]
-                r["timeout"] = bool(info["timeout"])
-                break
-        if hasattr(policy, "end_episode"):
-            policy.end_episode()
-        out.append(r)
-    return out
-
-
-def _line(
-    unit: int,
-    map: str,
-    method: str,
-    protocol: str,
-    covers: list[str],
-    train_seed: int | None,
-    train_episodes: int | None,
-    seed: int,
-    results: list[dict[str, Any]],
-    matvecs_per_reasoning_tick: int,
-) -> dict[str, Any]:
-    scenario, source = _source(map)
-    n = len(results)
-    ticks = sum(r["ticks"] for r in results)
-    reasoning = sum(r["reasoning_ticks"] for r in results)
-    inference = reasoning / ticks if ticks else 0.0
-    return {
-        "unit": unit,
-        "scenario": scenario,
-        "source": source,
-        "method": method,
-        "param_set": "default",
-        "params": [],
-        "protocol": protocol,
-        "covers": covers,
-        "train_seed": train_seed,
-        "train_episodes": train_episodes,
-        "seed": seed,
-        "episodes": n,
-        "mean_reward": sum(r["ret"] for r in results) / n,
-        "success_rate": sum(r["success"] for r in results) / n,
-        "collision_rate": sum(r["collision"] for r in results) / n,
-        "timeout_rate": sum(r["timeout"] for r in results) / n,
-        "red_light_rate": sum(r["red_lights"] for r in results) / n,
-        "inference_rate": inference,
-        "efe_matvecs_per_tick": inference * matvecs_per_reasoning_tick,
-        "mean_ticks": ticks / n,
-        "checks": [],
-        "timing_us_per_tick": (sum(r["decide_s"] for r in results) / ticks * 1e6) if ticks else 0.0,
-    }
+    """Runs ``policy`` (the module's protocol, or a :class:`~unforeseen.ScaledWrapper`)
+    for ``episodes`` evaluation episodes of ``map`` (an embedded name or a map file)
+    under ``protocol`` by the library's episode loop, with the episodes of a method named
+    ``method`` (default: the policy's ``method`` attribute, else ``"policy"``). Returns
+    the episodes as eval.json holds them: per episode ``ret``, ``success``,
+    ``collision``, ``timeout``, ``red_lights``, ``ticks``, ``reasoning_ticks``,
+    ``decide_ns`` and ``reasoning_ns`` (nanoseconds inside the controller) and
+    ``jaywalk_surprise``."""
+    name = method or getattr(policy, "method", None) or "policy"
+    [run] = _runs(policy, map, name, [protocol], episodes, seed)
+    return run.episodes
 
 
 class EvaluateResult(list):
@@ -189,13 +149,15 @@ def evaluate(
     and training seed (a second call would count it twice), or if another run is writing
     it.
 
-    ``policy``: a policy, a mapping ``train_seed -> policy`` or a callable
-    ``train_seed -> policy`` (the policy trained with that seed). ``seeds``: the training
-    seeds (``None`` for a policy without one). ``protocol``: ``"zero-shot"``,
-    ``"continual"`` or both; a policy whose ``learns`` is false runs once and its line
-    covers every protocol asked (as the batch does for methods that do not learn).
-    ``method``: the name in the lines (default: the policy's ``method`` attribute).
-    ``seed``: the evaluation seed (the batch's ``--seed``)."""
+    ``policy``: a policy (the module's protocol) or a :class:`~unforeseen.ScaledWrapper`,
+    a mapping ``train_seed -> policy`` or a callable ``train_seed -> policy`` (the policy
+    trained with that seed). ``seeds``: the training seeds (``None`` for a policy without
+    one). ``protocol``: ``"zero-shot"``, ``"continual"`` or both; a plain policy runs once
+    and its line covers every protocol asked (as the batch does for methods that do not
+    learn), a wrapper that learns runs once per protocol. ``method``: the name in the
+    lines, from which the episodes' controller seeds derive (default: the policy's
+    ``method`` attribute). ``seed``: the evaluation seed (the batch's ``--seed``).
+    ``train_episodes``: what the lines record as the policy's training episodes."""
     protocols = [protocol] if isinstance(protocol, str) else list(protocol)
     for p in protocols:
         if p not in PROTOCOLS:
@@ -229,16 +191,11 @@ def evaluate(
                 name = method or getattr(pol, "method", None)
                 if not name:
                     raise ValueError("evaluate: name the method (method='dqn-kinematic' or a policy.method)")
-                learns = bool(getattr(pol, "learns", False))
-                runs = [(p, [p]) for p in protocols] if learns else [(protocols[0], protocols)]
-                for proto, covers in runs:
-                    results = evaluate_policy(pol, m, episodes, proto, seed)
-                    line = _line(unit, m, name, proto, list(covers), s, train_episodes, seed, results,
-                                 _efe_tree(getattr(pol, "_params", {})))
+                for run in _runs(pol, m, name, protocols, episodes, seed, s, train_episodes, unit):
                     unit += 1
-                    lines.append(line)
+                    lines.append(run.line)
                     if fh is not None:
-                        fh.write(json.dumps(line) + "\n")
+                        fh.write(run.line_text + "\n")
                         fh.flush()
     finally:
         if fh is not None:

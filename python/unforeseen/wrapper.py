@@ -46,18 +46,21 @@ class ScaledWrapper:
     """The scaled agent of ``agent`` (an :class:`unforeseen.Agent` or an agent file) with
     the habit ``habit``:
 
-    * a callable ``habit(obs) -> probabilities`` (or an object with ``probs(obs)``, e.g.
-      a deep baseline of :mod:`unforeseen.baselines`), asked on each tick with the
-      env's observation (its form is ``observation``, or the policy's ``observation``
-      attribute);
+    * a policy with ``probs(obs) -> probabilities`` (e.g. a deep baseline of
+      :mod:`unforeseen.baselines`), or a callable ``obs -> probabilities``, asked each tick
+      with the env's observation (its form is ``observation``, or the habit's
+      ``observation`` attribute); its optional ``reset(seed)`` is called at the start of
+      every episode (the policy protocol of :mod:`unforeseen.evaluate`);
     * an ``(n_states, n_actions)`` array of probabilities per discrete state (e.g.
       :func:`q_table_habit`);
     * ``None``: the agent's own Q-table habit (the built-in scaled agent).
 
     Keywords are the scaled agent's parameters (the keys of ``unforeseen eval --set``).
-    Drive it with :meth:`act` and :meth:`observe`, which take the env's ``info`` too (the
-    agent reads the observed discrete state ``info["observed"]``); :func:`unforeseen.evaluate`
-    does that loop.
+    :func:`unforeseen.evaluate` and :func:`unforeseen.evaluate.evaluate_policy` evaluate
+    it by the library's episode loop, which asks the habit each tick (every run starts
+    from the agent as built). To drive it step by step instead: :meth:`begin_episode`,
+    :meth:`act` and :meth:`observe` with the env's ``info`` (the agent reads the observed
+    discrete state ``info["observed"]``), :meth:`end_episode`.
     """
 
     def __init__(
@@ -75,13 +78,14 @@ class ScaledWrapper:
         if habit is None:
             habit = q_table_habit(self._agent, **params)
         self._table: np.ndarray | None = None
+        self._habit: Any = None
         self._probs: Callable[[Any], Any] | None = None
         if isinstance(habit, np.ndarray):
             self._table = np.ascontiguousarray(habit, dtype=np.float64)
         elif hasattr(habit, "probs") and callable(habit.probs):
-            self._probs = habit.probs
+            self._habit, self._probs = habit, habit.probs
         elif callable(habit):
-            self._probs = habit
+            self._habit, self._probs = habit, habit
         else:
             raise TypeError(
                 f"habit: expected a callable obs -> probabilities, an object with probs(obs), "
@@ -98,35 +102,35 @@ class ScaledWrapper:
         self.learns = bool(self._inner.learns)
 
     def _build(self) -> Any:
-        return _unforeseen.ScaledHabitAgent(self._agent, self._table, **self._params)
+        return _unforeseen.ScaledHabitAgent(self._agent, self._table, self._habit, self.observation, **self._params)
 
     def reset_learning(self) -> None:
-        """Forget everything learned at test time (a fresh agent: the zero-shot protocol)."""
+        """Forget everything learned at test time while driven step by step (a fresh agent)."""
         self._inner = self._build()
 
     def begin_episode(self, seed: int) -> None:
-        """Starts an episode; ``seed`` seeds the agent's own sampling."""
+        """Starts an episode driven step by step; ``seed`` seeds the agent's own sampling."""
         self._inner.begin_episode(seed)
 
     def act(self, obs: Any, info: dict[str, Any]) -> tuple[int, dict[str, Any]]:
-        """``(action, decision)`` for the env's ``obs`` and ``info``; the decision as
-        :meth:`unforeseen.Controller.act` gives it."""
+        """``(action, decision)`` for the env's ``obs`` and ``info`` (step by step); the
+        decision as :meth:`unforeseen.Controller.act` gives it."""
         if self._probs is None:
             return self._inner.act(info["observed"])
         p = np.asarray(self._probs(obs), dtype=np.float64).reshape(-1)
         return self._inner.act(info["observed"], p)
 
     def observe(self, reward: float, obs: Any, info: dict[str, Any], terminated: bool, truncated: bool) -> None:
-        """The outcome of the last action."""
+        """The outcome of the last action (step by step)."""
         self._inner.observe(float(reward), info["observed"], bool(terminated), bool(truncated))
 
     def end_episode(self) -> None:
-        """Test-time learning (the habit's corrections included)."""
+        """Test-time learning (the habit's corrections included), step by step."""
         self._inner.end_episode()
 
     def habit_counts(self) -> np.ndarray:
-        """The corrections learning added to an external habit, ``(n_states, n_actions)``
-        (for a habit table: its counts ``ν``)."""
+        """The corrections learning added to an external habit while driven step by step,
+        ``(n_states, n_actions)`` (for a habit table: its counts ``ν``)."""
         return self._inner.habit_counts()
 
     def __repr__(self) -> str:

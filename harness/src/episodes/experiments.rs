@@ -24,9 +24,17 @@ use crate::training::agent_file::check_compatible;
 /// on the map and episode only (every method meets the same pedestrians), the
 /// controller seed on the method too.
 pub fn eval_seeds(seed: u64, map: &Map, method: Method, episode: u64) -> EpisodeSeeds {
+    eval_seeds_named(seed, map, method.name(), episode)
+}
+
+/// [`eval_seeds`] of the method named `method`: the seeds of a built-in method under its
+/// name ([`Method::name`]), and of a method given from outside (a Python policy) under
+/// the name its result lines carry, so that a line's (seed, map, method) alone says which
+/// episodes it ran.
+pub fn eval_seeds_named(seed: u64, map: &Map, method: &str, episode: u64) -> EpisodeSeeds {
     EpisodeSeeds {
         world: episode_seed(seed, &format!("{}/eval", map.name), episode),
-        controller: episode_seed(seed, &format!("{}/eval/{}", map.name, method.name()), episode),
+        controller: episode_seed(seed, &format!("{}/eval/{method}", map.name), episode),
     }
 }
 
@@ -111,6 +119,47 @@ pub fn evaluate_with(
             (0..episodes).map(|ep| run(&mut env, controller.as_mut(), ep)).collect()
         }
     }
+}
+
+/// Makes a fresh controller, for [`evaluate_in_order`] (it may borrow, and need not be `Sync`).
+pub type MakeControllerMut<'a, 'c> = dyn FnMut() -> Result<Box<dyn Controller + 'c>, Error> + 'a;
+
+/// Runs `episodes` evaluation episodes of the method named `method` on `map` under
+/// `protocol`, one at a time in order on one env observing as `config` says, with the
+/// seeds of that name ([`eval_seeds_named`]), advancing `progress` by one per episode.
+/// Zero-shot: a fresh controller from `make` per episode; continual: one controller
+/// throughout. For controllers that must not run on several threads at once (a policy
+/// given from Python: [`evaluate_with`] runs zero-shot episodes in parallel); the results
+/// are those [`evaluate_with`] gives for the same controllers and name.
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_in_order(
+    protocol: Protocol,
+    map: &Map,
+    config: EnvConfig,
+    method: &str,
+    make: &mut MakeControllerMut<'_, '_>,
+    episodes: u64,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<Vec<EpisodeResult>, Error> {
+    let mut env = Env::new(map, config)?;
+    let mut controller = make()?;
+    (0..episodes)
+        .map(|ep| {
+            if protocol == Protocol::ZeroShot && ep > 0 {
+                controller = make()?;
+            }
+            let result = run_episode(
+                &mut env,
+                controller.as_mut(),
+                eval_seeds_named(seed, map, method, ep),
+                false,
+            )?
+            .0;
+            crate::progress::step(progress)?;
+            Ok(result)
+        })
+        .collect()
 }
 
 /// Runs `episodes` episodes of a scripted reference `method` ([`Method::REFERENCE`]) on

@@ -2,7 +2,19 @@
 //! inference rate (share of ticks that ran planning) and measured reasoning time; and
 //! red-light violations per episode (the traffic rule, not in the paper).
 
+use unforeseen_agent::params::ScaledParams;
+use unforeseen_sim::Action;
+
 use crate::episodes::runner::EpisodeResult;
+
+/// The size of the scaled agent's planning tree, `U + U^2 + ... + U^H` (U actions,
+/// horizon H of `params`): the expected-free-energy mat-vecs one reasoning tick costs,
+/// which the batch's lines multiply by the inference rate (`efe_matvecs_per_tick`).
+pub fn efe_prefix_tree(params: &ScaledParams) -> usize {
+    (1..=params.planning.horizon)
+        .map(|k| Action::ALL.len().pow(k as u32))
+        .sum()
+}
 
 /// Aggregate over a set of episodes of one method on one map.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]

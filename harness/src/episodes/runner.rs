@@ -87,19 +87,25 @@ pub struct EpisodeError {
 }
 
 /// Runs one episode of `controller` in `env` (a loop over [`Env::reset`] and
-/// [`Env::step`]). With `record`, every tick is returned, and the terminal frame after them.
+/// [`Env::step`]): the controller acts on the discrete observation's joint index (an env
+/// that observes kinematically also gives it the vector first,
+/// [`Controller::see_features`]). With `record`, every tick is returned, and the terminal
+/// frame after them.
 pub fn run_episode(
     env: &mut Env,
     controller: &mut dyn Controller,
     seeds: EpisodeSeeds,
     record: bool,
 ) -> Result<(EpisodeResult, Vec<Tick>), EpisodeError> {
-    let (obs, mut info) = env.reset(seeds.world);
+    let (mut obs, mut info) = env.reset(seeds.world);
     let mut index = obs.index().unwrap_or_else(|| env.discretizer().encode(info.observed));
     let mut result = EpisodeResult::default();
     let mut ticks = Vec::new();
     controller.begin_episode(seeds.controller);
     loop {
+        if let Some(features) = obs.kinematic() {
+            controller.see_features(features);
+        }
         let started = Instant::now();
         let decision = controller.act(index);
         let ns = started.elapsed().as_nanos() as u64;
@@ -165,7 +171,7 @@ pub fn run_episode(
             }
             break;
         }
-        (info, index) = (step.info, next_index);
+        (info, index, obs) = (step.info, next_index, step.observation);
     }
     controller.end_episode();
     Ok((result, ticks))
