@@ -21,7 +21,7 @@ __all__ = [
     "EvalResult",
     "ScaledHabitAgent",
     "VectorEnv",
-    "batch_report",
+    "batch",
     "batch_result",
     "compare_report",
     "embedded_maps",
@@ -197,17 +197,14 @@ def compare_report(
     **params: Any,
 ) -> CompareResult:
     """``unforeseen compare``: its report."""
-def batch_report(
-    maps: Sequence[str],
-    agents: Agent | Sequence[Agent],
-    episodes: int = 100,
-    seed: int = 7,
-    methods: Sequence[str] | None = None,
-    protocols: Sequence[str] = ("zero-shot", "continual"),
-    sweep: dict[str, Any] | None = None,
-    jobs: int = 2,
-) -> BatchResult:
-    """``unforeseen batch``: its report (result lines and summary)."""
+def batch(request: str, agent: Agent | None = None) -> BatchResult:
+    """``unforeseen batch`` in this process: the batch request (JSON text of its fields;
+    :func:`unforeseen.batch` writes it), planned, trained and run by the library as the
+    command line runs it, writing its results file and summary; ``agent`` is an agent
+    given loaded instead of the request's agent file. A bad field raises ``ValueError``
+    naming it."""
+def batch_request_defaults() -> str:
+    """The batch request's fields with their defaults (JSON text)."""
 def batch_result(lines: str) -> BatchResult:
     """The report of result lines (the JSON text of their list) that ``evaluate`` wrote,
     summarized and printed as ``unforeseen batch`` does its own."""
@@ -342,24 +339,12 @@ class ResultsGuard:
 
 def summarize_json(path: str) -> str:
     """The batch summary over training seeds of a results file, as JSON text."""
-def plan_batch(
-    maps: Sequence[str],
-    out: str,
-    episodes: int = 100,
-    seed: int = 7,
-    methods: Sequence[str] | None = None,
-    protocol: str = "both",
-    sets: Sequence[str] = (),
-    train_seeds: Sequence[int] | None = None,
-    train_episodes: int = 6000,
-    agent: str | None = None,
-    resume: bool = False,
-    force: bool = False,
-) -> str:
-    """A batch run planned as `unforeseen batch` plans it (JSON text: spec, head, total,
-    kept, todo, todo_seeds, train_seeds_to_run, agent); runs and trains nothing."""
-def train_agent(seed: int, episodes: int) -> bytes:
-    """The agent of one training seed (agent-file text), trained with the GIL released."""
+def plan_batch(request: str, agent: Agent | None = None) -> str:
+    """The batch request (JSON text of its fields) planned as ``unforeseen batch`` plans it
+    (JSON text: spec, head, total, kept, todo, todo_seeds, train_seeds_to_run, train,
+    agent); passes the output guard, runs and trains nothing."""
+def train_agent(seed: int, episodes: int, train_map: str = "intersection", timeout_as: str = "truncation") -> bytes:
+    """The agent of one training seed (agent-file text), trained on ``train_map`` with the GIL released."""
 def run_units(spec: str, agents: Sequence[tuple[int | None, bytes]], units: Sequence[int], threads: int = 1) -> list[str]:
     """The result lines (JSON text) of units of a planned run, with the GIL released."""
 def finish_batch(out: str) -> str:

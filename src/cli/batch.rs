@@ -128,7 +128,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     // One run at a time per results file: the job holds the lock until it is dropped.
     let job = args.request().plan(None)?;
     if let Some(top) = creates {
-        errln!("note: --out: creating the folder {} (it does not exist yet)", top.display());
+        errln!(
+            "note: --out: creating the folder {} (it does not exist yet)",
+            top.display()
+        );
     }
     let setup = &job.setup;
     let to_train = job.to_train();
@@ -167,7 +170,7 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         }
         _ => format!("{} scenario(s)", scenarios.len()),
     };
-    let seeds = if setup.scripted_only() {
+    let seeds = if agents.is_empty() && setup.methods.iter().all(|m| m.is_scripted()) {
         "no agent (scripted methods only)".to_string()
     } else {
         format!("{} agent(s)", setup.train_seeds.len())

@@ -5,11 +5,11 @@
 use clap::Args;
 use std::path::{Path, PathBuf};
 
-use unforeseen_harness::episodes::protocol::ProtocolChoice;
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::methods::{Method, PaperFigures};
 use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::protocol::ProtocolChoice;
 use unforeseen_harness::maps;
 use unforeseen_harness::reports::figures::{BarPanel, BarRow, bar_key, grouped_bars};
 use unforeseen_harness::reports::files::{Csv, num, write_json};

@@ -166,33 +166,42 @@ pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
 }
 
 /// A failed command's message: the error and its causes (`outer: inner: ...`), with a
-/// parameter override spelt as the flag it came from (`--set epsilon=2: ...`) and a
-/// request's field as its flag (`train_seeds: ...` as `--train-seeds: ...`, the output
-/// guard's `out` as `--out`).
+/// parameter override spelt as the flag it came from (`--set epsilon=2: ...`), a
+/// request's field as its flag (`train_seeds: ...` as `--train-seeds: ...`), and the
+/// fields the output guard names (`out`, `agent`, the maps, ...) as their flags.
 pub fn error_message(err: &anyhow::Error) -> String {
     use unforeseen_harness::error::Error;
     let text = format!("{err:#}");
-    let field = match err.downcast_ref::<Error>() {
-        Some(Error::Override { .. }) => return format!("--set {text}"),
-        Some(Error::Request { field, .. } | Error::OutOfRange { field, .. }) => field.as_str(),
-        // The output guard names the request's inputs and outputs by field.
-        Some(Error::Flag { flag, .. }) => {
-            let first = flag.split(' ').next().unwrap_or_default();
-            match GUARDED_FIELDS.contains(&first) {
-                true => first,
-                false => return text,
-            }
-        }
-        _ => return text,
-    };
-    match text.strip_prefix(field) {
-        Some(rest) => format!("{}{rest}", flag_of(field)),
-        None => text,
+    match err.downcast_ref::<Error>() {
+        Some(Error::Override { .. }) => format!("--set {text}"),
+        Some(Error::Request { field, .. } | Error::OutOfRange { field, .. }) => match text.strip_prefix(field.as_str())
+        {
+            Some(rest) => format!("{}{rest}", flag_of(field)),
+            None => text,
+        },
+        Some(Error::Flag { .. }) => spell_guard_fields(text),
+        _ => text,
     }
 }
 
-/// The fields of a request that the output guard names (inputs and outputs).
-const GUARDED_FIELDS: [&str; 6] = ["out", "agent", "maps", "stream", "map", "space"];
+/// The fields of a request that the output guard names (inputs and outputs), longest
+/// first.
+const GUARDED_FIELDS: [&str; 6] = ["stream", "agent", "space", "maps", "map", "out"];
+
+/// A message of the output guard with the fields it names (at its start, in "given as
+/// FIELD" and in "give FIELD ...") spelt as their flags.
+fn spell_guard_fields(mut text: String) -> String {
+    for field in GUARDED_FIELDS {
+        let flag = flag_of(field);
+        if let Some(rest) = text.strip_prefix(&format!("{field} ")) {
+            text = format!("{flag} {rest}");
+        }
+        text = text
+            .replace(&format!("given as {field} "), &format!("given as {flag} "))
+            .replace(&format!("give {field} "), &format!("give {flag} "));
+    }
+    text
+}
 
 /// The command line's spelling of a request's field: its flag (`train_seeds` is
 /// `--train-seeds`, `sets` is `--set`, `methods` is `--method`), or `MAP` for the maps

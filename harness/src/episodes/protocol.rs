@@ -119,7 +119,11 @@ pub enum ProtocolChoice {
 
 impl ProtocolChoice {
     /// Every choice, in the order listings give them.
-    pub const ALL: [ProtocolChoice; 3] = [ProtocolChoice::ZeroShot, ProtocolChoice::Continual, ProtocolChoice::Both];
+    pub const ALL: [ProtocolChoice; 3] = [
+        ProtocolChoice::ZeroShot,
+        ProtocolChoice::Continual,
+        ProtocolChoice::Both,
+    ];
 
     /// The name of the choice in requests and on the command line.
     pub fn name(self) -> &'static str {

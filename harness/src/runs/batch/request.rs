@@ -176,7 +176,9 @@ impl BatchRequest {
         check_episodes("episodes", self.episodes)?;
         check_episodes("train_episodes", self.train_episodes)?;
         let jobs = match self.jobs {
-            None => std::thread::available_parallelism().map_or(1, |n| n.get()).min(MAX_JOBS),
+            None => std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(MAX_JOBS),
             Some(n) if (1..=MAX_JOBS).contains(&n) => n,
             Some(n) => {
                 return Err(Error::OutOfRange {
@@ -301,11 +303,6 @@ impl BatchSetup {
             shard,
             agents_identity: self.agents_identity.clone(),
         }
-    }
-
-    /// Whether the run has no agent (scripted methods only).
-    pub fn scripted_only(&self) -> bool {
-        matches!(self.agents, AgentChoice::None)
     }
 }
 
