@@ -351,11 +351,18 @@ def finish_batch(out: str) -> str:
     """Rewrites a driver's results file in canonical order with its summary; JSON text of
     ``lines``, ``summary`` (its path), ``checked``, ``failed``, ``failures`` and ``table``
     (the summary table ``unforeseen batch`` prints)."""
-def check_search(spec: str) -> bool:
-    """Checks a search's spec (JSON text: arguments, base map, space file) before any task;
-    whether its method is scripted (needs no agents)."""
-def search_agent_text(path: str | os.PathLike[str]) -> bytes:
-    """An agent file's text, as the search tasks take it."""
+def search_request_defaults() -> str:
+    """The search request's fields with their defaults (JSON text)."""
+def plan_search(request: str, agent: Agent | None = None) -> str:
+    """The search request (JSON text of its fields) checked as ``unforeseen search`` checks
+    it (arguments, base map, space file), before any task; JSON text of ``spec`` (the
+    request), ``train`` (training seeds to train), ``train_episodes``, ``timeout_as`` and
+    ``agent`` (the given agent's text, or null)."""
+def search(request: str, agent: Agent | None = None, command: str = "") -> str:
+    """``unforeseen search`` in this process: the search request (JSON text of its
+    fields) planned, trained and run by the library as the command line runs it, writing
+    its folder of outputs; ``summary.json``'s contents (JSON text). A bad field raises
+    ``ValueError`` naming it; Ctrl-C raises KeyboardInterrupt at the next episode."""
 def evaluate_search_candidates(
     spec: str,
     agents: Sequence[tuple[int | None, bytes]],
@@ -369,12 +376,11 @@ def drive_search(
     spec: str,
     agents: Sequence[tuple[int | None, bytes]],
     evaluate: Callable[[list[str]], list[list[str]]],
-    out: str | os.PathLike[str],
-    resume: bool = False,
     from_file: bool = False,
     jobs: int = 1,
     command: str = "",
     stop: Any | None = None,
 ) -> str:
-    """Runs a search's stages in Rust with ``evaluate`` for its candidates; the summary (JSON text).
+    """Runs a search's stages in Rust (the request ``spec`` from :func:`plan_search`, into
+    its ``out``) with ``evaluate`` for its candidates; the summary (JSON text).
     Ctrl-C raises KeyboardInterrupt, calling ``stop.set()`` so an ``evaluate`` under way can return early."""

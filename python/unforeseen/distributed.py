@@ -1,6 +1,7 @@
 """Batch runs across machines on a Ray cluster, with the results one machine writes.
 
-:func:`run_batch` takes the arguments of ``unforeseen batch``, connects to a running
+:func:`run_batch` takes the arguments of :func:`unforeseen.batch` (the batch request, the
+fields and defaults of ``unforeseen batch``), connects to a running
 cluster (``address="auto"``, or one given), and runs the batch as Ray tasks through the
 Rust binding (not the command line), a block of units per task with the GIL released::
 
@@ -8,8 +9,8 @@ Rust binding (not the command line), a block of units per task with the GIL rele
     report = run_batch(["maps/"], train_seeds=range(1, 5), episodes=20, out="sweep.jsonl")
 
 or, from a shell, ``python -m unforeseen.distributed batch maps/ --train-seeds 1..4
---episodes 20 --out sweep.jsonl`` (the options of ``unforeseen batch``, plus
-``--address`` and ``--units-per-task``).
+--episodes 20 --out sweep.jsonl`` (the options of ``unforeseen batch``, derived from the
+request's fields, plus ``--address`` and ``--units-per-task``).
 
 How it runs
 -----------
@@ -46,7 +47,8 @@ on loopback inside a network namespace (the tests do the same).
 
 How a search runs
 -----------------
-:func:`run_search` keeps the search's stages in Rust (``unforeseen::search::run_with``,
+:func:`run_search` takes the arguments of :func:`unforeseen.search` (the search
+request) and keeps the search's stages in Rust (``unforeseen::search::run_with``,
 through the binding's ``drive_search``): the Sobol stage, each cross-entropy round and
 each minimisation try hand their candidates to an evaluator, which here splits them into
 blocks and runs them as Ray tasks through :func:`_drive` (the same retry and input-error
@@ -73,8 +75,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _unforeseen
-from .requests import BATCH_DEFAULTS, flag, flag_message, request_json
-from .search import plan_search
+from .requests import BATCH_DEFAULTS, SEARCH_DEFAULTS, flag, flag_message, request_json
 
 __all__ = ["DEFAULT_MAX_RETRIES", "main", "run_batch", "run_search"]
 
@@ -328,8 +329,8 @@ def run_batch(
 
 
 def run_search(
+    space: str | os.PathLike[str] | None = None,
     *,
-    space: str | os.PathLike[str],
     map: str | os.PathLike[str] = "jaywalk",
     method: str = "scaled",
     protocol: str = "zero-shot",
@@ -339,52 +340,65 @@ def run_search(
     sobol_share: float = 0.5,
     rounds: int = 5,
     max_failures: int = 5,
-    out: str | os.PathLike[str] = "out/search",
-    train_seeds: Iterable[int] | None = None,
-    train_episodes: int = 6000,
-    agent: str | os.PathLike[str] | None = None,
+    jobs: int | None = None,
+    shard: str | None = None,
     resume: bool = False,
-    jobs: int = 1,
+    out: str | os.PathLike[str] = "out/search",
+    force: bool = False,
+    agent: str | os.PathLike[str] | _unforeseen.Agent | None = None,
+    train_seeds: Iterable[int] | str | None = None,
+    train_episodes: int = 6000,
+    timeout_as: str = "truncation",
+    cache: str | os.PathLike[str] | None = "out/agents",
+    command: str | None = None,
     candidates_per_task: int | None = None,
     address: str | None = "auto",
     max_retries: int = DEFAULT_MAX_RETRIES,
-    command: str | None = None,
 ) -> dict[str, Any]:
-    """``unforeseen search`` on a Ray cluster: the same arguments, the same folder of
-    outputs (``candidates.jsonl``, ``summary.json``, ``failures/*.ron``, ``search.svg``),
-    timing fields aside, whatever the number of workers.
+    """``unforeseen search`` on a Ray cluster: the arguments of :func:`unforeseen.search`
+    (the search request, checked by the library as the command line checks it), and the
+    same folder of outputs (``candidates.jsonl``, ``summary.json``, ``failures/*.ron``,
+    ``search.svg``), timing fields aside, whatever the number of workers. On the cluster
+    ``jobs`` is the threads, and CPUs, of each task (None: 1); agents train once per seed
+    on the cluster and are not cached (``cache`` is not used); ``shard`` is refused.
 
     The stages run in order on the driver, in the library (``unforeseen::search``); each
     stage's candidates (the Sobol stage's, each adaptive round's) run as tasks of
     ``candidates_per_task`` candidates (default: about 4 tasks per CPU), and each
     minimisation try as a task of its own, the best failures minimised at once. Agents
-    train once per training seed on the cluster and reach the tasks through the object
-    store. ``command`` is written in the failure maps' comments (``Found by: ...``).
-    Returns ``summary.json``'s contents.
+    reach the tasks through the object store. ``command`` is written in the failure maps'
+    comments (``Found by: ...``). Returns ``summary.json``'s contents.
     """
-    _check_task_options(jobs, "candidates_per_task", candidates_per_task, max_retries)
-    # The arguments, maps and space checked before any task runs.
-    plan = plan_search(
-        space=space, map=map, method=method, protocol=protocol, budget=budget, episodes=episodes, seed=seed,
-        sobol_share=sobol_share, rounds=rounds, max_failures=max_failures, train_seeds=train_seeds,
-        train_episodes=train_episodes, agent=agent,
-    )
-    spec, from_file = plan.spec, plan.from_file
+    fields = {k: v for k, v in locals().items() if k in SEARCH_DEFAULTS}
+    if space is None:
+        fields.pop("space")
+    if shard is not None:
+        raise ValueError(
+            f"shard {shard}: the cluster splits the run itself; run it whole here, "
+            "or run `unforeseen search --shard I/N` on separate machines and finish with --resume"
+        )
+    threads = 1 if jobs is None else jobs
+    _check_task_options(threads, "candidates_per_task", candidates_per_task, max_retries)
+    given = fields.pop("agent") if isinstance(agent, _unforeseen.Agent) else None
+    # The request, maps and space checked before any task runs.
+    plan = json.loads(_unforeseen.plan_search(request_json(fields), given))
+    spec = plan["spec"]
+    from_file = plan["agent"] is not None
     ray = _ray()
     if not ray.is_initialized():
         ray.init(address=address, include_dashboard=False, log_to_driver=False)
     options = _task_options(max_retries)
     pairs: list[tuple[int | None, Any]]
     if from_file:
-        pairs = [(None, ray.put(_unforeseen.search_agent_text(str(agent))))]
+        pairs = [(None, ray.put(plan["agent"].encode()))]
     else:
         train = ray.remote(num_cpus=1, **options)(_train_task)
-        pairs = [(s, train.remote(s, train_episodes)) for s in plan.train]
+        pairs = [(s, train.remote(s, plan["train_episodes"], "intersection", plan["timeout_as"])) for s in plan["train"]]
     agent_seeds = [s for s, _ in pairs]
     refs = [r for _, r in pairs]
     texts = ray.get(refs) if refs else []
-    task = ray.remote(num_cpus=jobs, **options)(_search_task)
-    cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // jobs)
+    task = ray.remote(num_cpus=threads, **options)(_search_task)
+    cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // threads)
 
     # Set by the binding on Ctrl-C: `evaluate` runs on the driver's other threads, which
     # never see the signal themselves.
@@ -397,7 +411,8 @@ def run_search(
 
         def submit(block: list[int]) -> Any:
             return task.remote(
-                spec, agent_seeds, *refs, candidates=[candidates[i] for i in block], from_file=from_file, threads=jobs
+                spec, agent_seeds, *refs, candidates=[candidates[i] for i in block], from_file=from_file,
+                threads=threads,
             )
 
         def sink(block: list[int], got: list[list[str]]) -> None:
@@ -411,8 +426,6 @@ def run_search(
         spec,
         list(zip(agent_seeds, texts, strict=True)),
         evaluate,
-        str(out),
-        resume=resume,
         from_file=from_file,
         jobs=max(1, max_failures),
         command=command if command is not None else f"unforeseen.distributed.run_search(space={str(space)!r}, ...)",
@@ -451,25 +464,7 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--units-per-task", type=int, help="units per task (default: about 4 tasks per CPU)")
     b.add_argument("--max-retries", type=int, default=DEFAULT_MAX_RETRIES)
     s = sub.add_parser("search", help="unforeseen search on a Ray cluster (its options, plus --address)")
-    s.add_argument("--map", default="jaywalk")
-    s.add_argument("--space", required=True)
-    s.add_argument("--method", default="scaled")
-    s.add_argument("--protocol", choices=["zero-shot", "continual"], default="zero-shot")
-    s.add_argument("--budget", type=int, default=100)
-    s.add_argument("--episodes", type=int, default=20)
-    s.add_argument("--seed", type=int, default=7)
-    s.add_argument("--sobol-share", type=float, default=0.5)
-    s.add_argument("--rounds", type=int, default=5)
-    s.add_argument("--max-failures", type=int, default=5)
-    s.add_argument("--jobs", type=int, default=1, help="threads (and CPUs) of each task")
-    s.add_argument("--shard", metavar="I/N", help="refused: the cluster splits the run itself")
-    s.add_argument("--resume", action="store_true")
-    s.add_argument("--out", default="out/search")
-    s.add_argument("--train-episodes", type=int, default=6000)
-    s.add_argument("--agent", metavar="FILE")
-    s.add_argument("--train-seeds", metavar="SEEDS")
-    s.add_argument("--cache", metavar="DIR", help="accepted; agents train on the cluster, once per seed per run")
-    s.add_argument("--no-cache", action="store_true", help="accepted (agents are not cached on the cluster)")
+    _request_options(s, SEARCH_DEFAULTS, positional=None)
     s.add_argument("--quiet", "-q", action="store_true")
     s.add_argument("--address", default="auto", help="Ray cluster address (default: auto, the local cluster)")
     s.add_argument("--candidates-per-task", type=int, help="candidates per task (default: about 4 tasks per CPU)")
@@ -479,35 +474,15 @@ def _parser() -> argparse.ArgumentParser:
 
 def _main_search(args: argparse.Namespace, argv: Sequence[str]) -> int:
     try:
-        if args.shard:
-            raise ValueError(
-                f"--shard {args.shard}: the cluster splits the run itself; run it whole here, "
-                "or run `unforeseen search --shard I/N` on separate machines and finish with --resume"
-            )
         summary = run_search(
-            space=args.space,
-            map=args.map,
-            method=args.method,
-            protocol=args.protocol,
-            budget=args.budget,
-            episodes=args.episodes,
-            seed=args.seed,
-            sobol_share=args.sobol_share,
-            rounds=args.rounds,
-            max_failures=args.max_failures,
-            out=args.out,
-            train_seeds=None if args.train_seeds is None else parse_train_seeds(args.train_seeds),
-            train_episodes=args.train_episodes,
-            agent=args.agent,
-            resume=args.resume,
-            jobs=args.jobs,
+            **{f: getattr(args, f) for f in SEARCH_DEFAULTS},
             candidates_per_task=args.candidates_per_task,
             address=args.address,
             max_retries=args.max_retries,
             command=" ".join(["python -m unforeseen.distributed", *argv]),
         )
     except ValueError as e:
-        print(f"error: {e}", file=sys.stderr)
+        print(f"error: {flag_message(str(e), SEARCH_DEFAULTS)}", file=sys.stderr)
         return 2
     except (RuntimeError, ConnectionError) as e:
         print(f"error: {e}", file=sys.stderr)
