@@ -450,7 +450,7 @@ def _request_options(parser: argparse.ArgumentParser, defaults: dict[str, Any], 
             kind = int if field == "jobs" or isinstance(default, int) else float if isinstance(default, float) else str
             parser.add_argument(flag(field), dest=field, type=kind, default=default)
     if "cache" in defaults:
-        parser.add_argument("--no-cache", dest="cache", action="store_const", const=None,
+        parser.add_argument("--no-cache", dest="cache", action="store_const", const=None, default=argparse.SUPPRESS,
                             help="accepted (agents are not cached on the cluster)")
 
 

@@ -236,3 +236,18 @@ pub(super) fn print_summary(rows: &[SummaryRow]) {
         );
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[test]
+    fn the_flags_defaults_are_the_requests() {
+        let cli = super::super::Cli::parse_from(["unforeseen", "batch"]);
+        let Some(super::super::Command::Batch(args)) = cli.command else {
+            panic!("not batch")
+        };
+        assert_eq!(args.request(), BatchRequest::default());
+    }
+}

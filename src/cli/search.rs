@@ -228,3 +228,22 @@ fn print_summary(s: &Summary, args: &SearchArgs) {
         args.out.display()
     );
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[test]
+    fn the_flags_defaults_are_the_requests() {
+        let cli = super::super::Cli::parse_from(["unforeseen", "search", "--space", "s.ron"]);
+        let Some(super::super::Command::Search(args)) = cli.command else {
+            panic!("not search")
+        };
+        let expected = SearchRequest {
+            space: "s.ron".into(),
+            ..SearchRequest::default()
+        };
+        assert_eq!(args.request(), expected);
+    }
+}
