@@ -127,7 +127,7 @@ pub enum AgentChoice {
         /// The training seeds.
         seeds: Vec<u64>,
         /// The training configuration.
-        config: TrainConfig,
+        config: Box<TrainConfig>,
         /// The agent cache's folder.
         cache: Option<PathBuf>,
     },
@@ -222,7 +222,7 @@ impl BatchRequest {
             let choice = AgentChoice::Trained {
                 map: Box::new(map),
                 seeds,
-                config: config.clone(),
+                config: Box::new(config.clone()),
                 cache,
             };
             Ok((choice, axis, identity))

@@ -179,7 +179,7 @@ impl SearchRequest {
             let choice = AgentChoice::Trained {
                 map: Box::new(map),
                 seeds,
-                config,
+                config: Box::new(config),
                 cache,
             };
             Ok((choice, axis, identity))
