@@ -12,7 +12,8 @@ r = d.run_batch(["maps/"], out=out, agent=agent, episodes=20, units_per_task=1, 
 wall = time.monotonic() - t
 units = len(r["lines"])
 # Overhead per task: a task that rebuilds the run and runs no unit, 200 times.
-plan = json.loads(_unforeseen.plan_batch(["maps/"], out + ".overhead.jsonl", episodes=20, agent=agent, force=True))
+plan = json.loads(_unforeseen.plan_batch(json.dumps({"maps": ["maps/"], "out": out + ".overhead.jsonl", "episodes": 20,
+                                                     "agent": agent, "force": True})))
 ref = ray.put(plan["agent"].encode())
 task = ray.remote(num_cpus=1, **d._task_options(3))(d._units_task)
 seed = plan["todo_seeds"][0]

@@ -58,6 +58,19 @@ pub enum Error {
         /// What is wrong and what is allowed.
         problem: String,
     },
+    /// A field of a job's request ([`crate::runs::batch::BatchRequest`],
+    /// [`crate::runs::search::SearchRequest`]) that cannot be used, named by the field
+    /// (`train_seeds`, `protocol`, `sets`, ...) and, where it helps, the value given; a
+    /// front spells the field its own way (the command line as its flag).
+    #[error("{field}{}: {problem}", value.as_ref().map(|v| format!(" {v}")).unwrap_or_default())]
+    Request {
+        /// The request's field, e.g. `train_seeds`.
+        field: String,
+        /// The value given, as the user wrote it, when the problem is one value.
+        value: Option<String>,
+        /// What is wrong and what is allowed.
+        problem: String,
+    },
     /// A command-line value: `--set`, `--obs` and the like.
     #[error("{flag}: {problem}")]
     Flag {
@@ -180,6 +193,7 @@ impl Error {
             | Error::Agent { .. }
             | Error::Flag { .. }
             | Error::Override { .. }
+            | Error::Request { .. }
             | Error::OutOfRange { .. }
             | Error::Results { .. }
             | Error::NotRegularFile { .. }
@@ -223,6 +237,15 @@ impl Error {
             cause = e.source();
         }
         text
+    }
+
+    /// An [`Error::Request`] about `field`, with no value quoted.
+    pub fn request(field: impl Into<String>, problem: impl Into<String>) -> Self {
+        Error::Request {
+            field: field.into(),
+            value: None,
+            problem: problem.into(),
+        }
     }
 
     /// A [`Error::Flag`].

@@ -29,7 +29,10 @@
 //!   sweeps, in parallel and in shards), deployment [`stream`](runs::stream)s, the
 //!   [`compare`](runs::compare) study (the paper's table over agents and protocols),
 //!   [`merge`](runs::merge) of shard files and the [`search`](runs::search) for fair
-//!   failing scenarios;
+//!   failing scenarios; a batch and a search are each asked for by one typed request
+//!   ([`BatchRequest`](runs::batch::BatchRequest), [`SearchRequest`](runs::search::SearchRequest)),
+//!   the same value from every front, whose planning owns defaults, checks, agents and
+//!   identity;
 //! * [`external`]: methods given from outside the library (a Python policy), evaluated
 //!   by the same runner and reported as the batch's result lines;
 //! * [`reports`]: result [`files`](reports::files) written atomically, SVG

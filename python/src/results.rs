@@ -1,21 +1,20 @@
 //! `compare` and `batch` from Python, through the library functions the command line
-//! runs ([`unforeseen_harness::runs::compare::run_study`], [`unforeseen_harness::runs::batch::run`]),
+//! runs ([`unforeseen_harness::runs::compare::run_study`], [`unforeseen_harness::runs::batch::BatchRequest`]),
 //! returned as the report objects of [`crate::reports`]: the data the command line's files
 //! hold, built by the same library functions, and the table it prints.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyList};
+use pyo3::types::PyDict;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::runs::batch::{BatchConfig, ResultLine, Scenario};
+use unforeseen_harness::runs::batch::{BatchRequest, ResultLine};
 use unforeseen_harness::runs::compare::{CompareReport, StudySetup};
 use unforeseen_harness::runs::outputs::{Guarded, Outputs};
 use unforeseen_harness::training::seed_agents::Agent;
 
-use crate::agent::{PyAgent, method, protocol, scaled_params};
+use crate::agent::{PyAgent, protocol, scaled_params};
 use crate::errors;
 use crate::reports::{BatchResult, CompareResult};
 
@@ -78,99 +77,24 @@ fn compare_report(
     CompareResult::new(&report)
 }
 
-static RUN: AtomicU64 = AtomicU64::new(0);
-
-/// `unforeseen batch`: its report ([`BatchResult`]): the result lines of the results
-/// file (after its `run` line) and the summary file's rows.
-/// `sweep` maps a `--set` key to a value or a list of values (their cross product).
+/// `unforeseen batch`: the batch `request` (JSON text of its fields, the library's
+/// `BatchRequest`) planned, its agents trained or loaded and its units run by the
+/// library, as the command line runs it, writing the same results file and summary
+/// (`out`); `agent` is an agent given loaded instead of the request's agent file.
+/// Returns its report ([`BatchResult`]): the result lines (after the file's `run` line)
+/// and the summary's rows. Ctrl-C raises `KeyboardInterrupt` at the next episode.
 #[pyfunction]
-#[pyo3(signature = (maps, agents, episodes = 100, seed = 7, methods = None, protocols = vec!["zero-shot".to_string(), "continual".to_string()], sweep = None, jobs = 2))]
-#[allow(clippy::too_many_arguments)]
-fn batch_report(
-    py: Python<'_>,
-    maps: Vec<String>,
-    agents: &Bound<'_, PyAny>,
-    episodes: u64,
-    seed: u64,
-    methods: Option<Vec<String>>,
-    protocols: Vec<String>,
-    sweep: Option<&Bound<'_, PyDict>>,
-    jobs: usize,
-) -> PyResult<BatchResult> {
-    crate::units::check_episodes("episodes", episodes)?;
-    let agents = agents_of(agents)?;
-    let protocols = self::protocols(protocols)?;
-    let methods: Vec<Method> = match methods {
-        Some(names) => names.iter().map(|n| method(n)).collect::<PyResult<_>>()?,
-        None => Method::PAPER.iter().chain(&Method::REFERENCE).copied().collect(),
-    };
-    let names: Vec<String> = if maps.is_empty() {
-        unforeseen_sim::embedded::names()
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
-    } else {
-        maps
-    };
-    let scenarios = names
-        .iter()
-        .map(|n| Ok(Scenario::of_map(crate::maps::load(n, None)?, n.clone())))
-        .collect::<PyResult<Vec<_>>>()?;
-    // Sweep lists as `--set key=v1,v2` (a sweep's points are labelled by that text).
-    let text = |x: &Bound<'_, PyAny>| -> PyResult<String> {
-        if x.is_instance_of::<PyBool>() {
-            Ok(if x.extract::<bool>()? { "true" } else { "false" }.to_string())
-        } else if x.is_none() {
-            Err(errors::value("sweep: None is not a value"))
-        } else {
-            Ok(x.str()?.to_string())
-        }
-    };
-    let mut sets = Vec::new();
-    if let Some(d) = sweep {
-        for (k, v) in d.iter() {
-            let key: String = k.extract()?;
-            let joined = if let Ok(list) = v.cast::<PyList>() {
-                list.iter().map(|x| text(&x)).collect::<PyResult<Vec<_>>>()?.join(",")
-            } else {
-                text(&v)?
-            };
-            sets.push(format!("{key}={joined}"));
-        }
-    }
-    let params = unforeseen_harness::runs::batch::sweep(&sets).map_err(errors::to_py)?;
-    let axis: Vec<Option<u64>> = agents.iter().map(|a| a.train_seed).collect();
-    let identity = format!(
-        "python agents {}",
-        agents
-            .iter()
-            .map(|a| unforeseen_harness::seeds::content_hash(a.bundle.to_ron_string().as_bytes()))
-            .collect::<Vec<_>>()
-            .join(",")
-    );
-    let cfg = BatchConfig {
-        agents: &agents,
-        train_seeds: &axis,
-        scenarios: &scenarios,
-        methods: &methods,
-        params: &params,
-        protocols: &protocols,
-        episodes,
-        seed,
-        jobs: jobs.clamp(1, 256),
-        shard: None,
-        agents_identity: identity,
-    };
-    let out: PathBuf = std::env::temp_dir().join(format!(
-        "unforeseen-python-batch-{}-{}.jsonl",
-        std::process::id(),
-        RUN.fetch_add(1, Ordering::Relaxed)
-    ));
-    let lines = crate::interrupt::interruptible(py, |progress| {
-        unforeseen_harness::runs::batch::run(&cfg, &out, false, progress)
-    });
-    let _ = std::fs::remove_file(&out);
-    BatchResult::new(&lines?)
+#[pyo3(signature = (request, agent = None))]
+fn batch(py: Python<'_>, request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<BatchResult> {
+    let request: BatchRequest = crate::units::request(request)?;
+    let given = agent.map(|a| a.bundle.clone());
+    let report = crate::interrupt::interruptible(py, |progress| {
+        let job = request.plan(given)?;
+        let agents = job.agents(progress)?;
+        let workers = job.workers(&agents);
+        job.run(&agents, workers.jobs, progress)
+    })?;
+    BatchResult::new(&report.lines)
 }
 
 /// The report of result lines a Python policy's evaluation wrote (`unforeseen.evaluate`),
@@ -214,7 +138,7 @@ impl ResultsGuard {
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ResultsGuard>()?;
     m.add_function(wrap_pyfunction!(compare_report, m)?)?;
-    m.add_function(wrap_pyfunction!(batch_report, m)?)?;
+    m.add_function(wrap_pyfunction!(batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch_result, m)?)?;
     Ok(())
 }

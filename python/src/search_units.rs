@@ -5,152 +5,137 @@
 //! ([`evaluate_search_candidates`], with the GIL released). The stage logic and the
 //! outputs stay in the library, so they equal one machine's.
 //!
-//! A `spec` (JSON) is the command line's arguments: `map`, `space`, `method`,
-//! `protocol`, `budget`, `episodes`, `seed`, `sobol_share`, `rounds`, `max_failures`,
-//! `train_seeds` (a list, or null for the agent given or, without one, the run seed) and
-//! `train_episodes`. Agents come as `(training seed, agent text)` pairs.
+//! A `spec` is the search's request (the library's `SearchRequest`, as JSON text), the
+//! same value `unforeseen search` builds from its flags and [`search`] runs in this
+//! process; [`plan_search`] checks it and says which agents it needs. Agents come as
+//! `(training seed, agent text)` pairs.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
 use rayon::prelude::*;
-use serde::Deserialize;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use serde_json::json;
+use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::error::Error;
-use unforeseen_harness::runs::batch::{agent_file_identity, trained_agents_identity};
-use unforeseen_harness::runs::search::{self, CandidateWire, Evaluator, SearchConfig, Space};
-use unforeseen_harness::training::DEFAULT_TRAIN_MAP;
+use unforeseen_harness::runs::batch::AgentChoice;
+use unforeseen_harness::runs::search::{CandidateWire, Evaluator, SearchConfig, SearchRequest, SearchSetup};
 use unforeseen_harness::training::seed_agents::Agent;
 
-use crate::agent::method;
+use crate::agent::PyAgent;
 use crate::errors;
 use crate::interrupt::{interruptible, interruptible_then};
-use crate::units::{check_episodes, parse_agent};
+use crate::units::{parse_agent, request};
 
-/// The arguments of `unforeseen search` that determine its results.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Spec {
-    map: String,
-    space: PathBuf,
-    method: String,
-    protocol: String,
-    budget: usize,
-    episodes: u64,
-    seed: u64,
-    sobol_share: f64,
-    rounds: usize,
-    max_failures: usize,
-    train_seeds: Option<Vec<u64>>,
-    train_episodes: u64,
+/// A search rebuilt from its request and the agents given (what [`SearchConfig`]
+/// borrows).
+struct Built {
+    setup: SearchSetup,
+    agents: Vec<Agent>,
 }
 
-/// A search rebuilt from its spec and agents (what [`SearchConfig`] borrows).
-struct Built {
-    spec: Spec,
-    space: Space,
-    method: Method,
-    protocol: Protocol,
-    agents: Vec<Agent>,
-    axis: Vec<Option<u64>>,
-    identity: String,
+/// The search request `spec` (JSON text of its fields) with the agent of `agents` given
+/// loaded when `from_file` (the request's agent file then not read again), and the
+/// agents parsed.
+fn resolve(
+    spec: &str,
+    agents: &[(Option<u64>, Vec<u8>)],
+    from_file: bool,
+) -> PyResult<(SearchRequest, Option<AgentBundle>, Vec<Agent>)> {
+    let mut request: SearchRequest = request(spec)?;
+    let parsed: Vec<Agent> = agents.iter().map(|(_, t)| parse_agent(t)).collect::<PyResult<_>>()?;
+    let given = if from_file && !request.method.is_scripted() {
+        let [agent] = <[&Agent; 1]>::try_from(parsed.iter().collect::<Vec<_>>())
+            .map_err(|_| errors::value("agent: give one agent file"))?;
+        request.agent = None;
+        Some(agent.bundle.clone())
+    } else {
+        None
+    };
+    Ok((request, given, parsed))
 }
 
 impl Built {
-    fn new(spec: &str, agents: Vec<(Option<u64>, Vec<u8>)>, from_file: bool) -> PyResult<Built> {
-        let spec: Spec = serde_json::from_str(spec).map_err(|e| errors::value(format!("search spec: {e}")))?;
-        check_episodes("episodes", spec.episodes)?;
-        check_episodes("train_episodes", spec.train_episodes)?;
-        let method = method(&spec.method)?;
-        let protocol = protocol(&spec.protocol)?;
-        let base = unforeseen_harness::maps::load(&spec.map).map_err(errors::to_py)?;
-        let space = Space::load(&spec.space, &base).map_err(errors::to_py)?;
-        let parsed: Vec<Agent> = agents.iter().map(|(_, t)| parse_agent(t)).collect::<PyResult<_>>()?;
-        let train_map = || unforeseen_harness::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py);
-        let (agents, axis, identity) = if method.is_scripted() {
-            (Vec::new(), vec![None], "none (a scripted method)".to_string())
-        } else if from_file {
-            let [agent] = <[Agent; 1]>::try_from(parsed).map_err(|_| errors::value("agent: give one agent file"))?;
-            let identity = agent_file_identity(&agent.bundle);
-            let axis = vec![agent.train_seed];
-            (vec![agent], axis, identity)
-        } else {
-            let seeds = spec.train_seeds.clone().unwrap_or_else(|| vec![spec.seed]);
-            if seeds.is_empty() {
-                return Err(errors::value("--train-seeds: give at least one training seed"));
-            }
-            let axis: Vec<Option<u64>> = seeds.iter().map(|&s| Some(s)).collect();
-            let identity = trained_agents_identity(&train_map()?, &axis, spec.train_episodes).map_err(errors::to_py)?;
-            for s in &axis {
-                if !parsed.iter().any(|a| a.train_seed == *s) {
-                    return Err(errors::value(format!("agents: none of training seed {s:?} given")));
+    /// The setup with the agents it runs: the one given, or those of its training seeds
+    /// among `parsed` (each seed must be there).
+    fn new(setup: SearchSetup, parsed: Vec<Agent>) -> PyResult<Built> {
+        let agents = match &setup.agents {
+            AgentChoice::None => Vec::new(),
+            AgentChoice::Given(agent) => vec![agent.as_ref().clone()],
+            AgentChoice::Trained { .. } => {
+                for s in &setup.train_seeds {
+                    if !parsed.iter().any(|a| a.train_seed == *s) {
+                        return Err(errors::value(format!("agents: none of training seed {s:?} given")));
+                    }
                 }
+                parsed
             }
-            (parsed, axis, identity)
         };
-        Ok(Built {
-            spec,
-            space,
-            method,
-            protocol,
-            agents,
-            axis,
-            identity,
-        })
+        Ok(Built { setup, agents })
     }
 
     fn config(&self, jobs: usize, command: String) -> SearchConfig<'_> {
-        SearchConfig {
-            space: &self.space,
-            method: self.method,
-            agents: &self.agents,
-            train_seeds: &self.axis,
-            agents_identity: self.identity.clone(),
-            protocol: self.protocol,
-            budget: self.spec.budget,
-            episodes: self.spec.episodes,
-            seed: self.spec.seed,
-            jobs: jobs.max(1),
-            shard: None,
-            sobol_share: self.spec.sobol_share,
-            rounds: self.spec.rounds,
-            max_failures: self.spec.max_failures,
-            command,
-        }
+        let mut cfg = self.setup.config(&self.agents, jobs.max(1), command);
+        // The tasks and the driver evaluate the whole search (a shard is refused before).
+        cfg.shard = None;
+        cfg
     }
 }
 
-/// Checks a search's spec (its arguments, base map and space file) before any task
-/// runs; returns whether its method is scripted (needs no agents).
+/// The fields of the search request with their defaults, as JSON text (what
+/// `unforeseen.search` and `unforeseen.distributed.run_search` take).
 #[pyfunction]
-fn check_search(spec: &str) -> PyResult<bool> {
-    let spec: Spec = serde_json::from_str(spec).map_err(|e| errors::value(format!("search spec: {e}")))?;
-    check_episodes("episodes", spec.episodes)?;
-    check_episodes("train_episodes", spec.train_episodes)?;
-    protocol(&spec.protocol)?;
-    let base = unforeseen_harness::maps::load(&spec.map).map_err(errors::to_py)?;
-    Space::load(&spec.space, &base).map_err(errors::to_py)?;
-    Ok(method(&spec.method)?.is_scripted())
+fn search_request_defaults() -> PyResult<String> {
+    let defaults = unforeseen_harness::runs::request::defaults::<SearchRequest>().map_err(errors::to_py)?;
+    Ok(defaults.to_string())
 }
 
-fn protocol(name: &str) -> PyResult<Protocol> {
-    match name {
-        "zero-shot" => Ok(Protocol::ZeroShot),
-        "continual" => Ok(Protocol::Continual),
-        other => Err(errors::value(format!(
-            "protocol {other:?}: expected zero-shot or continual"
-        ))),
-    }
+/// Checks the search `request` (JSON text of its fields: arguments, base map, space file)
+/// before any task runs, as `unforeseen search` does; `agent` is an agent given loaded
+/// instead of the request's agent file. Returns JSON text: `spec` (the request, for
+/// [`evaluate_search_candidates`] and [`drive_search`]), `train` (the training seeds of
+/// the agents to train), `train_episodes`, `timeout_as`, and `agent` (the agent's text
+/// when one is given, else null).
+#[pyfunction]
+#[pyo3(signature = (request, agent = None))]
+fn plan_search(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
+    let request: SearchRequest = self::request(request)?;
+    let setup = request.setup(agent.map(|a| a.bundle.clone())).map_err(errors::to_py)?;
+    let agent_text = match &setup.agents {
+        AgentChoice::Given(agent) => Some(agent.bundle.to_ron_string()),
+        _ => None,
+    };
+    let spec = SearchRequest {
+        agent: None,
+        ..request.clone()
+    };
+    Ok(json!({
+        "spec": serde_json::to_string(&spec).map_err(errors::to_py)?,
+        "train": setup.to_train(),
+        "train_episodes": request.train_episodes,
+        "timeout_as": request.timeout_as,
+        "agent": agent_text,
+    })
+    .to_string())
 }
 
-/// An agent file's text as the search reads it (`--agent FILE`), for the object store.
+/// `unforeseen search` in this process: the search `request` (JSON text of its fields)
+/// planned, its agents trained or loaded and the search run by the library, as the
+/// command line runs it, writing the same folder of outputs; `agent` is an agent given
+/// loaded instead of the request's agent file, `command` goes in the failure maps'
+/// comments. Returns `summary.json`'s contents (JSON text). Ctrl-C raises
+/// `KeyboardInterrupt` at the next episode.
 #[pyfunction]
-fn search_agent_text<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyBytes>> {
-    let bundle = unforeseen_harness::training::agent_file::load(&path).map_err(errors::to_py)?;
-    Ok(PyBytes::new(py, bundle.to_ron_string().as_bytes()))
+#[pyo3(signature = (request, agent = None, command = String::new()))]
+fn search(py: Python<'_>, request: &str, agent: Option<PyRef<'_, PyAgent>>, command: String) -> PyResult<String> {
+    let request: SearchRequest = self::request(request)?;
+    let given = agent.map(|a| a.bundle.clone());
+    interruptible(py, |progress| {
+        let job = request.plan(given)?;
+        let agents = job.setup.agents(progress)?;
+        let summary = job.run(&agents, command, progress)?;
+        Ok(serde_json::to_string(&summary)?)
+    })
 }
 
 /// Evaluates the candidates (JSON texts of `unforeseen_harness::runs::search::CandidateWire`) of the
@@ -168,7 +153,8 @@ fn evaluate_search_candidates(
     from_file: bool,
     threads: usize,
 ) -> PyResult<Vec<Vec<String>>> {
-    let built = Built::new(spec, agents, from_file)?;
+    let (request, given, parsed) = resolve(spec, &agents, from_file)?;
+    let built = Built::new(request.setup(given).map_err(errors::to_py)?, parsed)?;
     let wires: Vec<CandidateWire> = candidates
         .iter()
         .map(|c| serde_json::from_str(c).map_err(|e| errors::value(format!("candidate: {e}"))))
@@ -179,7 +165,7 @@ fn evaluate_search_candidates(
         pool.install(|| {
             wires
                 .par_iter()
-                .map(|w| search::evaluate_wire_with(&cfg, w, cancel))
+                .map(|w| unforeseen_harness::runs::search::evaluate_wire_with(&cfg, w, cancel))
                 .collect::<Result<Vec<_>, Error>>()
         })
     })
@@ -212,41 +198,39 @@ impl Evaluator for PyEvaluator {
     }
 }
 
-/// Runs the search `spec` into folder `out` as `unforeseen search` does, with the
-/// candidates evaluated by `evaluate` (a callable given a list of candidate JSON texts,
-/// returning each one's lines, as [`evaluate_search_candidates`] does); `jobs` failures
-/// are minimised at once. `command` goes in the failure maps' comments. Returns
-/// `summary.json`'s contents. The GIL is released while the search runs; `evaluate` is
-/// called with it held, from up to `jobs` threads (never the calling one).
+/// Runs the search `spec` (the request [`plan_search`] returns) into its folder `out` as
+/// `unforeseen search` does, with the candidates evaluated by `evaluate` (a callable
+/// given a list of candidate JSON texts, returning each one's lines, as
+/// [`evaluate_search_candidates`] does); `jobs` failures are minimised at once. `command`
+/// goes in the failure maps' comments. Returns `summary.json`'s contents. The GIL is
+/// released while the search runs; `evaluate` is called with it held, from up to `jobs`
+/// threads (never the calling one).
 ///
 /// Ctrl-C raises `KeyboardInterrupt` once the search stops ([`interruptible_then`]): at
 /// its next episode, or before its next call to `evaluate`; a call under way is asked to
 /// return early by setting `stop` (e.g. a `threading.Event` that `evaluate` checks),
 /// when given. The candidates finished stay in `candidates.jsonl` for `resume`.
 #[pyfunction]
-#[pyo3(signature = (spec, agents, evaluate, out, resume = false, from_file = false, jobs = 1, command = String::new(), stop = None))]
+#[pyo3(signature = (spec, agents, evaluate, from_file = false, jobs = 1, command = String::new(), stop = None))]
 #[allow(clippy::too_many_arguments)]
 fn drive_search(
     py: Python<'_>,
     spec: &str,
     agents: Vec<(Option<u64>, Vec<u8>)>,
     evaluate: Py<PyAny>,
-    out: PathBuf,
-    resume: bool,
     from_file: bool,
     jobs: usize,
     command: String,
     stop: Option<Py<PyAny>>,
 ) -> PyResult<String> {
-    let built = Built::new(spec, agents, from_file)?;
+    let (request, given, parsed) = resolve(spec, &agents, from_file)?;
+    // The output guard, held until the search ends.
+    let job = request.plan(given).map_err(errors::to_py)?;
+    let built = Built::new(job.setup.clone(), parsed)?;
     // One driver thread per failure minimised at once, waiting on its remote calls.
     let cfg = built.config(jobs.clamp(1, unforeseen_harness::limits::MAX_JOBS), command);
     cfg.check().map_err(errors::to_py)?;
-    let _guard = search::output::outputs(&out)
-        .input("map", &built.spec.map)
-        .input("space", &built.spec.space)
-        .guard(resume)
-        .map_err(errors::to_py)?;
+    let out = request.out.clone();
     let remote = PyEvaluator {
         evaluate,
         raised: Mutex::new(None),
@@ -261,7 +245,8 @@ fn drive_search(
         }
     };
     let done = interruptible_then(py, on_signal, |cancel| {
-        let summary = search::run_with(&cfg, Path::new(&out), resume, cancel, Some(&remote))?;
+        let summary =
+            unforeseen_harness::runs::search::run_with(&cfg, Path::new(&out), request.resume, cancel, Some(&remote))?;
         Ok(serde_json::to_string(&summary)?)
     });
     // The error `evaluate` raised as is (not the search's report of it), unless a signal
@@ -275,8 +260,9 @@ fn drive_search(
 
 /// Registers the search units.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(check_search, m)?)?;
-    m.add_function(wrap_pyfunction!(search_agent_text, m)?)?;
+    m.add_function(wrap_pyfunction!(search_request_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(plan_search, m)?)?;
+    m.add_function(wrap_pyfunction!(search, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate_search_candidates, m)?)?;
     m.add_function(wrap_pyfunction!(drive_search, m)?)?;
     Ok(())

@@ -1,5 +1,6 @@
 //! A batch run as units of work for a distributed driver (`unforeseen.distributed`):
-//! plan a run on the driver ([`plan_batch`], the command line's `batch` planning), train
+//! plan a run's request on the driver ([`plan_batch`]: the library's
+//! `BatchRequest::plan`, as the command line's `batch` and `unforeseen.batch` plan it), train
 //! one agent per training seed wherever a task runs ([`train_agent`]), run a block of
 //! units anywhere with the GIL released ([`run_units`]), and join the lines into the
 //! results file and summary on the driver ([`finish_batch`], [`unforeseen_harness::runs::merge`]).
@@ -23,145 +24,87 @@ use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::batch::{
-    BatchConfig, DEFAULT_METHODS, RunIdentity, SCRIPTED_ONLY, Scenario, agent_file_identity, checked_sweep,
-    load_scenarios, run_unit, trained_agents_identity,
+    AgentChoice, BatchConfig, BatchRequest, RunIdentity, Scenario, checked_sweep, run_unit,
 };
-use unforeseen_harness::runs::outputs::Outputs;
 use unforeseen_harness::training::seed_agents::Agent;
-use unforeseen_harness::training::{DEFAULT_TRAIN_MAP, TrainConfig};
+use unforeseen_harness::training::{TimeoutAs, TrainConfig};
 
-use crate::agent::method;
+use crate::agent::PyAgent;
 use crate::errors;
-
-fn protocols_of(choice: &str) -> PyResult<Vec<Protocol>> {
-    match choice {
-        "both" => Ok(Protocol::ALL.to_vec()),
-        "zero-shot" => Ok(vec![Protocol::ZeroShot]),
-        "continual" => Ok(vec![Protocol::Continual]),
-        other => Err(errors::value(format!(
-            "protocol {other:?}: expected zero-shot, continual or both"
-        ))),
-    }
-}
 
 pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
     unforeseen_harness::limits::check_episodes(what, n).map_err(errors::to_py)?;
     Ok(())
 }
 
-/// Where a node finds a scenario: an embedded map's name, or the map file's absolute path
-/// (a node's working folder is not the driver's).
-fn locate(s: &Scenario) -> String {
-    match s.source.strip_prefix("embedded:") {
+/// Where a node finds a map given as `source` (a scenario's source, or the training
+/// map): an embedded map's name, or the map file's absolute path (a node's working
+/// folder is not the driver's).
+fn locate(source: &str) -> String {
+    match source.strip_prefix("embedded:") {
         Some(name) => name.to_string(),
-        None => std::fs::canonicalize(&s.source)
-            .unwrap_or_else(|_| PathBuf::from(&s.source))
+        None if !Path::new(source).exists() => source.to_string(),
+        None => std::fs::canonicalize(source)
+            .unwrap_or_else(|_| PathBuf::from(source))
             .display()
             .to_string(),
     }
 }
 
-/// Plans a batch run into `out` as `unforeseen batch` does (same arguments, same run
-/// identity, `resume` keeping the lines of an earlier run of it), without running or
-/// training anything. Returns JSON text: `spec` (for [`run_units`]), `head` (the
-/// results file's identity line and kept lines), `total` units, `kept`, `todo` (unit
-/// positions still to run) with `todo_seeds` (each one's training seed),
-/// `train_seeds_to_run`, and `agent` (the agent file's text with `agent`, else null).
+/// The request of a job (`BatchRequest`, `SearchRequest`) from the JSON text of its
+/// fields (Python's keyword arguments); errors name the field
+/// ([`unforeseen_harness::runs::request::from_fields`]).
+pub(crate) fn request<T>(fields: &str) -> PyResult<T>
+where
+    T: serde::Serialize + serde::de::DeserializeOwned + Default,
+{
+    let fields: serde_json::Map<String, Value> =
+        serde_json::from_str(fields).map_err(|e| errors::value(format!("request: not a JSON object ({e})")))?;
+    unforeseen_harness::runs::request::from_fields(fields).map_err(errors::to_py)
+}
+
+/// The fields of the batch request with their defaults, as JSON text (what
+/// `unforeseen.batch` and `unforeseen.distributed.run_batch` take).
 #[pyfunction]
-#[pyo3(signature = (maps, out, episodes = 100, seed = 7, methods = None, protocol = "both", sets = Vec::new(), train_seeds = None, train_episodes = unforeseen_harness::training::DEFAULT_TRAIN_EPISODES, agent = None, resume = false, force = false))]
-#[allow(clippy::too_many_arguments)]
-fn plan_batch(
-    maps: Vec<PathBuf>,
-    out: PathBuf,
-    episodes: u64,
-    seed: u64,
-    methods: Option<Vec<String>>,
-    protocol: &str,
-    sets: Vec<String>,
-    train_seeds: Option<Vec<u64>>,
-    train_episodes: u64,
-    agent: Option<PathBuf>,
-    resume: bool,
-    force: bool,
-) -> PyResult<String> {
-    check_episodes("episodes", episodes)?;
-    check_episodes("train_episodes", train_episodes)?;
-    let scenarios = load_scenarios(&maps).map_err(errors::to_py)?;
-    // The checks of `unforeseen batch --out` (the driver writes `out` and its summary).
-    let guard = maps
-        .iter()
-        .fold(Outputs::results("out", &out), |g, m| g.input("maps", m));
-    let guard = match &agent {
-        Some(a) => guard.input("agent", a),
-        None => guard,
-    };
-    guard.check(force || resume).map_err(errors::to_py)?;
-    let methods: Vec<Method> = match methods {
-        Some(names) if !names.is_empty() => names.iter().map(|n| method(n)).collect::<PyResult<_>>()?,
-        _ => DEFAULT_METHODS.to_vec(),
-    };
-    let params = checked_sweep(&sets).map_err(errors::to_py)?;
-    let protocols = protocols_of(protocol)?;
-    let train_map = unforeseen_harness::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py)?;
-    let (axis, agents_identity, agent_text) = match (&train_seeds, &agent) {
-        (Some(_), Some(_)) => {
-            return Err(errors::value(
-                "--train-seeds and --agent: give one (train agents per seed, or run one agent file)",
-            ));
-        }
-        (Some(seeds), None) => {
-            if seeds.is_empty() {
-                return Err(errors::value("--train-seeds: give at least one training seed"));
-            }
-            let axis: Vec<Option<u64>> = seeds.iter().map(|&s| Some(s)).collect();
-            let id = trained_agents_identity(&train_map, &axis, train_episodes).map_err(errors::to_py)?;
-            (axis, id, None)
-        }
-        (None, Some(path)) => {
-            let bundle = unforeseen_harness::training::agent_file::load(path).map_err(errors::to_py)?;
-            let a = Agent::from_bundle(bundle.clone());
-            (
-                vec![a.train_seed],
-                agent_file_identity(&bundle),
-                Some(bundle.to_ron_string()),
-            )
-        }
-        // Scripted methods only: no agent, as `unforeseen batch` runs them.
-        (None, None) if methods.iter().all(|m| m.is_scripted()) => (vec![None], SCRIPTED_ONLY.to_string(), None),
-        (None, None) => {
-            let axis = vec![Some(seed)];
-            let id = trained_agents_identity(&train_map, &axis, train_episodes).map_err(errors::to_py)?;
-            (axis, id, None)
-        }
-    };
-    let cfg = BatchConfig {
-        agents: &[],
-        train_seeds: &axis,
-        scenarios: &scenarios,
-        methods: &methods,
-        params: &params,
-        protocols: &protocols,
-        episodes,
-        seed,
-        jobs: 1,
-        shard: None,
-        agents_identity,
-    };
-    let plan = cfg.plan(&out, resume).map_err(errors::to_py)?;
+fn batch_request_defaults() -> PyResult<String> {
+    let defaults = unforeseen_harness::runs::request::defaults::<BatchRequest>().map_err(errors::to_py)?;
+    Ok(defaults.to_string())
+}
+
+/// Plans the batch `request` (JSON text of its fields) as `unforeseen batch` does (the
+/// same request, checks, agents and run identity, `resume` keeping the lines of an
+/// earlier run of it, the output guard passed), without running or training anything;
+/// `agent` is an agent given loaded instead of the request's agent file. Returns JSON
+/// text: `spec` (for [`run_units`]), `head` (the results file's identity line and kept
+/// lines), `total` units, `kept`, `todo` (unit positions still to run) with `todo_seeds`
+/// (each one's training seed), `train_seeds_to_run` with `train` (the training map where
+/// a node finds it, its episodes and `timeout_as`), and `agent` (the agent's text when
+/// one is given, else null).
+#[pyfunction]
+#[pyo3(signature = (request, agent = None))]
+fn plan_batch(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
+    let request: BatchRequest = self::request(request)?;
+    let job = request.plan(agent.map(|a| a.bundle.clone())).map_err(errors::to_py)?;
+    let setup = &job.setup;
+    let plan = &job.plan;
     let todo = plan.todo();
     let head: String = std::iter::once(format!("{}\n", json!({ "run": plan.identity })))
         .chain(plan.kept.iter().map(|l| l.raw.clone()))
         .collect();
     let spec = json!({
-        "scenarios": scenarios.iter().map(|s| json!([s.source, locate(s)])).collect::<Vec<_>>(),
-        "methods": methods.iter().map(|m| m.name()).collect::<Vec<_>>(),
-        "sets": sets,
-        "protocols": protocols,
-        "train_seeds": axis,
-        "episodes": episodes,
-        "seed": seed,
+        "scenarios": setup.scenarios.iter().map(|s| json!([s.source, locate(&s.source)])).collect::<Vec<_>>(),
+        "methods": setup.methods,
+        "sets": request.sets,
+        "protocols": setup.protocols,
+        "train_seeds": setup.train_seeds,
+        "episodes": setup.episodes,
+        "seed": setup.seed,
         "identity": plan.identity,
     });
+    let agent_text = match &setup.agents {
+        AgentChoice::Given(agent) => Some(agent.bundle.to_ron_string()),
+        _ => None,
+    };
     Ok(json!({
         "spec": spec.to_string(),
         "head": head,
@@ -169,30 +112,44 @@ fn plan_batch(
         "kept": plan.kept.len(),
         "todo": todo.iter().map(|u| u.index).collect::<Vec<_>>(),
         "todo_seeds": todo.iter().map(|u| u.train_seed).collect::<Vec<_>>(),
-        "train_seeds_to_run": plan.train_seeds_to_run(),
+        "train_seeds_to_run": job.to_train(),
+        "train": {
+            "map": locate(&request.train_map),
+            "episodes": request.train_episodes,
+            "timeout_as": request.timeout_as,
+        },
         "agent": agent_text,
     })
     .to_string())
 }
 
-/// Trains the agent of training seed `seed` on the training map for `episodes` episodes,
-/// as `batch --train-seeds` does (no cache), with the GIL released; returns the agent
-/// file's text as bytes (what a driver puts in the object store once per seed).
+/// Trains the agent of training seed `seed` on `train_map` (a file or an embedded name)
+/// for `episodes` episodes, as `batch --train-seeds` does (no cache), with the GIL
+/// released; returns the agent file's text as bytes (what a driver puts in the object
+/// store once per seed).
 #[pyfunction]
-fn train_agent<'py>(py: Python<'py>, seed: u64, episodes: u64) -> PyResult<Bound<'py, PyBytes>> {
+#[pyo3(signature = (seed, episodes, train_map = unforeseen_harness::training::DEFAULT_TRAIN_MAP, timeout_as = "truncation"))]
+fn train_agent<'py>(
+    py: Python<'py>,
+    seed: u64,
+    episodes: u64,
+    train_map: &str,
+    timeout_as: &str,
+) -> PyResult<Bound<'py, PyBytes>> {
     check_episodes("train_episodes", episodes)?;
-    let map = unforeseen_harness::maps::load(DEFAULT_TRAIN_MAP).map_err(errors::to_py)?;
+    let timeout_as: TimeoutAs = timeout_as
+        .parse()
+        .map_err(|e: String| errors::value(format!("timeout_as: {e}")))?;
+    let map = unforeseen_harness::maps::load(train_map).map_err(errors::to_py)?;
+    let config = TrainConfig {
+        timeout_as,
+        ..TrainConfig::new(episodes, 0)
+    };
     let text = py
         .detach(|| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
             pool.install(|| {
-                unforeseen_harness::training::seed_agents::train_agents(
-                    &map,
-                    &[seed],
-                    &TrainConfig::new(episodes, 0),
-                    None,
-                    &NoProgress,
-                )
+                unforeseen_harness::training::seed_agents::train_agents(&map, &[seed], &config, None, &NoProgress)
             })
             .map(|mut a| a.remove(0).bundle.to_ron_string())
         })
@@ -259,8 +216,7 @@ fn run_units(
         };
         scenarios.push(Scenario::of_map(map, source.clone()));
     }
-    let names: Vec<String> = from(&spec, "methods")?;
-    let methods: Vec<Method> = names.iter().map(|n| method(n)).collect::<PyResult<_>>()?;
+    let methods: Vec<Method> = from(&spec, "methods")?;
     let sets: Vec<String> = from(&spec, "sets")?;
     let params = checked_sweep(&sets).map_err(errors::to_py)?;
     let protocols: Vec<Protocol> = from(&spec, "protocols")?;
@@ -358,6 +314,7 @@ fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<String> {
 
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(batch_request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(plan_batch, m)?)?;
     m.add_function(wrap_pyfunction!(train_agent, m)?)?;
     m.add_function(wrap_pyfunction!(run_units, m)?)?;

@@ -24,8 +24,6 @@ from typing import Any
 
 import pytest
 
-from unforeseen.distributed import parse_train_seeds
-
 from test_agents import required_cli
 
 REPO = Path(__file__).resolve().parents[2]
@@ -39,12 +37,19 @@ SWEEP = ["batch", str(REPO / "maps" / "jaywalk.ron"), str(REPO / "maps" / "stop_
          "--train-seeds", "1..2", "--train-episodes", "200", "--episodes", "6", "--seed", "5"]
 
 
-def test_train_seeds_parse_as_the_command_line_writes_them():
-    assert parse_train_seeds("1..4") == [1, 2, 3, 4]
-    assert parse_train_seeds("1..3,7") == [1, 2, 3, 7]
-    for bad in ["3..1", "1,1", "x", "-2"]:
-        with pytest.raises(ValueError, match="--train-seeds"):
-            parse_train_seeds(bad)
+def test_a_bad_field_is_named_as_the_field_in_python_and_as_the_flag_on_the_command_line(tmp_path: Path):
+    """The request's planning names the field; the Ray driver's command spells it as the
+    command line's flag, as `unforeseen batch` does."""
+    from unforeseen.distributed import run_batch
+
+    for bad in ["3..1", "1,1", "x"]:
+        with pytest.raises(ValueError, match="^train_seeds: "):
+            run_batch(["jaywalk"], train_seeds=bad, out=tmp_path / "r.jsonl")
+    run = subprocess.run([sys.executable, "-m", "unforeseen.distributed", "batch", "jaywalk", "--train-seeds", "3..1",
+                          "--out", str(tmp_path / "r.jsonl"), "--address", "127.0.0.1:9"],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2 and "error: --train-seeds: '3..1': the range runs backwards" in run.stderr, run.stderr
+    assert not (tmp_path / "r.jsonl").exists()
 
 
 def test_bad_input_fails_before_any_task_with_its_reason(tmp_path: Path):
@@ -229,8 +234,9 @@ from unforeseen import _unforeseen, distributed as d
 ray.init(address=sys.argv[1], log_to_driver=False)
 tmp, good_map, bad_map = sys.argv[2:5]
 count = os.path.join(tmp, "attempts")
-plan = json.loads(_unforeseen.plan_batch([good_map], os.path.join(tmp, "plan.jsonl"), episodes=1,
-                                         methods=["never-brake"], train_seeds=[1], train_episodes=1))
+plan = json.loads(_unforeseen.plan_batch(json.dumps({"maps": [good_map], "out": os.path.join(tmp, "plan.jsonl"),
+                                                     "episodes": 1, "methods": ["never-brake"], "train_seeds": [1],
+                                                     "train_episodes": 1})))
 spec = json.loads(plan["spec"])
 spec["scenarios"] = [[bad_map, bad_map]]  # the map as a node would see it: not a valid map
 

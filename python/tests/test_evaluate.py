@@ -25,8 +25,8 @@ class AlwaysFast:
 
 def test_lines_are_read_by_the_batch_summary_beside_builtin_methods(agent, tmp_path):
     out = tmp_path / "results.jsonl"
-    builtin = unforeseen.batch("jaywalk", agents=[agent], episodes=4, seed=7, methods=["q-learning"],
-                               protocols=["zero-shot"])
+    builtin = unforeseen.batch("jaywalk", agent=agent, episodes=4, seed=7, methods=["q-learning"],
+                               protocol="zero-shot", out=tmp_path / "builtin.jsonl")
     with open(out, "w") as f:
         for line in builtin["lines"]:
             f.write(json.dumps(line) + "\n")

@@ -1,15 +1,20 @@
 """Three fronts, one core: the same batch or search request through the command line, the
-Ray driver and the library gives the same results, line for line (the wall-clock figures
-aside). The batch request has an agent file, scripted and learning methods, both
+Ray driver and the library gives the same results file, byte for byte (the wall-clock
+figures aside); the library and the Ray driver take the request's fields with the
+library's defaults; a bad field is named as the field in Python and as its flag on the
+command line. The batch request has an agent file, scripted and learning methods, both
 protocols and a sweep, so that agent choice, run identity, protocols and parameter sets
 all cross each front; the search runs every stage (Sobol, adaptive, minimisation)."""
 
 from __future__ import annotations
 
+import inspect
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -37,26 +42,94 @@ def _file_lines(path: Path) -> list[dict]:
     return _untimed([json.loads(line) for line in path.read_text().splitlines()])
 
 
-def test_one_batch_request_gives_the_same_lines_through_every_front(agent_file: Path, tmp_path: Path,
-                                                                    monkeypatch: pytest.MonkeyPatch):
+def _untimed_text(path: Path) -> str:
+    """A results file's bytes with the wall-clock figures' values taken out."""
+    return re.sub(r'"timing_us_per_tick":[^,}]+', '"timing_us_per_tick":_', path.read_text())
+
+
+def test_one_batch_request_gives_the_same_file_through_every_front(agent_file: Path, tmp_path: Path,
+                                                                   monkeypatch: pytest.MonkeyPatch):
     cli_out = tmp_path / "cli.jsonl"
     method_args = [a for m in METHODS for a in ("--method", m)]
     _cli("batch", *MAPS, "--agent", str(agent_file), *method_args, "--protocol", "both", "--set", "horizon=2,3",
          "--episodes", "3", "--seed", "5", "-q", "--out", str(cli_out))
-    expected = _file_lines(cli_out)
+    expected = _untimed_text(cli_out)
+    assert '"param_set":"horizon=3"' in expected and '"protocol":"continual"' in expected
+
+    # The same request, in the same words, through the library and through Ray.
+    request = dict(agent=agent_file, methods=METHODS, protocol="both", sets=["horizon=2,3"], episodes=3, seed=5)
+    library_out = tmp_path / "library.jsonl"
+    library = unforeseen.batch(MAPS, out=library_out, **request)
+    assert _untimed_text(library_out) == expected
+    # The library's lines are the results file's after its `run` line.
+    assert _untimed(list(library["lines"])) == _file_lines(cli_out)[1:]
+    # An agent given loaded is the agent of its file: the same run, the same bytes.
+    loaded_out = tmp_path / "loaded.jsonl"
+    unforeseen.batch(MAPS, out=loaded_out, **{**request, "agent": unforeseen.load_agent(str(agent_file))})
+    assert _untimed_text(loaded_out) == expected
 
     monkeypatch.setitem(sys.modules, "ray", _InlineRay())
     from unforeseen.distributed import run_batch
 
     ray_out = tmp_path / "ray.jsonl"
-    run_batch(MAPS, out=ray_out, agent=agent_file, methods=METHODS, protocol="both", sets=["horizon=2,3"],
-              episodes=3, seed=5, quiet=True)
-    assert _file_lines(ray_out) == expected
+    run_batch(MAPS, out=ray_out, quiet=True, **request)
+    assert _untimed_text(ray_out) == expected
 
-    library = unforeseen.batch(*MAPS, agents=unforeseen.load_agent(str(agent_file)), methods=METHODS,
-                               protocols=["zero-shot", "continual"], sweep={"horizon": [2, 3]}, episodes=3, seed=5)
-    # The library's lines are the results file's after its `run` line.
-    assert _untimed(list(library["lines"])) == expected[1:]
+
+def _request_parameters(function: Any, ray_only: set[str]) -> dict[str, Any]:
+    return {name: p.default for name, p in inspect.signature(function).parameters.items() if name not in ray_only}
+
+
+def _as_json(value: Any) -> Any:
+    return list(value) if isinstance(value, tuple) else value
+
+
+@pytest.mark.parametrize("job", ["batch", "search"])
+def test_local_and_ray_take_the_request_with_the_librarys_defaults(job: str):
+    from unforeseen import distributed
+    from unforeseen.requests import BATCH_DEFAULTS, SEARCH_DEFAULTS, flag
+
+    local, ray, defaults, ray_only = {
+        "batch": (unforeseen.batch, distributed.run_batch, BATCH_DEFAULTS,
+                  {"units_per_task", "address", "max_retries", "quiet"}),
+        "search": (unforeseen.search, distributed.run_search, SEARCH_DEFAULTS,
+                   {"candidates_per_task", "address", "max_retries", "command"}),
+    }[job]
+    on_ray = _request_parameters(ray, ray_only)
+    assert on_ray == _request_parameters(local, {"command"}), "the same arguments, names and defaults"
+    given = {k: _as_json(v) for k, v in on_ray.items()}
+    # The space has no default: the request refuses it empty, Python takes None for it.
+    assert given == {**defaults, **({"space": None} if job == "search" else {})}
+    # The Ray driver's command has one option per field, spelt as the command line's flag.
+    parser = distributed._parser()
+    actions = parser._subparsers._group_actions[0].choices[job]._actions
+    given_nothing = vars(parser.parse_args([job]))
+    for field, default in defaults.items():
+        spellings = [s for a in actions if a.dest == field for s in a.option_strings]
+        assert flag(field) in spellings or (field == "maps" and spellings == []), (field, spellings)
+        # With nothing given, the command's request is the library's default.
+        assert given_nothing[field] == default, field
+
+
+def test_a_bad_field_names_the_field_in_python_and_the_flag_on_the_command_line(tmp_path: Path):
+    with pytest.raises(ValueError, match="^train_seeds: '3..1': the range runs backwards"):
+        unforeseen.batch("jaywalk", train_seeds="3..1", out=tmp_path / "r.jsonl")
+    with pytest.raises(ValueError, match="^sets horizon=1,,2: an empty value"):
+        unforeseen.batch("jaywalk", sets=["horizon=1,,2"], methods=["never-brake"], out=tmp_path / "r.jsonl")
+    with pytest.raises(ValueError, match="^budget 0: expected 1 to"):
+        unforeseen.search(REPO / "maps" / "spaces" / "jaywalk.ron", budget=0, method="never-brake",
+                          out=tmp_path / "s")
+    cli = required_cli()
+    for args, said in [(["--train-seeds", "3..1"], "--train-seeds"),
+                       (["--set", "horizon=1,,2", "--method", "never-brake"], "error: --set horizon=1,,2: an empty value")]:
+        run = subprocess.run([str(cli), "batch", "jaywalk", *args, "--out", str(tmp_path / "r.jsonl")],
+                             capture_output=True, text=True, timeout=120)
+        assert run.returncode == 2 and said in run.stderr, run.stderr
+    run = subprocess.run([str(cli), "search", "--space", str(REPO / "maps" / "spaces" / "jaywalk.ron"), "--budget",
+                          "0", "--method", "never-brake", "--out", str(tmp_path / "s")],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "error: --budget 0: expected 1 to" in run.stderr, run.stderr
+    assert not (tmp_path / "r.jsonl").exists()
 
 
 def test_one_search_request_gives_the_same_outputs_through_every_front(agent_file: Path, tmp_path: Path,

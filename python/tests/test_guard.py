@@ -71,9 +71,9 @@ def test_summarize_a_missing_file_is_an_error(tmp_path):
 
 
 @pytest.mark.parametrize("episodes", [0, 10**7])
-def test_batch_bounds_episodes(agent, episodes):
+def test_batch_bounds_episodes(agent, episodes, tmp_path):
     with pytest.raises(ValueError, match="episodes"):
-        unforeseen.batch("jaywalk", agents=agent, episodes=episodes, methods=["never-brake"])
+        unforeseen.batch("jaywalk", agent=agent, episodes=episodes, methods=["never-brake"], out=tmp_path / "r.jsonl")
 
 
 def _recursive():
@@ -119,13 +119,14 @@ def test_the_search_drivers_threads_are_capped(tmp_path):
 
     spec = json.dumps({"map": "jaywalk", "space": str(MAPS / "spaces" / "jaywalk.ron"), "method": "never-brake",
                        "protocol": "zero-shot", "budget": 2, "episodes": 1, "seed": 3, "sobol_share": 0.5,
-                       "rounds": 1, "max_failures": 1, "train_seeds": None, "train_episodes": 1})
+                       "rounds": 1, "max_failures": 1, "train_seeds": None, "train_episodes": 1,
+                       "out": str(tmp_path / "out")})
 
     def evaluate(candidates):
         return _unforeseen.evaluate_search_candidates(spec, [], candidates)
 
     start = time.monotonic()
-    summary = json.loads(_unforeseen.drive_search(spec, [], evaluate, tmp_path / "out", jobs=20_000))
+    summary = json.loads(_unforeseen.drive_search(spec, [], evaluate, jobs=20_000))
     assert time.monotonic() - start < 30
     assert summary["counts"]["sobol"] == 1
 
@@ -153,7 +154,8 @@ agent = unforeseen.train("intersection", episodes=20, seed=1) if which in ("batc
 calls = {
     "train": lambda: unforeseen.train("intersection", episodes=1_000_000),
     "train_agents": lambda: unforeseen.train_agents([1, 2], episodes=1_000_000, cache=None),
-    "batch": lambda: unforeseen.batch("jaywalk", agents=agent, episodes=1_000_000, methods=["never-brake"]),
+    "batch": lambda: unforeseen.batch("jaywalk", agent=agent, episodes=1_000_000, methods=["never-brake"],
+                                      out=os.path.join(os.environ["TMPDIR"], "r.jsonl")),
     "compare": lambda: unforeseen.compare(agents=agent, episodes=1_000_000),
     "evaluate_builtin": lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=1_000_000),
 }
@@ -190,7 +192,8 @@ from unforeseen import _unforeseen
 which, out, space = sys.argv[1], sys.argv[2], sys.argv[3]
 spec = json.dumps({"map": "jaywalk", "space": space, "method": "never-brake", "protocol": "zero-shot",
                    "budget": 4, "episodes": 1_000_000, "seed": 3, "sobol_share": 0.5, "rounds": 1,
-                   "max_failures": 1, "train_seeds": None, "train_episodes": 1})
+                   "max_failures": 1, "train_seeds": None, "train_episodes": 1,
+                   "out": os.path.join(out, "first")})
 
 class Ray(types.ModuleType):
     # A cluster whose tasks never finish: run_search's own waiting is what Ctrl-C must stop.
@@ -229,7 +232,7 @@ else:
         got.extend(candidates)
         raise Got
     try:
-        _unforeseen.drive_search(spec, [], capture, os.path.join(out, "first"))
+        _unforeseen.drive_search(spec, [], capture)
     except Got:
         pass
     call = lambda: _unforeseen.evaluate_search_candidates(spec, [], got, threads=2)

@@ -61,7 +61,8 @@ def test_batch_prints_the_command_lines_summary_byte_for_byte(agent_file, tmp_pa
     printed = cli("batch", *maps, "--agent", str(agent_file), "--episodes", "2", "--method", "scaled",
                   "--method", "never-brake", "--protocol", "both", "--quiet", "--out", str(tmp_path / "b.jsonl"))
     agent = unforeseen.load_agent(str(agent_file))
-    result = unforeseen.batch(*maps, agents=agent, episodes=2, methods=["scaled", "never-brake"])
+    result = unforeseen.batch(maps, agent=agent, episodes=2, methods=["scaled", "never-brake"],
+                              out=tmp_path / "lib.jsonl")
     assert isinstance(result, unforeseen.BatchResult)
     # No wall-clock figure in the batch's table: the same bytes.
     assert str(result) == printed
@@ -123,7 +124,8 @@ def test_a_python_policys_lines_print_as_the_batch_of_the_same_agent(agent, tmp_
     lines = unforeseen.evaluate(unforeseen.ScaledWrapper(agent=agent, method="scaled"), ["jaywalk"], [7],
                                 episodes=4, seed=7, out=out)
     assert isinstance(lines, unforeseen.EvaluateResult) and isinstance(lines, list) and len(lines) == 2
-    built_in = unforeseen.batch("jaywalk", agents=agent, episodes=4, seed=7, methods=["scaled"])
+    built_in = unforeseen.batch("jaywalk", agent=agent, episodes=4, seed=7, methods=["scaled"],
+                                out=tmp_path / "built_in.jsonl")
     assert str(lines) == str(built_in)
     assert lines.report.summary == unforeseen.summarize(out)
     assert "| jaywalk | scaled | default | zero-shot | 1 |" in lines._repr_markdown_()

@@ -15,14 +15,14 @@ def test_compare(agent):
     assert report["train_seeds"] == [7] and report["episodes"] == 3
 
 
-def test_batch_with_a_sweep(agent):
-    out = unforeseen.batch("jaywalk", agents=agent, episodes=2, methods=["scaled", "never-brake"],
-                           protocols=["zero-shot"], sweep={"horizon": [1, 2]})
+def test_batch_with_a_sweep(agent, tmp_path):
+    out = unforeseen.batch("jaywalk", agent=agent, episodes=2, methods=["scaled", "never-brake"],
+                           protocol="zero-shot", sets=["horizon=1,2"], out=tmp_path / "r.jsonl")
     lines = out["lines"]
     assert {(l["method"], l["param_set"]) for l in lines} >= {("scaled", "horizon=1"), ("scaled", "horizon=2")}
     assert out["summary"]
-    with pytest.raises(ValueError, match="unknown method"):
-        unforeseen.batch("jaywalk", agents=agent, methods=["nope"])
+    with pytest.raises(ValueError, match="^methods: unknown variant `nope`"):
+        unforeseen.batch("jaywalk", agent=agent, methods=["nope"], out=tmp_path / "r.jsonl")
 
 
 def test_train_agents_trains_each_seed_once_and_caches_them(tmp_path):

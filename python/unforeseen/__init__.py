@@ -14,7 +14,9 @@ Every number comes from the Rust crates the ``unforeseen`` command line uses.
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+import os
+from collections.abc import Iterable, Sequence
+from typing import Any
 
 import gymnasium as gym
 
@@ -33,6 +35,7 @@ from ._unforeseen import (
 )
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
 from .evaluate import EvaluateResult, evaluate, evaluate_policy, summarize
+from .requests import request_json
 from .search import search
 from .vector import VectorEnv
 from .wrapper import ScaledWrapper, q_table_habit
@@ -172,21 +175,50 @@ def compare(
 
 
 def batch(
-    *maps: str,
-    agents: Agent | Sequence[Agent],
+    maps: str | os.PathLike[str] | Sequence[str | os.PathLike[str]] = (),
+    *,
+    stream: str | os.PathLike[str] | None = None,
+    methods: Sequence[str] = (),
+    protocol: str = "both",
+    sets: Sequence[str] = (),
     episodes: int = 100,
     seed: int = 7,
-    methods: Sequence[str] | None = None,
-    protocols: Sequence[str] = ("zero-shot", "continual"),
-    sweep: Mapping[str, Any] | None = None,
-    jobs: int = 2,
+    jobs: int | None = None,
+    out: str | os.PathLike[str] = "results.jsonl",
+    resume: bool = False,
+    force: bool = False,
+    shard: str | None = None,
+    agent: str | os.PathLike[str] | Agent | None = None,
+    train_seeds: Iterable[int] | str | None = None,
+    train_map: str = "intersection",
+    train_episodes: int = 6000,
+    timeout_as: str = "truncation",
+    cache: str | os.PathLike[str] | None = "out/agents",
 ) -> BatchResult:
-    """``unforeseen batch`` in the library: every (map, method, parameter set, protocol,
-    agent) as one unit (no maps: the embedded ones; ``methods`` default to the paper's
-    three and the scripted references; ``sweep`` maps a ``--set`` key to a value or a
-    list of values, their cross product). Returns a :class:`BatchResult`:
-    ``print(result)`` gives the summary table ``batch`` prints, ``result["lines"]`` the
-    results file's lines and ``result["summary"]`` the summary's rows, and
-    ``to_pandas()`` one row per summary row."""
-    return _unforeseen.batch_report(list(maps), agents, episodes, seed, None if methods is None else list(methods),
-                                    list(protocols), None if sweep is None else dict(sweep), jobs)
+    """``unforeseen batch`` in this process: the same request, planned, trained and run by
+    the library as the command line runs it, writing the same results file ``out`` and
+    the summary beside it (``results.summary.json``). :func:`unforeseen.distributed.run_batch`
+    takes the same arguments and runs the units on a Ray cluster.
+
+    Every (map, method, parameter set, protocol, training seed) is one unit:
+
+    * ``maps``: map files, folders of maps or embedded names (none: the embedded maps);
+      or ``stream``, a deployment stream file, as the one scenario;
+    * ``methods``: method names (none: q-learning, bayes-rl, scaled, brake-on-pedestrian
+      and never-brake); ``protocol``: ``"zero-shot"``, ``"continual"`` or ``"both"``;
+    * ``sets``: the sweep, one ``"KEY=V1,V2"`` per parameter (the cross product);
+    * the agents: ``agent`` (an agent file, or an :class:`Agent`), ``train_seeds`` (one
+      agent per seed, ``range(1, 5)`` or ``"1..4"``, trained on ``train_map`` for
+      ``train_episodes`` and kept in the agent cache ``cache``, None for none), or
+      neither (one agent trained with ``seed``; scripted methods alone need none);
+    * ``episodes`` per unit, the evaluation ``seed``, ``jobs`` threads (None: every
+      core), ``resume`` (keep the lines of the same run in ``out``), ``force`` (replace an
+      ``out`` that is not a results file), ``shard`` (``"I/N"``: one slice of the units).
+
+    A bad argument raises ``ValueError`` naming it (``train_seeds: ...``) before any work.
+    Returns a :class:`BatchResult`: ``print(result)`` gives the summary table ``batch``
+    prints, ``result["lines"]`` the results file's lines and ``result["summary"]`` the
+    summary's rows, and ``to_pandas()`` one row per summary row."""
+    fields = dict(locals())
+    given = fields.pop("agent") if isinstance(agent, Agent) else None
+    return _unforeseen.batch(request_json(fields), given)

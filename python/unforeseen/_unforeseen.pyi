@@ -22,7 +22,7 @@ __all__ = [
     "PolicyRun",
     "ScaledHabitAgent",
     "VectorEnv",
-    "batch_report",
+    "batch",
     "batch_result",
     "compare_report",
     "embedded_maps",
@@ -234,17 +234,14 @@ def compare_report(
     **params: Any,
 ) -> CompareResult:
     """``unforeseen compare``: its report."""
-def batch_report(
-    maps: Sequence[str],
-    agents: Agent | Sequence[Agent],
-    episodes: int = 100,
-    seed: int = 7,
-    methods: Sequence[str] | None = None,
-    protocols: Sequence[str] = ("zero-shot", "continual"),
-    sweep: dict[str, Any] | None = None,
-    jobs: int = 2,
-) -> BatchResult:
-    """``unforeseen batch``: its report (result lines and summary)."""
+def batch(request: str, agent: Agent | None = None) -> BatchResult:
+    """``unforeseen batch`` in this process: the batch request (JSON text of its fields;
+    :func:`unforeseen.batch` writes it), planned, trained and run by the library as the
+    command line runs it, writing its results file and summary; ``agent`` is an agent
+    given loaded instead of the request's agent file. A bad field raises ``ValueError``
+    naming it."""
+def batch_request_defaults() -> str:
+    """The batch request's fields with their defaults (JSON text)."""
 def batch_result(lines: str) -> BatchResult:
     """The report of result lines (the JSON text of their list) that ``evaluate`` wrote,
     summarized and printed as ``unforeseen batch`` does its own."""
@@ -390,35 +387,30 @@ class ResultsGuard:
 
 def summarize_json(path: str) -> str:
     """The batch summary over training seeds of a results file, as JSON text."""
-def plan_batch(
-    maps: Sequence[str],
-    out: str,
-    episodes: int = 100,
-    seed: int = 7,
-    methods: Sequence[str] | None = None,
-    protocol: str = "both",
-    sets: Sequence[str] = (),
-    train_seeds: Sequence[int] | None = None,
-    train_episodes: int = 6000,
-    agent: str | None = None,
-    resume: bool = False,
-    force: bool = False,
-) -> str:
-    """A batch run planned as `unforeseen batch` plans it (JSON text: spec, head, total,
-    kept, todo, todo_seeds, train_seeds_to_run, agent); runs and trains nothing."""
-def train_agent(seed: int, episodes: int) -> bytes:
-    """The agent of one training seed (agent-file text), trained with the GIL released."""
+def plan_batch(request: str, agent: Agent | None = None) -> str:
+    """The batch request (JSON text of its fields) planned as ``unforeseen batch`` plans it
+    (JSON text: spec, head, total, kept, todo, todo_seeds, train_seeds_to_run, train,
+    agent); passes the output guard, runs and trains nothing."""
+def train_agent(seed: int, episodes: int, train_map: str = "intersection", timeout_as: str = "truncation") -> bytes:
+    """The agent of one training seed (agent-file text), trained on ``train_map`` with the GIL released."""
 def run_units(spec: str, agents: Sequence[tuple[int | None, bytes]], units: Sequence[int], threads: int = 1) -> list[str]:
     """The result lines (JSON text) of units of a planned run, with the GIL released."""
 def finish_batch(out: str) -> str:
     """Rewrites a driver's results file in canonical order with its summary; JSON text of
     ``lines``, ``summary`` (its path), ``checked``, ``failed``, ``failures`` and ``table``
     (the summary table ``unforeseen batch`` prints)."""
-def check_search(spec: str) -> bool:
-    """Checks a search's spec (JSON text: arguments, base map, space file) before any task;
-    whether its method is scripted (needs no agents)."""
-def search_agent_text(path: str | os.PathLike[str]) -> bytes:
-    """An agent file's text, as the search tasks take it."""
+def search_request_defaults() -> str:
+    """The search request's fields with their defaults (JSON text)."""
+def plan_search(request: str, agent: Agent | None = None) -> str:
+    """The search request (JSON text of its fields) checked as ``unforeseen search`` checks
+    it (arguments, base map, space file), before any task; JSON text of ``spec`` (the
+    request), ``train`` (training seeds to train), ``train_episodes``, ``timeout_as`` and
+    ``agent`` (the given agent's text, or null)."""
+def search(request: str, agent: Agent | None = None, command: str = "") -> str:
+    """``unforeseen search`` in this process: the search request (JSON text of its
+    fields) planned, trained and run by the library as the command line runs it, writing
+    its folder of outputs; ``summary.json``'s contents (JSON text). A bad field raises
+    ``ValueError`` naming it; Ctrl-C raises KeyboardInterrupt at the next episode."""
 def evaluate_search_candidates(
     spec: str,
     agents: Sequence[tuple[int | None, bytes]],
@@ -432,12 +424,11 @@ def drive_search(
     spec: str,
     agents: Sequence[tuple[int | None, bytes]],
     evaluate: Callable[[list[str]], list[list[str]]],
-    out: str | os.PathLike[str],
-    resume: bool = False,
     from_file: bool = False,
     jobs: int = 1,
     command: str = "",
     stop: Any | None = None,
 ) -> str:
-    """Runs a search's stages in Rust with ``evaluate`` for its candidates; the summary (JSON text).
+    """Runs a search's stages in Rust (the request ``spec`` from :func:`plan_search`, into
+    its ``out``) with ``evaluate`` for its candidates; the summary (JSON text).
     Ctrl-C raises KeyboardInterrupt, calling ``stop.set()`` so an ``evaluate`` under way can return early."""

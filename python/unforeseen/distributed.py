@@ -1,6 +1,7 @@
 """Batch runs across machines on a Ray cluster, with the results one machine writes.
 
-:func:`run_batch` takes the arguments of ``unforeseen batch``, connects to a running
+:func:`run_batch` takes the arguments of :func:`unforeseen.batch` (the batch request, the
+fields and defaults of ``unforeseen batch``), connects to a running
 cluster (``address="auto"``, or one given), and runs the batch as Ray tasks through the
 Rust binding (not the command line), a block of units per task with the GIL released::
 
@@ -8,8 +9,8 @@ Rust binding (not the command line), a block of units per task with the GIL rele
     report = run_batch(["maps/"], train_seeds=range(1, 5), episodes=20, out="sweep.jsonl")
 
 or, from a shell, ``python -m unforeseen.distributed batch maps/ --train-seeds 1..4
---episodes 20 --out sweep.jsonl`` (the options of ``unforeseen batch``, plus
-``--address`` and ``--units-per-task``).
+--episodes 20 --out sweep.jsonl`` (the options of ``unforeseen batch``, derived from the
+request's fields, plus ``--address`` and ``--units-per-task``).
 
 How it runs
 -----------
@@ -46,7 +47,8 @@ on loopback inside a network namespace (the tests do the same).
 
 How a search runs
 -----------------
-:func:`run_search` keeps the search's stages in Rust (``unforeseen::search::run_with``,
+:func:`run_search` takes the arguments of :func:`unforeseen.search` (the search
+request) and keeps the search's stages in Rust (``unforeseen::search::run_with``,
 through the binding's ``drive_search``): the Sobol stage, each cross-entropy round and
 each minimisation try hand their candidates to an evaluator, which here splits them into
 blocks and runs them as Ray tasks through :func:`_drive` (the same retry and input-error
@@ -73,9 +75,9 @@ from pathlib import Path
 from typing import Any
 
 from . import _unforeseen
-from .search import plan_search
+from .requests import BATCH_DEFAULTS, SEARCH_DEFAULTS, flag, flag_message, request_json
 
-__all__ = ["DEFAULT_MAX_RETRIES", "main", "parse_train_seeds", "run_batch", "run_search"]
+__all__ = ["DEFAULT_MAX_RETRIES", "main", "run_batch", "run_search"]
 
 #: Retries of a task whose worker process or node died (system failures only).
 DEFAULT_MAX_RETRIES = 3
@@ -117,9 +119,9 @@ def _task_options(max_retries: int) -> dict[str, Any]:
     return {"max_retries": max_retries, "retry_exceptions": False}
 
 
-def _train_task(seed: int, episodes: int) -> bytes:
+def _train_task(seed: int, episodes: int, train_map: str = "intersection", timeout_as: str = "truncation") -> bytes:
     """One agent, trained on the node that runs the task."""
-    return _unforeseen.train_agent(seed, episodes)
+    return _unforeseen.train_agent(seed, episodes, train_map, timeout_as)
 
 
 def _units_task(spec: str, seeds: Sequence[int | None], *agents: bytes, units: list[int], threads: int) -> list[str]:
@@ -225,60 +227,63 @@ def _lock(out: Path) -> Any:
     except BlockingIOError:
         f.close()
         raise ValueError(
-            f"--out {out}: another batch is writing this results file now (it holds {path}); "
-            "wait for it to finish, or give another --out"
+            f"out {out}: another batch is writing this results file now (it holds {path}); "
+            "wait for it to finish, or give another out"
         ) from None
     return f
 
 
 def run_batch(
-    maps: Iterable[str | os.PathLike[str]] = (),
+    maps: str | os.PathLike[str] | Sequence[str | os.PathLike[str]] = (),
     *,
-    out: str | os.PathLike[str] = "results.jsonl",
-    episodes: int = 100,
-    seed: int = 7,
-    methods: Sequence[str] | None = None,
+    stream: str | os.PathLike[str] | None = None,
+    methods: Sequence[str] = (),
     protocol: str = "both",
     sets: Sequence[str] = (),
-    train_seeds: Iterable[int] | None = None,
-    train_episodes: int = 6000,
-    agent: str | os.PathLike[str] | None = None,
+    episodes: int = 100,
+    seed: int = 7,
+    jobs: int | None = None,
+    out: str | os.PathLike[str] = "results.jsonl",
     resume: bool = False,
     force: bool = False,
-    jobs: int = 1,
+    shard: str | None = None,
+    agent: str | os.PathLike[str] | _unforeseen.Agent | None = None,
+    train_seeds: Iterable[int] | str | None = None,
+    train_map: str = "intersection",
+    train_episodes: int = 6000,
+    timeout_as: str = "truncation",
+    cache: str | os.PathLike[str] | None = "out/agents",
     units_per_task: int | None = None,
     address: str | None = "auto",
     max_retries: int = DEFAULT_MAX_RETRIES,
     quiet: bool = False,
 ) -> dict[str, Any]:
-    """``unforeseen batch`` on a Ray cluster (see the module's documentation).
+    """``unforeseen batch`` on a Ray cluster (see the module's documentation): the
+    arguments of :func:`unforeseen.batch` (the batch request, planned by the library as
+    the command line plans it), and the same results file ``out`` and summary, timing
+    fields aside. On the cluster ``jobs`` is the threads, and CPUs, of each task (None:
+    1); agents train once per seed on the cluster and are not cached (``cache`` is not
+    used); ``shard`` is refused (the cluster splits the run itself).
 
-    The arguments are the command line's (``sets`` are ``--set`` texts such as
-    ``"horizon=1,2"``; ``jobs`` is the threads, and CPUs, of each task). Connects with
-    ``ray.init(address)`` unless Ray is connected already. Returns the finished file's
-    ``lines`` (dicts), ``summary`` (its path), ``checked``, ``failed``, ``failures``
-    (the expectations failed on the mean over training seeds, in ``batch``'s words; the
-    command exits 1 on any, as ``batch`` does) and ``table`` (the summary table ``batch``
-    prints, which the command prints too).
+    Ray's own: ``units_per_task`` (default: about 4 tasks per CPU), ``address`` (connects
+    with ``ray.init(address)`` unless Ray is connected already), ``max_retries`` and
+    ``quiet``. A bad argument raises ``ValueError`` naming it before any task runs.
+    Returns the finished file's ``lines`` (dicts), ``summary`` (its path), ``checked``,
+    ``failed``, ``failures`` (the expectations failed on the mean over training seeds,
+    in ``batch``'s words; the command exits 1 on any, as ``batch`` does) and ``table``
+    (the summary table ``batch`` prints, which the command prints too).
     """
-    out = Path(out)
-    _check_task_options(jobs, "units_per_task", units_per_task, max_retries)
-    plan = json.loads(
-        _unforeseen.plan_batch(
-            [str(m) for m in maps],
-            str(out),
-            episodes=episodes,
-            seed=seed,
-            methods=list(methods) if methods else None,
-            protocol=protocol,
-            sets=list(sets),
-            train_seeds=None if train_seeds is None else list(train_seeds),
-            train_episodes=train_episodes,
-            agent=None if agent is None else str(agent),
-            resume=resume,
-            force=force,
+    fields = {k: v for k, v in locals().items() if k in BATCH_DEFAULTS}
+    if shard is not None:
+        raise ValueError(
+            f"shard {shard}: the cluster splits the run itself; run it whole here, "
+            "or run `unforeseen batch --shard I/N` on separate machines and `unforeseen merge` the parts"
         )
-    )
+    threads = 1 if jobs is None else jobs
+    _check_task_options(threads, "units_per_task", units_per_task, max_retries)
+    given = fields.pop("agent") if isinstance(agent, _unforeseen.Agent) else None
+    out = Path(out)
+    plan = json.loads(_unforeseen.plan_batch(request_json(fields), given))
     ray = _ray()
     lock = _lock(out)
     try:
@@ -291,19 +296,20 @@ def run_batch(
             agent_refs = {plan["todo_seeds"][0] if plan["todo_seeds"] else None: ray.put(plan["agent"].encode())}
         else:
             train = ray.remote(num_cpus=1, **options)(_train_task)
-            agent_refs = {s: train.remote(s, train_episodes) for s in plan["train_seeds_to_run"]}
+            t = plan["train"]
+            agent_refs = {s: train.remote(s, t["episodes"], t["map"], t["timeout_as"]) for s in plan["train_seeds_to_run"]}
         todo: list[int] = plan["todo"]
         seed_of = dict(zip(todo, plan["todo_seeds"], strict=True))
         if units_per_task is None:
-            cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // jobs)
+            cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // threads)
             units_per_task = max(1, math.ceil(len(todo) / (4 * cpus)))
         blocks = [todo[i : i + units_per_task] for i in range(0, len(todo), units_per_task)]
-        run = ray.remote(num_cpus=jobs, **options)(_units_task)
+        run = ray.remote(num_cpus=threads, **options)(_units_task)
 
         def submit(block: list[int]) -> Any:
             # The block's agents (a scripted method's units need none: none is trained for them).
             seeds = sorted({seed_of[u] for u in block} & agent_refs.keys(), key=lambda s: (s is None, s or 0))
-            return run.remote(plan["spec"], seeds, *(agent_refs[s] for s in seeds), units=block, threads=jobs)
+            return run.remote(plan["spec"], seeds, *(agent_refs[s] for s in seeds), units=block, threads=threads)
 
         progress = _Progress(plan["total"], plan["kept"], quiet)
         with open(out, "a", encoding="utf-8") as f:
@@ -323,8 +329,8 @@ def run_batch(
 
 
 def run_search(
+    space: str | os.PathLike[str] | None = None,
     *,
-    space: str | os.PathLike[str],
     map: str | os.PathLike[str] = "jaywalk",
     method: str = "scaled",
     protocol: str = "zero-shot",
@@ -334,52 +340,65 @@ def run_search(
     sobol_share: float = 0.5,
     rounds: int = 5,
     max_failures: int = 5,
-    out: str | os.PathLike[str] = "out/search",
-    train_seeds: Iterable[int] | None = None,
-    train_episodes: int = 6000,
-    agent: str | os.PathLike[str] | None = None,
+    jobs: int | None = None,
+    shard: str | None = None,
     resume: bool = False,
-    jobs: int = 1,
+    out: str | os.PathLike[str] = "out/search",
+    force: bool = False,
+    agent: str | os.PathLike[str] | _unforeseen.Agent | None = None,
+    train_seeds: Iterable[int] | str | None = None,
+    train_episodes: int = 6000,
+    timeout_as: str = "truncation",
+    cache: str | os.PathLike[str] | None = "out/agents",
+    command: str | None = None,
     candidates_per_task: int | None = None,
     address: str | None = "auto",
     max_retries: int = DEFAULT_MAX_RETRIES,
-    command: str | None = None,
 ) -> dict[str, Any]:
-    """``unforeseen search`` on a Ray cluster: the same arguments, the same folder of
-    outputs (``candidates.jsonl``, ``summary.json``, ``failures/*.ron``, ``search.svg``),
-    timing fields aside, whatever the number of workers.
+    """``unforeseen search`` on a Ray cluster: the arguments of :func:`unforeseen.search`
+    (the search request, checked by the library as the command line checks it), and the
+    same folder of outputs (``candidates.jsonl``, ``summary.json``, ``failures/*.ron``,
+    ``search.svg``), timing fields aside, whatever the number of workers. On the cluster
+    ``jobs`` is the threads, and CPUs, of each task (None: 1); agents train once per seed
+    on the cluster and are not cached (``cache`` is not used); ``shard`` is refused.
 
     The stages run in order on the driver, in the library (``unforeseen::search``); each
     stage's candidates (the Sobol stage's, each adaptive round's) run as tasks of
     ``candidates_per_task`` candidates (default: about 4 tasks per CPU), and each
     minimisation try as a task of its own, the best failures minimised at once. Agents
-    train once per training seed on the cluster and reach the tasks through the object
-    store. ``command`` is written in the failure maps' comments (``Found by: ...``).
-    Returns ``summary.json``'s contents.
+    reach the tasks through the object store. ``command`` is written in the failure maps'
+    comments (``Found by: ...``). Returns ``summary.json``'s contents.
     """
-    _check_task_options(jobs, "candidates_per_task", candidates_per_task, max_retries)
-    # The arguments, maps and space checked before any task runs.
-    plan = plan_search(
-        space=space, map=map, method=method, protocol=protocol, budget=budget, episodes=episodes, seed=seed,
-        sobol_share=sobol_share, rounds=rounds, max_failures=max_failures, train_seeds=train_seeds,
-        train_episodes=train_episodes, agent=agent,
-    )
-    spec, from_file = plan.spec, plan.from_file
+    fields = {k: v for k, v in locals().items() if k in SEARCH_DEFAULTS}
+    if space is None:
+        fields.pop("space")
+    if shard is not None:
+        raise ValueError(
+            f"shard {shard}: the cluster splits the run itself; run it whole here, "
+            "or run `unforeseen search --shard I/N` on separate machines and finish with --resume"
+        )
+    threads = 1 if jobs is None else jobs
+    _check_task_options(threads, "candidates_per_task", candidates_per_task, max_retries)
+    given = fields.pop("agent") if isinstance(agent, _unforeseen.Agent) else None
+    # The request, maps and space checked before any task runs.
+    plan = json.loads(_unforeseen.plan_search(request_json(fields), given))
+    spec = plan["spec"]
+    from_file = plan["agent"] is not None
     ray = _ray()
     if not ray.is_initialized():
         ray.init(address=address, include_dashboard=False, log_to_driver=False)
     options = _task_options(max_retries)
     pairs: list[tuple[int | None, Any]]
     if from_file:
-        pairs = [(None, ray.put(_unforeseen.search_agent_text(str(agent))))]
+        pairs = [(None, ray.put(plan["agent"].encode()))]
     else:
         train = ray.remote(num_cpus=1, **options)(_train_task)
-        pairs = [(s, train.remote(s, train_episodes)) for s in plan.train]
+        pairs = [(s, train.remote(s, plan["train_episodes"], "intersection", plan["timeout_as"])) for s in plan["train"]]
     agent_seeds = [s for s, _ in pairs]
     refs = [r for _, r in pairs]
     texts = ray.get(refs) if refs else []
-    task = ray.remote(num_cpus=jobs, **options)(_search_task)
-    cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // jobs)
+    task = ray.remote(num_cpus=threads, **options)(_search_task)
+    cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // threads)
 
     # Set by the binding on Ctrl-C: `evaluate` runs on the driver's other threads, which
     # never see the signal themselves.
@@ -392,7 +411,8 @@ def run_search(
 
         def submit(block: list[int]) -> Any:
             return task.remote(
-                spec, agent_seeds, *refs, candidates=[candidates[i] for i in block], from_file=from_file, threads=jobs
+                spec, agent_seeds, *refs, candidates=[candidates[i] for i in block], from_file=from_file,
+                threads=threads,
             )
 
         def sink(block: list[int], got: list[list[str]]) -> None:
@@ -406,8 +426,6 @@ def run_search(
         spec,
         list(zip(agent_seeds, texts, strict=True)),
         evaluate,
-        str(out),
-        resume=resume,
         from_file=from_file,
         jobs=max(1, max_failures),
         command=command if command is not None else f"unforeseen.distributed.run_search(space={str(space)!r}, ...)",
@@ -416,71 +434,37 @@ def run_search(
     return json.loads(summary)
 
 
-def parse_train_seeds(text: str) -> list[int]:
-    """``1..10``, ``1,3,5`` or ``1..3,7`` (ranges inclusive), as ``--train-seeds``."""
-    seeds: list[int] = []
-    for part in text.split(","):
-        part = part.strip()
-        try:
-            if ".." in part:
-                a, b = (int(x) for x in part.split("..", 1))
-                if a > b:
-                    raise ValueError
-                seeds.extend(range(a, b + 1))
-            else:
-                seeds.append(int(part))
-        except ValueError:
-            raise ValueError(f"--train-seeds {text!r}: expected seeds like 1..10, 1,3,5 or 1..3,7") from None
-    if any(s < 0 for s in seeds) or len(set(seeds)) != len(seeds):
-        raise ValueError(f"--train-seeds {text!r}: seeds are non-negative and listed once")
-    return seeds
+def _request_options(parser: argparse.ArgumentParser, defaults: dict[str, Any], positional: str | None) -> None:
+    """One option per field of a request (``defaults``: its fields and defaults, from the
+    library), spelt as the command line spells it (:func:`unforeseen.requests.flag`):
+    ``positional`` as the arguments, a list as a repeatable option, a flag for a bool,
+    ``--no-cache`` for no agent cache."""
+    for field, default in defaults.items():
+        if field == positional:
+            parser.add_argument(field, nargs="*", metavar="MAP|DIR")
+        elif isinstance(default, bool):
+            parser.add_argument(flag(field), dest=field, action="store_true")
+        elif isinstance(default, list):
+            parser.add_argument(flag(field), dest=field, action="append", default=[])
+        else:
+            kind = int if field == "jobs" or isinstance(default, int) else float if isinstance(default, float) else str
+            parser.add_argument(flag(field), dest=field, type=kind, default=default)
+    if "cache" in defaults:
+        parser.add_argument("--no-cache", dest="cache", action="store_const", const=None, default=argparse.SUPPRESS,
+                            help="accepted (agents are not cached on the cluster)")
 
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m unforeseen.distributed", description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="command", required=True)
     b = sub.add_parser("batch", help="unforeseen batch on a Ray cluster (its options, plus --address)")
-    b.add_argument("maps", nargs="*", metavar="MAP|DIR")
-    b.add_argument("--episodes", type=int, default=100)
-    b.add_argument("--seed", type=int, default=7)
-    b.add_argument("--method", dest="methods", action="append", default=[])
-    b.add_argument("--protocol", choices=["zero-shot", "continual", "both"], default="both")
-    b.add_argument("--jobs", type=int, default=1, help="threads (and CPUs) of each task")
-    b.add_argument("--out", default="results.jsonl")
-    b.add_argument("--resume", action="store_true")
-    b.add_argument("--force", action="store_true")
-    b.add_argument("--shard", metavar="I/N", help="refused: the cluster splits the run itself")
-    b.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=V1,V2")
-    b.add_argument("--train-episodes", type=int, default=6000)
-    b.add_argument("--agent", metavar="FILE")
-    b.add_argument("--train-seeds", metavar="SEEDS")
-    b.add_argument("--cache", metavar="DIR", help="accepted; agents train on the cluster, once per seed per run")
-    b.add_argument("--no-cache", action="store_true", help="accepted (agents are not cached on the cluster)")
-    b.add_argument("--timeout-as", choices=["truncation"], default="truncation")
+    _request_options(b, BATCH_DEFAULTS, positional="maps")
     b.add_argument("--quiet", "-q", action="store_true")
     b.add_argument("--address", default="auto", help="Ray cluster address (default: auto, the local cluster)")
     b.add_argument("--units-per-task", type=int, help="units per task (default: about 4 tasks per CPU)")
     b.add_argument("--max-retries", type=int, default=DEFAULT_MAX_RETRIES)
     s = sub.add_parser("search", help="unforeseen search on a Ray cluster (its options, plus --address)")
-    s.add_argument("--map", default="jaywalk")
-    s.add_argument("--space", required=True)
-    s.add_argument("--method", default="scaled")
-    s.add_argument("--protocol", choices=["zero-shot", "continual"], default="zero-shot")
-    s.add_argument("--budget", type=int, default=100)
-    s.add_argument("--episodes", type=int, default=20)
-    s.add_argument("--seed", type=int, default=7)
-    s.add_argument("--sobol-share", type=float, default=0.5)
-    s.add_argument("--rounds", type=int, default=5)
-    s.add_argument("--max-failures", type=int, default=5)
-    s.add_argument("--jobs", type=int, default=1, help="threads (and CPUs) of each task")
-    s.add_argument("--shard", metavar="I/N", help="refused: the cluster splits the run itself")
-    s.add_argument("--resume", action="store_true")
-    s.add_argument("--out", default="out/search")
-    s.add_argument("--train-episodes", type=int, default=6000)
-    s.add_argument("--agent", metavar="FILE")
-    s.add_argument("--train-seeds", metavar="SEEDS")
-    s.add_argument("--cache", metavar="DIR", help="accepted; agents train on the cluster, once per seed per run")
-    s.add_argument("--no-cache", action="store_true", help="accepted (agents are not cached on the cluster)")
+    _request_options(s, SEARCH_DEFAULTS, positional=None)
     s.add_argument("--quiet", "-q", action="store_true")
     s.add_argument("--address", default="auto", help="Ray cluster address (default: auto, the local cluster)")
     s.add_argument("--candidates-per-task", type=int, help="candidates per task (default: about 4 tasks per CPU)")
@@ -490,35 +474,15 @@ def _parser() -> argparse.ArgumentParser:
 
 def _main_search(args: argparse.Namespace, argv: Sequence[str]) -> int:
     try:
-        if args.shard:
-            raise ValueError(
-                f"--shard {args.shard}: the cluster splits the run itself; run it whole here, "
-                "or run `unforeseen search --shard I/N` on separate machines and finish with --resume"
-            )
         summary = run_search(
-            space=args.space,
-            map=args.map,
-            method=args.method,
-            protocol=args.protocol,
-            budget=args.budget,
-            episodes=args.episodes,
-            seed=args.seed,
-            sobol_share=args.sobol_share,
-            rounds=args.rounds,
-            max_failures=args.max_failures,
-            out=args.out,
-            train_seeds=None if args.train_seeds is None else parse_train_seeds(args.train_seeds),
-            train_episodes=args.train_episodes,
-            agent=args.agent,
-            resume=args.resume,
-            jobs=args.jobs,
+            **{f: getattr(args, f) for f in SEARCH_DEFAULTS},
             candidates_per_task=args.candidates_per_task,
             address=args.address,
             max_retries=args.max_retries,
             command=" ".join(["python -m unforeseen.distributed", *argv]),
         )
     except ValueError as e:
-        print(f"error: {e}", file=sys.stderr)
+        print(f"error: {flag_message(str(e), SEARCH_DEFAULTS)}", file=sys.stderr)
         return 2
     except (RuntimeError, ConnectionError) as e:
         print(f"error: {e}", file=sys.stderr)
@@ -539,33 +503,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "search":
         return _main_search(args, argv)
     try:
-        if args.shard:
-            raise ValueError(
-                f"--shard {args.shard}: the cluster splits the run itself; run it whole here, "
-                "or run `unforeseen batch --shard I/N` on separate machines and `unforeseen merge` the parts"
-            )
-        seeds = None if args.train_seeds is None else parse_train_seeds(args.train_seeds)
         report = run_batch(
-            args.maps,
-            out=args.out,
-            episodes=args.episodes,
-            seed=args.seed,
-            methods=args.methods or None,
-            protocol=args.protocol,
-            sets=args.sets,
-            train_seeds=seeds,
-            train_episodes=args.train_episodes,
-            agent=args.agent,
-            resume=args.resume,
-            force=args.force,
-            jobs=args.jobs,
+            **{f: getattr(args, f) for f in BATCH_DEFAULTS},
             units_per_task=args.units_per_task,
             address=args.address,
             max_retries=args.max_retries,
             quiet=args.quiet,
         )
     except ValueError as e:
-        print(f"error: {e}", file=sys.stderr)
+        print(f"error: {flag_message(str(e), BATCH_DEFAULTS)}", file=sys.stderr)
         return 2
     except (RuntimeError, ConnectionError) as e:
         print(f"error: {e}", file=sys.stderr)

@@ -3,24 +3,15 @@
 //! training-seed studies.
 
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use super::ProtocolChoice;
 use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::survivability::{Witness, warnings};
-use unforeseen_harness::maps;
-use unforeseen_harness::reports::files::write_json;
+use unforeseen_harness::episodes::protocol::ProtocolChoice;
 use unforeseen_harness::reports::tables;
-use unforeseen_harness::runs::batch::{
-    BatchConfig, DEFAULT_METHODS, ResultLine, SCRIPTED_ONLY, Scenario, ScenarioKind, Shard, SummaryRow,
-    agent_file_identity, checked_sweep, load_scenarios, load_stream_scenario, run_plan, stream_learning, summarize,
-    summary_path, trained_agents_identity,
-};
-use unforeseen_harness::runs::merge::summary_document;
-use unforeseen_harness::runs::outputs::Outputs;
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::runs::batch::{AgentChoice, BatchRequest, ScenarioKind, Shard, SummaryRow, stream_learning};
+use unforeseen_harness::runs::outputs::missing_folder;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `batch`.
@@ -49,11 +40,11 @@ pub struct BatchArgs {
     /// Evaluation protocol: zero-shot (every episode starts from the trained agent),
     /// continual (learning carries over between episodes, in order) or both. A method
     /// that does not learn across episodes runs once; its line covers both.
-    #[arg(long, value_enum, default_value_t = ProtocolChoice::Both)]
+    #[arg(long, default_value = "both", value_parser = super::protocol_choice_parser())]
     pub protocol: ProtocolChoice,
-    /// Worker threads (results do not depend on it).
-    #[arg(long, default_value_t = default_jobs(), value_parser = jobs)]
-    pub jobs: usize,
+    /// Worker threads (results do not depend on it); default: every core.
+    #[arg(long, value_parser = jobs)]
+    pub jobs: Option<usize>,
     /// Results file (JSON Lines), one line per unit as soon as it finishes; the summary
     /// over training seeds goes beside it (`results.summary.json`).
     #[arg(long, value_name = "FILE", default_value = "results.jsonl")]
@@ -100,207 +91,132 @@ fn jobs(s: &str) -> Result<usize, String> {
     }
 }
 
-fn default_jobs() -> usize {
-    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+impl BatchArgs {
+    /// The request these arguments make.
+    pub fn request(&self) -> BatchRequest {
+        BatchRequest {
+            maps: self.maps.clone(),
+            stream: self.stream.clone(),
+            methods: self.methods.clone(),
+            protocol: self.protocol,
+            sets: self.sweep.clone(),
+            episodes: self.episodes,
+            seed: self.seed,
+            jobs: self.jobs,
+            out: self.out.clone(),
+            resume: self.resume,
+            force: self.force,
+            shard: self.shard,
+            agent: self.agent.clone(),
+            train_seeds: self.seeds.train_seeds.clone(),
+            train_map: self.train_map.clone(),
+            train_episodes: self.train_episodes,
+            timeout_as: self.seeds.timeout_as,
+            cache: self.seeds.cache_dir().map(Path::to_path_buf),
+        }
+    }
 }
 
-/// Runs `batch`; fails (exit 1) when any expectation fails on the mean over seeds.
+/// Runs `batch`: the request of the arguments, planned, its agents trained and its units
+/// run by the library ([`BatchRequest::plan`]); fails (exit 1) when any expectation fails
+/// on the mean over seeds.
 pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
-    let scenarios = match &args.stream {
-        Some(file) => vec![load_stream_scenario(file)?],
-        None => load_scenarios(&args.maps)?,
-    };
-    let summary = summary_path(&args.out);
-    // One run at a time per results file: a second one would interleave its lines with
-    // this run's and lose them. The lock is released when the run ends.
-    let _guard = guard(&args, &scenarios)?;
-    let methods = if args.methods.is_empty() {
-        DEFAULT_METHODS.to_vec()
-    } else {
-        args.methods.clone()
-    };
-    let params = checked_sweep(&args.sweep)?;
-    let protocols = args.protocol.protocols();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs.max(1)).build()?;
-    // Without --train-seeds, the one agent (loaded, or trained now) and what determines
-    // it; with them, what determines the agents, trained once the plan says which the
-    // units still to run need. Scripted methods only, with neither: no agent at all.
-    let scripted_only = methods.iter().all(|m| m.is_scripted());
-    let (single, axis, agents_identity) = match &args.seeds.train_seeds {
-        None if scripted_only && args.agent.is_none() => (None, vec![None], SCRIPTED_ONLY.to_string()),
-        None => {
-            let bundle = pool.install(|| {
-                super::load_or_train(
-                    args.agent.as_deref(),
-                    &args.train_map,
-                    args.train_episodes,
-                    args.seed,
-                    args.quiet,
-                )
-            })?;
-            let identity = match &args.agent {
-                Some(_) => agent_file_identity(&bundle),
-                None => {
-                    trained_agents_identity(&maps::load(&args.train_map)?, &[Some(args.seed)], args.train_episodes)?
-                }
-            };
-            let agent = Agent::from_bundle(bundle);
-            let axis = vec![agent.train_seed];
-            (Some(agent), axis, identity)
-        }
-        Some(seeds) => {
-            let axis: Vec<Option<u64>> = seeds.0.iter().map(|&s| Some(s)).collect();
-            let identity = trained_agents_identity(&maps::load(&args.train_map)?, &axis, args.train_episodes)?;
-            (None, axis, identity)
-        }
-    };
-    let planning = BatchConfig {
-        agents: &[],
-        train_seeds: &axis,
-        scenarios: &scenarios,
-        methods: &methods,
-        params: &params,
-        protocols: &protocols,
-        episodes: args.episodes,
-        seed: args.seed,
-        jobs: args.jobs,
-        shard: args.shard,
-        agents_identity,
-    };
-    let plan = planning.plan(&args.out, args.resume)?;
-    let to_train = plan.train_seeds_to_run();
-    let agents = match single {
-        Some(agent) => vec![agent],
-        None if to_train.is_empty() => Vec::new(),
-        None => pool.install(|| {
-            args.seeds
-                .train(&to_train, &args.train_map, args.train_episodes, args.quiet)
-        })?,
-    };
-    let states = agents.iter().map(|a| a.bundle.bayes_rl.n_states()).max().unwrap_or(0);
-    let cfg = BatchConfig {
-        agents: &agents,
-        jobs: memory_bound_jobs(args.jobs, states),
-        ..planning
-    };
+    let quiet = args.quiet;
+    let out = &args.out;
+    // The folder the run creates for --out, if any, said once the guard has passed.
+    let creates = missing_folder(out.parent().unwrap_or(Path::new("")));
+    // One run at a time per results file: the job holds the lock until it is dropped.
+    let job = args.request().plan(None)?;
+    if let Some(top) = creates {
+        errln!(
+            "note: --out: creating the folder {} (it does not exist yet)",
+            top.display()
+        );
+    }
+    let setup = &job.setup;
+    let to_train = job.to_train();
+    if let AgentChoice::Trained { map, .. } = &setup.agents
+        && !to_train.is_empty()
+    {
+        let what = match &args.seeds.train_seeds {
+            Some(_) => format!(
+                "training {} agent(s) for {} episodes on '{}' (or loading them from the cache), one line each",
+                to_train.len(),
+                args.train_episodes,
+                map.name
+            ),
+            None => format!(
+                "training {} episodes on '{}' (seed {})",
+                args.train_episodes, map.name, args.seed
+            ),
+        };
+        progress::phase(quiet, what);
+    }
+    let agents = job.agents(&Bars::counting(quiet, "episodes"))?;
+    let workers = job.workers(&agents);
+    if let Some((per, available)) = workers.bounded {
+        errln!(
+            "warning: --jobs {}: each worker holds its own copy of the agent's learners (about {} MB each) and {} MB are available; running {} worker(s)",
+            setup.jobs,
+            per >> 20,
+            available >> 20,
+            workers.jobs
+        );
+    }
+    let scenarios = &setup.scenarios;
     let what = match &scenarios[0].kind {
         ScenarioKind::Stream(stream) if scenarios.len() == 1 => {
             format!("the stream '{}' ({} maps)", stream.name, stream.maps.len())
         }
         _ => format!("{} scenario(s)", scenarios.len()),
     };
-    let seeds = if scripted_only && cfg.agents.is_empty() {
+    let seeds = if agents.is_empty() && setup.methods.iter().all(|m| m.is_scripted()) {
         "no agent (scripted methods only)".to_string()
     } else {
-        format!("{} agent(s)", axis.len())
+        format!("{} agent(s)", setup.train_seeds.len())
     };
     progress::phase(
-        args.quiet,
+        quiet,
         format_args!(
             "running {what} x {} method(s) x {} parameter set(s) x {} protocol(s) x {seeds} on {} thread(s), {} episodes each, into {}",
-            methods.len(),
-            params.len(),
-            protocols.len(),
-            cfg.jobs,
+            setup.methods.len(),
+            setup.params.len(),
+            setup.protocols.len(),
+            workers.jobs,
             args.episodes,
-            args.out.display()
+            out.display()
         ),
     );
-    let total = plan.units.len();
-    if plan.shard.is_empty() {
+    let total = job.plan.units.len();
+    if job.plan.shard.is_empty() {
         errln!(
             "note: shard {}/{} has no units (the run has {total}); writing a results file with none",
             args.shard.map_or(1, |s| s.index),
             args.shard.map_or(1, |s| s.count),
         );
-    } else if plan.todo().is_empty() {
-        errln!(
-            "note: --resume: every unit of this run is in {} already",
-            args.out.display()
-        );
+    } else if job.plan.todo().is_empty() {
+        errln!("note: --resume: every unit of this run is in {} already", out.display());
     }
-    let lines = run_plan(&cfg, &plan, &args.out, &Bars::new(args.quiet))?;
-    let rows = summarize(&lines);
-    print_summary(&rows);
-    for warning in survivability_warnings(&scenarios, &lines) {
+    let report = job.run(&agents, workers.jobs, &Bars::new(quiet))?;
+    print_summary(&report.rows);
+    for warning in &report.survivability {
         errln!("{warning}");
     }
-    let checked: usize = rows.iter().map(|r| r.checks.len()).sum();
-    let failures = tables::expectation_failures(&rows);
-    let shard = args.shard.map(|s| format!("{}/{}", s.index, s.count));
-    write_json(
-        &summary,
-        &summary_document(&args.out, shard.as_deref(), &plan.identity, &rows),
-    )?;
     outln!(
         "wrote {} ({} lines) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
-        args.out.display(),
-        lines.len(),
-        summary.display(),
-        checked,
-        failures.len()
+        out.display(),
+        report.lines.len(),
+        report.summary.display(),
+        report.checked,
+        report.failures.len()
     );
-    if !failures.is_empty() {
-        for f in &failures {
+    if !report.failures.is_empty() {
+        for f in &report.failures {
             errln!("expectation failed: {f}");
         }
-        anyhow::bail!("{} expectation(s) failed", failures.len());
+        anyhow::bail!("{} expectation(s) failed", report.failures.len());
     }
     Ok(())
-}
-
-/// Bytes of one copy of an agent's learners with `states` joint states (the world model
-/// and Bayesian RL keep dense N x N matrices per action: about 370 bytes x N²).
-fn learner_bytes(states: usize) -> u64 {
-    370 * (states as u64).pow(2)
-}
-
-/// The memory the system says is available (`MemAvailable` of /proc/meminfo), if known.
-fn available_bytes() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
-
-/// `jobs`, or fewer when that many workers' copies of the learners (each running episode
-/// learns on its own copy of its method's learner) would take more than half the memory
-/// available; says so on stderr. Results do not depend on the number of workers.
-fn memory_bound_jobs(jobs: usize, states: usize) -> usize {
-    let per = learner_bytes(states);
-    let Some(available) = available_bytes() else {
-        return jobs;
-    };
-    let fit = ((available / 2) / per.max(1)).max(1) as usize;
-    if jobs > fit {
-        errln!(
-            "warning: --jobs {jobs}: each worker holds its own copy of the agent's learners (about {} MB for {states} states) and {} MB are available; running {fit} worker(s)",
-            per >> 20,
-            available >> 20
-        );
-        fit
-    } else {
-        jobs
-    }
-}
-
-/// The output guard of `batch` (`--out` and the summary beside it; the inputs `--agent`,
-/// the maps, or the stream and its maps): checked before any work and held until the
-/// end of the run (a second run into the same `--out` is refused).
-fn guard(args: &BatchArgs, scenarios: &[Scenario]) -> anyhow::Result<unforeseen_harness::runs::outputs::Guarded> {
-    let mut guard = Outputs::results("--out", &args.out);
-    if let Some(agent) = &args.agent {
-        guard = guard.input("--agent", agent);
-    }
-    for s in scenarios {
-        guard = match (&s.kind, &args.stream) {
-            (ScenarioKind::Stream(stream), Some(file)) => guard.stream("--stream", file, stream),
-            _ => guard.input("MAP", &s.source),
-        };
-    }
-    guard.check(args.force || args.resume)?;
-    super::outputs::note_created("--out", args.out.parent().unwrap_or(std::path::Path::new("")));
-    Ok(guard.guard(args.force || args.resume)?)
 }
 
 /// Prints the summary table ([`tables::batch_summary`]), then warns on stderr about each
@@ -321,51 +237,17 @@ pub(super) fn print_summary(rows: &[SummaryRow]) {
     }
 }
 
-/// The survivability warnings of `check-map`, from the brake-on-pedestrian and
-/// never-brake units that ran (scripted methods ignore parameter sets, protocols and
-/// training seeds, so the first line of each is taken), for map scenarios with pedestrian
-/// rules.
-fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<String> {
-    let witness = |scenario: &str, method: Method| {
-        lines
-            .iter()
-            .find(|l| l.scenario == scenario && l.method == method.name())
-            .map(|l| Witness {
-                episodes: l.episodes,
-                success_rate: l.success_rate,
-                collision_rate: l.collision_rate,
-                timeout_rate: l.timeout_rate,
-                cruise: 1.0,
-            })
-    };
-    scenarios
-        .iter()
-        .filter_map(|s| s.map().map(|map| (s, map)))
-        .filter(|(_, map)| !map.pedestrians.is_empty())
-        .flat_map(|(s, map)| {
-            let name = &map.name;
-            warnings(
-                name,
-                witness(name, Method::BrakeOnPedestrian).as_ref(),
-                witness(name, Method::NeverBrake).as_ref(),
-            )
-            .into_iter()
-            .map(move |w| format!("{}: {w}", s.source))
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clap::Parser;
 
     #[test]
-    fn jobs_are_bounded_by_the_memory_of_the_learners_copies() {
-        // 64 states (the embedded maps): 1.5 MB a copy, never a bound.
-        assert_eq!(memory_bound_jobs(16, 64), 16);
-        // A million states would be 370 TB a copy: one worker, where memory is known.
-        if available_bytes().is_some() {
-            assert_eq!(memory_bound_jobs(16, 1 << 20), 1);
-        }
+    fn the_flags_defaults_are_the_requests() {
+        let cli = super::super::Cli::parse_from(["unforeseen", "batch"]);
+        let Some(super::super::Command::Batch(args)) = cli.command else {
+            panic!("not batch")
+        };
+        assert_eq!(args.request(), BatchRequest::default());
     }
 }

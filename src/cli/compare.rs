@@ -5,11 +5,11 @@
 use clap::Args;
 use std::path::{Path, PathBuf};
 
-use super::ProtocolChoice;
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::methods::{Method, PaperFigures};
 use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::protocol::ProtocolChoice;
 use unforeseen_harness::maps;
 use unforeseen_harness::reports::figures::{BarPanel, BarRow, bar_key, grouped_bars};
 use unforeseen_harness::reports::files::{Csv, num, write_json};
@@ -39,7 +39,7 @@ pub struct CompareArgs {
     /// Evaluation protocol: zero-shot (every test episode starts from the trained agent,
     /// the paper's table), continual (learning carries over between test episodes, in
     /// order) or both (zero-shot table first).
-    #[arg(long, value_enum, default_value_t = ProtocolChoice::Both)]
+    #[arg(long, default_value = "both", value_parser = super::protocol_choice_parser())]
     pub protocol: ProtocolChoice,
     /// Output folder for compare.json, compare.csv, compare_seeds.csv and compare.svg
     /// (files from an earlier run there are replaced, with a warning).

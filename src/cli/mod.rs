@@ -5,14 +5,14 @@
 //! errors), 1 for any other failure.
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::limits::MAX_EPISODES;
 
 use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::protocol::{Protocol, ProtocolChoice};
 use unforeseen_harness::progress::Progress;
 use unforeseen_harness::training::{DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
 
@@ -166,11 +166,52 @@ pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
 }
 
 /// A failed command's message: the error and its causes (`outer: inner: ...`), with a
-/// parameter override spelt as the flag it came from (`--set epsilon=2: ...`).
+/// parameter override spelt as the flag it came from (`--set epsilon=2: ...`), a
+/// request's field as its flag (`train_seeds: ...` as `--train-seeds: ...`), and the
+/// fields the output guard names (`out`, `agent`, the maps, ...) as their flags.
 pub fn error_message(err: &anyhow::Error) -> String {
-    match err.downcast_ref::<unforeseen_harness::error::Error>() {
-        Some(unforeseen_harness::error::Error::Override { .. }) => format!("--set {err:#}"),
-        _ => format!("{err:#}"),
+    use unforeseen_harness::error::Error;
+    let text = format!("{err:#}");
+    match err.downcast_ref::<Error>() {
+        Some(Error::Override { .. }) => format!("--set {text}"),
+        Some(Error::Request { field, .. } | Error::OutOfRange { field, .. }) => match text.strip_prefix(field.as_str())
+        {
+            Some(rest) => format!("{}{rest}", flag_of(field)),
+            None => text,
+        },
+        Some(Error::Flag { .. }) => spell_guard_fields(text),
+        _ => text,
+    }
+}
+
+/// The fields of a request that the output guard names (inputs and outputs), longest
+/// first.
+const GUARDED_FIELDS: [&str; 6] = ["stream", "agent", "space", "maps", "map", "out"];
+
+/// A message of the output guard with the fields it names (at its start, in "given as
+/// FIELD" and in "give FIELD ...") spelt as their flags.
+fn spell_guard_fields(mut text: String) -> String {
+    for field in GUARDED_FIELDS {
+        let flag = flag_of(field);
+        if let Some(rest) = text.strip_prefix(&format!("{field} ")) {
+            text = format!("{flag} {rest}");
+        }
+        text = text
+            .replace(&format!("given as {field} "), &format!("given as {flag} "))
+            .replace(&format!("give {field} "), &format!("give {flag} "));
+    }
+    text
+}
+
+/// The command line's spelling of a request's field: its flag (`train_seeds` is
+/// `--train-seeds`, `sets` is `--set`, `methods` is `--method`), or `MAP` for the maps
+/// given as arguments.
+pub fn flag_of(field: &str) -> String {
+    match field {
+        "maps" => "MAP".into(),
+        "methods" => "--method".into(),
+        "sets" => "--set".into(),
+        f => format!("--{}", f.replace('_', "-")),
     }
 }
 
@@ -186,27 +227,11 @@ pub fn protocol_parser() -> impl TypedValueParser<Value = Protocol> {
     PossibleValuesParser::new(names).map(|s| s.parse::<Protocol>().expect("a listed protocol name"))
 }
 
-/// The `--protocol` option of `compare` and `batch`: one protocol or both.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum ProtocolChoice {
-    /// Only zero-shot.
-    ZeroShot,
-    /// Only continual.
-    Continual,
-    /// Zero-shot, then continual.
-    #[default]
-    Both,
-}
-
-impl ProtocolChoice {
-    /// The chosen protocols, zero-shot first.
-    pub fn protocols(self) -> Vec<Protocol> {
-        match self {
-            ProtocolChoice::ZeroShot => vec![Protocol::ZeroShot],
-            ProtocolChoice::Continual => vec![Protocol::Continual],
-            ProtocolChoice::Both => Protocol::ALL.to_vec(),
-        }
-    }
+/// Parses the `--protocol` option of `compare` and `batch` (one protocol or both),
+/// listing every choice.
+pub fn protocol_choice_parser() -> impl TypedValueParser<Value = ProtocolChoice> {
+    let names = ProtocolChoice::ALL.map(|p| PossibleValue::new(p.name()).help(p.summary()));
+    PossibleValuesParser::new(names).map(|s| s.parse::<ProtocolChoice>().expect("a listed protocol choice"))
 }
 
 /// Options shared by the commands that drive a trained agent.

@@ -2,16 +2,15 @@
 //! method fails (`unforeseen_harness::runs::search`).
 
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::maps;
-use unforeseen_harness::runs::batch::{Shard, agent_file_identity, trained_agents_identity};
-use unforeseen_harness::runs::search::{self, SearchConfig, Space, Summary};
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::runs::batch::Shard;
+use unforeseen_harness::runs::outputs::missing_folder;
+use unforeseen_harness::runs::search::{self, SearchRequest, Summary};
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `search`.
@@ -47,9 +46,9 @@ pub struct SearchArgs {
     /// Failures minimised and written as maps.
     #[arg(long, default_value_t = search::DEFAULT_MAX_FAILURES)]
     pub max_failures: usize,
-    /// Worker threads (results do not depend on it).
-    #[arg(long, default_value_t = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1))]
-    pub jobs: usize,
+    /// Worker threads (results do not depend on it); default: every core.
+    #[arg(long)]
+    pub jobs: Option<usize>,
     /// Evaluate only shard I of N of the Sobol stage (no adaptive stage, no
     /// minimisation); concatenate the shards' candidates.jsonl and finish with --resume.
     #[arg(long, value_name = "I/N")]
@@ -80,101 +79,86 @@ pub struct SearchArgs {
     pub quiet: bool,
 }
 
-/// Runs `search`.
-pub fn run(args: SearchArgs) -> anyhow::Result<()> {
-    if !(1..=super::MAX_JOBS).contains(&args.jobs) {
-        return Err(unforeseen_harness::error::Error::flag("--jobs", "expected 1 to 256 worker threads").into());
-    }
-    let base = maps::load(&args.map)?;
-    let space = Space::load(&args.space, &base)?;
-    SearchConfig::check_arguments(&space, args.budget, args.sobol_share)?;
-    // Every output checked, the folder created and locked, before any work.
-    let mut guard = search::output::outputs(&args.out)
-        .input("--map", &args.map)
-        .input("--space", &args.space);
-    if let Some(agent) = &args.agent {
-        guard = guard.input("--agent", agent);
-    }
-    guard.check(args.force || args.resume)?;
-    super::outputs::note_created("--out", &args.out);
-    let _guard = guard.guard(args.force || args.resume)?;
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(args.jobs).build()?;
-    let (agents, train_seeds, agents_identity): (Vec<Agent>, Vec<Option<u64>>, String) = if args.method.is_scripted() {
-        (Vec::new(), vec![None], "none (a scripted method)".into())
-    } else {
-        match &args.seeds.train_seeds {
-            Some(seeds) => {
-                let axis: Vec<Option<u64>> = seeds.0.iter().map(|&s| Some(s)).collect();
-                let identity = trained_agents_identity(&maps::load(DEFAULT_TRAIN_MAP)?, &axis, args.train_episodes)?;
-                let agents = pool.install(|| {
-                    args.seeds
-                        .train(&seeds.0, DEFAULT_TRAIN_MAP, args.train_episodes, args.quiet)
-                })?;
-                (agents, axis, identity)
-            }
-            None => {
-                let bundle = pool.install(|| {
-                    super::load_or_train(
-                        args.agent.as_deref(),
-                        DEFAULT_TRAIN_MAP,
-                        args.train_episodes,
-                        args.seed,
-                        args.quiet,
-                    )
-                })?;
-                let identity = match &args.agent {
-                    Some(_) => agent_file_identity(&bundle),
-                    None => trained_agents_identity(
-                        &maps::load(DEFAULT_TRAIN_MAP)?,
-                        &[Some(args.seed)],
-                        args.train_episodes,
-                    )?,
-                };
-                let agent = Agent::from_bundle(bundle);
-                let axis = vec![agent.train_seed];
-                (vec![agent], axis, identity)
-            }
+impl SearchArgs {
+    /// The request these arguments make.
+    pub fn request(&self) -> SearchRequest {
+        SearchRequest {
+            space: self.space.clone(),
+            map: self.map.clone(),
+            method: self.method,
+            protocol: self.protocol,
+            budget: self.budget,
+            episodes: self.episodes,
+            seed: self.seed,
+            sobol_share: self.sobol_share,
+            rounds: self.rounds,
+            max_failures: self.max_failures,
+            jobs: self.jobs,
+            shard: self.shard,
+            resume: self.resume,
+            out: self.out.clone(),
+            force: self.force,
+            agent: self.agent.clone(),
+            train_seeds: self.seeds.train_seeds.clone(),
+            train_episodes: self.train_episodes,
+            timeout_as: self.seeds.timeout_as,
+            cache: self.seeds.cache_dir().map(Path::to_path_buf),
         }
-    };
+    }
+}
+
+/// Runs `search`: the request of the arguments, planned, its agents trained and the
+/// search run by the library ([`SearchRequest::plan`]).
+pub fn run(args: SearchArgs) -> anyhow::Result<()> {
+    let quiet = args.quiet;
+    let creates = missing_folder(&args.out);
+    // Every output checked, the folder created and locked, before any work.
+    let job = args.request().plan(None)?;
+    if let Some(top) = creates {
+        errln!(
+            "note: --out: creating the folder {} (it does not exist yet)",
+            top.display()
+        );
+    }
+    let setup = &job.setup;
+    let to_train = setup.to_train();
+    if !to_train.is_empty() {
+        let what = match &args.seeds.train_seeds {
+            Some(_) => format!(
+                "training {} agent(s) for {} episodes on '{DEFAULT_TRAIN_MAP}' (or loading them from the cache), one line each",
+                to_train.len(),
+                args.train_episodes
+            ),
+            None => format!(
+                "training {} episodes on '{DEFAULT_TRAIN_MAP}' (seed {})",
+                args.train_episodes, args.seed
+            ),
+        };
+        progress::phase(quiet, what);
+    }
+    let agents = setup.agents(&Bars::counting(quiet, "episodes"))?;
     let command = std::iter::once("unforeseen".to_string())
         .chain(std::env::args().skip(1))
         .collect::<Vec<_>>()
         .join(" ");
-    let cfg = SearchConfig {
-        space: &space,
-        method: args.method,
-        agents: &agents,
-        train_seeds: &train_seeds,
-        agents_identity,
-        protocol: args.protocol,
-        budget: args.budget,
-        episodes: args.episodes,
-        seed: args.seed,
-        jobs: args.jobs,
-        shard: args.shard,
-        sobol_share: args.sobol_share,
-        rounds: args.rounds,
-        max_failures: args.max_failures,
-        command,
-    };
-    cfg.check()?;
+    let cfg = setup.config(&agents, setup.jobs, command.clone());
     progress::phase(
-        args.quiet,
+        quiet,
         format_args!(
             "searching {} ({} parameters over {}) for failures of {} ({}): {} candidates ({} Sobol), {} episodes each, on {} thread(s), into {}",
-            space.name,
-            space.params.len(),
-            base.name,
+            setup.space.name,
+            setup.space.params.len(),
+            setup.space.base.name,
             args.method.name(),
             args.protocol.name(),
             args.budget,
             cfg.sobol_count(),
             args.episodes,
-            args.jobs,
+            setup.jobs,
             args.out.display()
         ),
     );
-    let summary = search::run(&cfg, &args.out, args.resume, &Bars::new(args.quiet))?;
+    let summary = job.run(&agents, command, &Bars::new(quiet))?;
     print_summary(&summary, &args);
     Ok(())
 }
@@ -243,4 +227,23 @@ fn print_summary(s: &Summary, args: &SearchArgs) {
         "wrote {}/{{candidates.jsonl, summary.json, search.svg, failures/}}",
         args.out.display()
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[test]
+    fn the_flags_defaults_are_the_requests() {
+        let cli = super::super::Cli::parse_from(["unforeseen", "search", "--space", "s.ron"]);
+        let Some(super::super::Command::Search(args)) = cli.command else {
+            panic!("not search")
+        };
+        let expected = SearchRequest {
+            space: "s.ron".into(),
+            ..SearchRequest::default()
+        };
+        assert_eq!(args.request(), expected);
+    }
 }

@@ -104,6 +104,68 @@ impl std::str::FromStr for Protocol {
     }
 }
 
+/// The protocols a run asks for (`batch`, `compare`): one of them, or both.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ProtocolChoice {
+    /// Only zero-shot.
+    ZeroShot,
+    /// Only continual.
+    Continual,
+    /// Zero-shot, then continual.
+    #[default]
+    Both,
+}
+
+impl ProtocolChoice {
+    /// Every choice, in the order listings give them.
+    pub const ALL: [ProtocolChoice; 3] = [
+        ProtocolChoice::ZeroShot,
+        ProtocolChoice::Continual,
+        ProtocolChoice::Both,
+    ];
+
+    /// The name of the choice in requests and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ProtocolChoice::ZeroShot => "zero-shot",
+            ProtocolChoice::Continual => "continual",
+            ProtocolChoice::Both => "both",
+        }
+    }
+
+    /// One line saying what the choice runs (for listings such as `--help`).
+    pub fn summary(self) -> &'static str {
+        match self {
+            ProtocolChoice::ZeroShot => "Only zero-shot",
+            ProtocolChoice::Continual => "Only continual",
+            ProtocolChoice::Both => "Zero-shot, then continual",
+        }
+    }
+
+    /// The chosen protocols, zero-shot first.
+    pub fn protocols(self) -> Vec<Protocol> {
+        match self {
+            ProtocolChoice::ZeroShot => vec![Protocol::ZeroShot],
+            ProtocolChoice::Continual => vec![Protocol::Continual],
+            ProtocolChoice::Both => Protocol::ALL.to_vec(),
+        }
+    }
+}
+
+impl std::str::FromStr for ProtocolChoice {
+    type Err = String;
+    /// Parses a choice by [`ProtocolChoice::name`].
+    fn from_str(s: &str) -> Result<Self, String> {
+        ProtocolChoice::ALL.into_iter().find(|p| p.name() == s).ok_or_else(|| {
+            format!(
+                "'{s}' is not a protocol choice; expected one of {}",
+                ProtocolChoice::ALL.map(ProtocolChoice::name).join(", ")
+            )
+        })
+    }
+}
+
 /// The protocols among `asked` under which one run of `method` is reported: all of them
 /// when the method does not learn across episodes (its results are identical under
 /// each), otherwise just `protocol`.

@@ -2,11 +2,13 @@
 //! ([`stream`]), the paper's comparison over agents and protocols ([`compare`]), the
 //! merge of shard files ([`merge`]) and the search for fair failing scenarios
 //! ([`search`]); the guard all of them pass before any work ([`outputs`]: no output
-//! replaces an input or another program's file, one writer at a time).
+//! replaces an input or another program's file, one writer at a time). Jobs are asked
+//! for by typed requests, read field by field from other fronts by [`request`].
 
 pub mod batch;
 pub mod compare;
 pub mod merge;
 pub mod outputs;
+pub mod request;
 pub mod search;
 pub mod stream;

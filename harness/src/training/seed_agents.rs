@@ -21,9 +21,55 @@ pub const MAX_TRAIN_SEEDS: usize = 1000;
 /// Default folder of the agent cache.
 pub const DEFAULT_CACHE: &str = "out/agents";
 
-/// A list of training seeds parsed from `1..10` (inclusive), `1,3,5` or `1..3,7`.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// A list of training seeds: parsed from `1..10` (inclusive), `1,3,5` or `1..3,7`, or
+/// given as a list; non-empty, at most [`MAX_TRAIN_SEEDS`], each seed once. In a request
+/// (serde) it is that text or a list of numbers, and is written as the list.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "SeedsGiven", into = "Vec<u64>")]
 pub struct TrainSeeds(pub Vec<u64>);
+
+/// Training seeds as a request gives them: text to parse, or the list.
+#[derive(serde::Deserialize)]
+#[serde(untagged)]
+enum SeedsGiven {
+    Text(String),
+    List(Vec<u64>),
+}
+
+impl TryFrom<SeedsGiven> for TrainSeeds {
+    type Error = String;
+    fn try_from(given: SeedsGiven) -> Result<Self, String> {
+        match given {
+            SeedsGiven::Text(s) => s.parse(),
+            SeedsGiven::List(seeds) => TrainSeeds::new(seeds),
+        }
+    }
+}
+
+impl From<TrainSeeds> for Vec<u64> {
+    fn from(seeds: TrainSeeds) -> Vec<u64> {
+        seeds.0
+    }
+}
+
+impl TrainSeeds {
+    /// The seeds `seeds` if they are a list one run accepts: at least one, at most
+    /// [`MAX_TRAIN_SEEDS`], each once.
+    pub fn new(seeds: Vec<u64>) -> Result<Self, String> {
+        if seeds.is_empty() {
+            return Err("no seed; give at least one training seed".into());
+        }
+        if seeds.len() > MAX_TRAIN_SEEDS {
+            return Err(format!("{} seeds; at most {MAX_TRAIN_SEEDS}", seeds.len()));
+        }
+        let mut sorted = seeds.clone();
+        sorted.sort_unstable();
+        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!("seed {} is listed twice", w[0]));
+        }
+        Ok(TrainSeeds(seeds))
+    }
+}
 
 impl std::str::FromStr for TrainSeeds {
     type Err = String;
@@ -56,12 +102,7 @@ impl std::str::FromStr for TrainSeeds {
                 return Err(format!("'{s}': more than {MAX_TRAIN_SEEDS} seeds"));
             }
         }
-        let mut sorted = seeds.clone();
-        sorted.sort_unstable();
-        if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
-            return Err(format!("'{s}': seed {} is listed twice", w[0]));
-        }
-        Ok(TrainSeeds(seeds))
+        TrainSeeds::new(seeds).map_err(|e| format!("'{s}': {e}"))
     }
 }
 

@@ -25,13 +25,18 @@
 //! train only the agents the units still to run use ([`Plan::train_seeds_to_run`]), then
 //! [`run_plan`] runs it.
 //!
-//! One module per part: [`scenario`], [`sweep`](mod@sweep), [`units`](mod@units), [`expectations`],
+//! A run's request ([`BatchRequest`]) is every choice of its user; its planning
+//! ([`BatchRequest::plan`]) gives the [`BatchJob`] that the command line, the Python
+//! package and the Ray driver all run.
+//!
+//! One module per part: [`request`], [`scenario`], [`sweep`](mod@sweep), [`units`](mod@units), [`expectations`],
 //! [`result_line`], [`plan`], [`identity`], [`run`](mod@run), [`results_file`] and [`summary`];
 //! the items callers use are re-exported here.
 
 pub mod expectations;
 pub mod identity;
 pub mod plan;
+pub mod request;
 pub mod result_line;
 pub mod results_file;
 pub mod run;
@@ -43,6 +48,7 @@ pub mod units;
 pub use expectations::{Check, check_expectations};
 pub use identity::{RunIdentity, SCRIPTED_ONLY, agent_file_identity, trained_agents_identity};
 pub use plan::{BatchConfig, Plan};
+pub use request::{AgentChoice, BatchJob, BatchReport, BatchRequest, BatchSetup, Workers, survivability_warnings};
 pub use result_line::{MapFigures, ResultLine, UnitKey};
 pub use results_file::{KeptLine, MAX_FIGURE, ResultsFile, read_lines, read_results, resume_lines};
 pub use run::{run, run_plan, run_unit, run_unit_with};

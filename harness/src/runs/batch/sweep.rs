@@ -1,4 +1,4 @@
-//! Parameter sweeps: `--set key=v1,v2` options expanded into the cross product of
+//! Parameter sweeps: `key=v1,v2` sets (a request's `sets`, the command line's `--set`) expanded into the cross product of
 //! named parameter sets ([`ParamSet`]), checked against the scaled agent's parameters.
 
 use serde::{Deserialize, Serialize};
@@ -26,10 +26,10 @@ impl ParamSet {
     }
 }
 
-/// Most parameter sets one sweep may have (the cross product of its `--set` lists).
+/// Most parameter sets one sweep may have (the cross product of its sets' lists).
 pub const MAX_PARAM_SETS: usize = 10_000;
 
-/// Expands `--set key=v1,v2` options into the cross product of parameter sets, in the
+/// Expands `key=v1,v2` sets into the cross product of parameter sets, in the
 /// order the options were given (the last varies fastest). Values equal after parsing
 /// (`omega=0.5,5e-1`) count once, in the order of their first occurrence.
 /// At most [`MAX_PARAM_SETS`] sets.
@@ -37,26 +37,29 @@ pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
     let mut out = vec![ParamSet(Vec::new())];
     let mut keys: Vec<&str> = Vec::new();
     for set in sets {
-        let flag = format!("--set {set}");
+        // Errors name the request's field, `sets`, and the set given.
+        let bad = |problem: String| Error::Request {
+            field: "sets".into(),
+            value: Some(set.clone()),
+            problem,
+        };
         let (key, values) = set
             .split_once('=')
-            .ok_or_else(|| Error::flag(&flag, "expected KEY=V1,V2,..., e.g. --set horizon=1,2,3"))?;
+            .ok_or_else(|| bad("expected KEY=V1,V2,..., e.g. horizon=1,2,3".into()))?;
         let key = key.trim();
         // `epsilon` and `gate.epsilon` are one parameter.
         let canonical = param_table::lookup(key).map_or(key, |k| k.name.as_str());
         if keys.contains(&canonical) {
-            return Err(Error::flag(
-                &flag,
-                format!("`{key}` is set twice; give all its values in one --set, e.g. --set {key}=1,2"),
-            ));
+            return Err(bad(format!(
+                "`{key}` is set twice; give all its values in one set, e.g. {key}=1,2"
+            )));
         }
         keys.push(canonical);
         let listed: Vec<&str> = values.split(',').map(str::trim).collect();
         if listed.iter().any(|v| v.is_empty()) {
-            return Err(Error::flag(
-                &flag,
-                format!("an empty value; separate values by single commas, e.g. --set {key}=1,2"),
-            ));
+            return Err(bad(format!(
+                "an empty value; separate values by single commas, e.g. {key}=1,2"
+            )));
         }
         // Equal values (after parsing: `0.5` and `5e-1`) give one parameter set, the first
         // spelling kept. A value that does not parse on its own is kept as written: the
@@ -75,13 +78,10 @@ pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
             }
         }
         if out.len().saturating_mul(values.len()) > MAX_PARAM_SETS {
-            return Err(Error::flag(
-                &flag,
-                format!(
-                    "the sweep would have {} parameter sets (at most {MAX_PARAM_SETS}: each runs every scenario and protocol); sweep fewer values, or split the sweep over several runs",
-                    out.len().saturating_mul(values.len())
-                ),
-            ));
+            return Err(bad(format!(
+                "the sweep would have {} parameter sets (at most {MAX_PARAM_SETS}: each runs every scenario and protocol); sweep fewer values, or split the sweep over several runs",
+                out.len().saturating_mul(values.len())
+            )));
         }
         out = out
             .into_iter()

@@ -96,8 +96,10 @@ pub fn units(
     Ok(out)
 }
 
-/// A shard `i/n` (1-based): the contiguous slice `[(i-1)U/n, iU/n)` of `U` units.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A shard `i/n` (1-based): the contiguous slice `[(i-1)U/n, iU/n)` of `U` units. In a
+/// request (serde) it is the text `i/n`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "String", into = "String")]
 pub struct Shard {
     /// 1-based shard number.
     pub index: usize,
@@ -122,6 +124,19 @@ impl std::str::FromStr for Shard {
             return Err(bad());
         }
         Ok(Shard { index, count })
+    }
+}
+
+impl TryFrom<String> for Shard {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
+    }
+}
+
+impl From<Shard> for String {
+    fn from(s: Shard) -> String {
+        format!("{}/{}", s.index, s.count)
     }
 }
 

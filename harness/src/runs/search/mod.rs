@@ -37,6 +37,10 @@
 //! another run (its first line is the run's identity), keeps the complete candidates'
 //! lines byte for byte and evaluates the rest.
 //!
+//! A search's request ([`SearchRequest`]) is every choice of its user; its planning
+//! ([`SearchRequest::plan`]) is shared by the command line, the Python package and the
+//! Ray driver.
+//!
 //! Outputs ([`output`]): `candidates.jsonl`, `failures/NAME.ron`, `summary.json` and
 //! `search.svg`.
 
@@ -44,6 +48,7 @@ pub mod adaptive;
 pub mod fairness;
 pub mod minimise;
 pub mod output;
+pub mod request;
 pub mod sampler;
 pub mod space;
 
@@ -68,6 +73,7 @@ use crate::training::seed_agents::Agent;
 
 pub use fairness::Fairness;
 pub use output::Summary;
+pub use request::{SearchJob, SearchRequest, SearchSetup};
 pub use space::{Space, Value};
 
 /// Default share of the budget that the Sobol stage takes.
@@ -142,16 +148,21 @@ impl SearchConfig<'_> {
     /// before training any: the budget, the Sobol share and the space's dimensions.
     pub fn check_arguments(space: &Space, budget: usize, sobol_share: f64) -> Result<(), Error> {
         if budget == 0 || budget > MAX_BUDGET {
-            return Err(Error::flag(
-                "--budget",
-                format!("{budget}: expected 1 to {MAX_BUDGET} candidates"),
-            ));
+            return Err(Error::Request {
+                field: "budget".into(),
+                value: Some(budget.to_string()),
+                problem: format!("expected 1 to {MAX_BUDGET} candidates"),
+            });
         }
         if !(sobol_share > 0.0 && sobol_share <= 1.0) {
-            return Err(Error::flag("--sobol-share", "expected a share in (0, 1]"));
+            return Err(Error::Request {
+                field: "sobol_share".into(),
+                value: Some(sobol_share.to_string()),
+                problem: "expected a share in (0, 1]".into(),
+            });
         }
         if space.params.len() > sampler::MAX_DIMENSIONS {
-            return Err(Error::flag("--space", "too many parameters for the Sobol sequence"));
+            return Err(Error::request("space", "too many parameters for the Sobol sequence"));
         }
         Ok(())
     }

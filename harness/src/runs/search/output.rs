@@ -51,11 +51,11 @@ pub const MAX_LISTED_REJECTIONS: usize = 20;
 /// taken, as the search writes them anew at its end.
 pub fn outputs(out: &Path) -> Outputs {
     Outputs::new()
-        .folder("--out", out)
-        .file("--out", out.join(CANDIDATES), Own::Candidates)
-        .file_at_end("--out", out.join(SUMMARY), Own::Json)
-        .file_at_end("--out", out.join(FIGURE), Own::Svg)
-        .folder_files("--out", &out.join(FAILURES), "ron", Own::FailureMap)
+        .folder("out", out)
+        .file("out", out.join(CANDIDATES), Own::Candidates)
+        .file_at_end("out", out.join(SUMMARY), Own::Json)
+        .file_at_end("out", out.join(FIGURE), Own::Svg)
+        .folder_files("out", &out.join(FAILURES), "ron", Own::FailureMap)
 }
 
 /// `{"search": identity}` and a newline.
