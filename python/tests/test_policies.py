@@ -37,13 +37,11 @@ def untimed(line):
     return {k: v for k, v in line.items() if k != UNTIMED}
 
 
-def test_a_python_never_brake_gives_the_librarys_never_brake_line(agent):
+def test_a_python_never_brake_gives_the_librarys_never_brake_line(agent, tmp_path):
     # The library's batch (the code `unforeseen batch` runs) and the Python policy, on the
     # same map, seed and training-seed record: the same line, every field but the clock.
-    # (A map file: for an embedded name, `unforeseen.batch` writes the name as the source
-    # where the command line writes `embedded:NAME`; the next test compares with it.)
-    built_in = unforeseen.batch(JAYWALK, agents=agent, episodes=8, seed=3, methods=["never-brake"],
-                                protocols=["zero-shot", "continual"])
+    built_in = unforeseen.batch([JAYWALK], agent=agent, episodes=8, seed=3, methods=["never-brake"],
+                                protocol="both", out=tmp_path / "batch.jsonl")
     [line] = built_in["lines"]
     [mine] = unforeseen.evaluate(NeverBrake(), [JAYWALK], [line["train_seed"]], episodes=8, seed=3,
                                  train_episodes=line["train_episodes"])
@@ -189,7 +187,7 @@ def test_a_habit_that_fails_surfaces_its_exception(agent):
 
 
 @pytest.mark.parametrize("protocol", ["zero-shot", "continual"])
-def test_the_scaled_agent_around_the_q_tables_probabilities_asked_each_tick_gives_the_scaled_line(agent, protocol):
+def test_the_scaled_agent_around_the_q_tables_probabilities_asked_each_tick_gives_the_scaled_line(agent, protocol, tmp_path):
     # The wrapped path: the habit is a Python callable asked each tick (the Q-table's
     # probabilities of the observed state); the line is the built-in scaled agent's.
     table = unforeseen.q_table_habit(agent)
@@ -201,8 +199,8 @@ def test_the_scaled_agent_around_the_q_tables_probabilities_asked_each_tick_give
             i = i * n + int(f)
         return table[i]
 
-    built_in = unforeseen.batch(JAYWALK, agents=agent, episodes=6, seed=7, methods=["scaled"],
-                                protocols=[protocol])
+    built_in = unforeseen.batch([JAYWALK], agent=agent, episodes=6, seed=7, methods=["scaled"],
+                                protocol=protocol, out=tmp_path / "batch.jsonl")
     [line] = built_in["lines"]
     wrapped = unforeseen.ScaledWrapper(habit=habit, agent=agent, method="scaled")
     [mine] = unforeseen.evaluate(wrapped, [JAYWALK], [line["train_seed"]], episodes=6, seed=7, protocol=protocol,

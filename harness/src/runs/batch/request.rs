@@ -160,6 +160,97 @@ pub struct BatchSetup {
     pub jobs: usize,
 }
 
+/// Worker threads asked for (`jobs`): 1 to [`MAX_JOBS`], or every core of the machine.
+pub(crate) fn resolve_jobs(jobs: Option<usize>) -> Result<usize, Error> {
+    match jobs {
+        None => Ok(std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(MAX_JOBS)),
+        Some(n) if (1..=MAX_JOBS).contains(&n) => Ok(n),
+        Some(n) => Err(Error::OutOfRange {
+            field: "jobs".into(),
+            value: n.to_string(),
+            expected: format!("1..={MAX_JOBS} worker threads"),
+        }),
+    }
+}
+
+/// The fields that say which agents a run uses, as the batch and search requests hold
+/// them: one choice of agents for both.
+pub(crate) struct AgentFields<'a> {
+    /// An agent file.
+    pub agent: Option<&'a std::path::Path>,
+    /// One agent per training seed.
+    pub train_seeds: Option<&'a TrainSeeds>,
+    /// The training map of agents trained here.
+    pub train_map: &'a str,
+    /// Training episodes of agents trained here.
+    pub train_episodes: u64,
+    /// What a training episode's time-out is to the learners.
+    pub timeout_as: TimeoutAs,
+    /// The agent cache of `train_seeds`.
+    pub cache: Option<&'a PathBuf>,
+    /// The run seed: the training seed of the one agent trained when none is given.
+    pub seed: u64,
+}
+
+impl AgentFields<'_> {
+    /// The agents, their training-seed axis and what determines them: `given` (an agent
+    /// given loaded) or the agent file; one per training seed; none when `scripted` (the
+    /// identity of a run with scripted methods only) is given and no agent is; else one
+    /// trained with the run seed, not cached. `one_agent` says what one agent does, for
+    /// the error when both `train_seeds` and an agent are given.
+    pub fn choose(
+        &self,
+        given: Option<AgentBundle>,
+        scripted: Option<&str>,
+        one_agent: &str,
+    ) -> Result<(AgentChoice, Vec<Option<u64>>, String), Error> {
+        if self.train_seeds.is_some() && (self.agent.is_some() || given.is_some()) {
+            return Err(Error::request(
+                "train_seeds",
+                format!("give train_seeds or agent, not both (train one agent per seed, or {one_agent})"),
+            ));
+        }
+        if self.agent.is_some() && given.is_some() {
+            return Err(Error::request("agent", "give one agent"));
+        }
+        let trained = |seeds: Vec<u64>, cache: Option<PathBuf>| -> Result<_, Error> {
+            let map = crate::maps::load(self.train_map)?;
+            let axis: Vec<Option<u64>> = seeds.iter().map(|&s| Some(s)).collect();
+            let identity = trained_agents_identity(&map, &axis, self.train_episodes)?;
+            let config = TrainConfig {
+                timeout_as: self.timeout_as,
+                ..TrainConfig::new(self.train_episodes, 0)
+            };
+            let choice = AgentChoice::Trained {
+                map: Box::new(map),
+                seeds,
+                config: Box::new(config),
+                cache,
+            };
+            Ok((choice, axis, identity))
+        };
+        let given = match (given, self.agent) {
+            (Some(bundle), _) => Some(bundle),
+            (None, Some(file)) => Some(crate::training::agent_file::load(file)?),
+            (None, None) => None,
+        };
+        match (self.train_seeds, given, scripted) {
+            (Some(seeds), _, _) => trained(seeds.0.clone(), self.cache.cloned()),
+            (None, Some(bundle), _) => {
+                let identity = agent_file_identity(&bundle);
+                let agent = Agent::from_bundle(bundle);
+                let axis = vec![agent.train_seed];
+                Ok((AgentChoice::Given(Box::new(agent)), axis, identity))
+            }
+            (None, None, Some(scripted)) => Ok((AgentChoice::None, vec![None], scripted.to_string())),
+            // One agent trained with the run seed, not cached.
+            (None, None, None) => trained(vec![self.seed], None),
+        }
+    }
+}
+
 impl BatchRequest {
     /// The request with `fields` set (a JSON object of field names and values, such as
     /// Python's keyword arguments) and the other fields at their defaults; an unknown
@@ -175,30 +266,9 @@ impl BatchRequest {
     pub fn setup(&self, given: Option<AgentBundle>) -> Result<BatchSetup, Error> {
         check_episodes("episodes", self.episodes)?;
         check_episodes("train_episodes", self.train_episodes)?;
-        let jobs = match self.jobs {
-            None => std::thread::available_parallelism()
-                .map_or(1, |n| n.get())
-                .min(MAX_JOBS),
-            Some(n) if (1..=MAX_JOBS).contains(&n) => n,
-            Some(n) => {
-                return Err(Error::OutOfRange {
-                    field: "jobs".into(),
-                    value: n.to_string(),
-                    expected: format!("1..={MAX_JOBS} worker threads"),
-                });
-            }
-        };
+        let jobs = resolve_jobs(self.jobs)?;
         if self.stream.is_some() && !self.maps.is_empty() {
             return Err(Error::request("stream", "give maps or a stream, not both"));
-        }
-        if self.train_seeds.is_some() && (self.agent.is_some() || given.is_some()) {
-            return Err(Error::request(
-                "train_seeds",
-                "give train_seeds or agent, not both (train one agent per seed, or run one agent)",
-            ));
-        }
-        if self.agent.is_some() && given.is_some() {
-            return Err(Error::request("agent", "give one agent"));
         }
         let scenarios = match &self.stream {
             Some(file) => vec![load_stream_scenario(file)?],
@@ -211,41 +281,17 @@ impl BatchRequest {
         };
         let params = checked_sweep(&self.sets)?;
         let protocols = self.protocol.protocols();
-        let config = TrainConfig {
+        let scripted_only = methods.iter().all(|m| m.is_scripted());
+        let (agents, train_seeds, agents_identity) = AgentFields {
+            agent: self.agent.as_deref(),
+            train_seeds: self.train_seeds.as_ref(),
+            train_map: &self.train_map,
+            train_episodes: self.train_episodes,
             timeout_as: self.timeout_as,
-            ..TrainConfig::new(self.train_episodes, 0)
-        };
-        let trained = |seeds: Vec<u64>, cache: Option<PathBuf>| -> Result<_, Error> {
-            let map = crate::maps::load(&self.train_map)?;
-            let axis: Vec<Option<u64>> = seeds.iter().map(|&s| Some(s)).collect();
-            let identity = trained_agents_identity(&map, &axis, self.train_episodes)?;
-            let choice = AgentChoice::Trained {
-                map: Box::new(map),
-                seeds,
-                config: Box::new(config.clone()),
-                cache,
-            };
-            Ok((choice, axis, identity))
-        };
-        let given = match (given, &self.agent) {
-            (Some(bundle), _) => Some(bundle),
-            (None, Some(file)) => Some(crate::training::agent_file::load(file)?),
-            (None, None) => None,
-        };
-        let (agents, train_seeds, agents_identity) = match (&self.train_seeds, given) {
-            (Some(seeds), _) => trained(seeds.0.clone(), self.cache.clone())?,
-            (None, Some(bundle)) => {
-                let identity = agent_file_identity(&bundle);
-                let agent = Agent::from_bundle(bundle);
-                let axis = vec![agent.train_seed];
-                (AgentChoice::Given(Box::new(agent)), axis, identity)
-            }
-            (None, None) if methods.iter().all(|m| m.is_scripted()) => {
-                (AgentChoice::None, vec![None], SCRIPTED_ONLY.to_string())
-            }
-            // One agent trained with the run seed, not cached.
-            (None, None) => trained(vec![self.seed], None)?,
-        };
+            cache: self.cache.as_ref(),
+            seed: self.seed,
+        }
+        .choose(given, scripted_only.then_some(SCRIPTED_ONLY), "run one agent")?;
         Ok(BatchSetup {
             scenarios,
             methods,

@@ -8,17 +8,17 @@
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_sim::Map;
 
 use crate::episodes::methods::Method;
 use crate::episodes::protocol::Protocol;
 use crate::error::Error;
-use crate::limits::{MAX_JOBS, check_episodes};
+use crate::limits::check_episodes;
 use crate::progress::Progress;
-use crate::runs::batch::{AgentChoice, Shard, agent_file_identity, trained_agents_identity};
+use crate::runs::batch::request::{AgentFields, resolve_jobs};
+use crate::runs::batch::{AgentChoice, Shard};
 use crate::runs::outputs::Guarded;
 use crate::training::seed_agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs, TrainConfig};
+use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs};
 
 use super::{DEFAULT_MAX_FAILURES, DEFAULT_ROUNDS, DEFAULT_SOBOL_SHARE, SearchConfig, Space, Summary};
 
@@ -137,73 +137,30 @@ impl SearchRequest {
     pub fn setup(&self, given: Option<AgentBundle>) -> Result<SearchSetup, Error> {
         check_episodes("episodes", self.episodes)?;
         check_episodes("train_episodes", self.train_episodes)?;
-        let jobs = match self.jobs {
-            None => std::thread::available_parallelism()
-                .map_or(1, |n| n.get())
-                .min(MAX_JOBS),
-            Some(n) if (1..=MAX_JOBS).contains(&n) => n,
-            Some(n) => {
-                return Err(Error::OutOfRange {
-                    field: "jobs".into(),
-                    value: n.to_string(),
-                    expected: format!("1..={MAX_JOBS} worker threads"),
-                });
-            }
-        };
+        let jobs = resolve_jobs(self.jobs)?;
         if self.space.as_os_str().is_empty() {
             return Err(Error::request(
                 "space",
                 "give a space file, e.g. maps/spaces/jaywalk.ron",
             ));
         }
-        if self.train_seeds.is_some() && (self.agent.is_some() || given.is_some()) {
-            return Err(Error::request(
-                "train_seeds",
-                "give train_seeds or agent, not both (train one agent per seed, or search with one agent)",
-            ));
-        }
-        if self.agent.is_some() && given.is_some() {
-            return Err(Error::request("agent", "give one agent"));
-        }
         let base = crate::maps::load(&self.map)?;
         let space = Space::load(&self.space, &base)?;
         SearchConfig::check_arguments(&space, self.budget, self.sobol_share)?;
-        let trained = |seeds: Vec<u64>, cache: Option<PathBuf>| -> Result<_, Error> {
-            let map: Map = crate::maps::load(DEFAULT_TRAIN_MAP)?;
-            let axis: Vec<Option<u64>> = seeds.iter().map(|&s| Some(s)).collect();
-            let identity = trained_agents_identity(&map, &axis, self.train_episodes)?;
-            let config = TrainConfig {
-                timeout_as: self.timeout_as,
-                ..TrainConfig::new(self.train_episodes, 0)
-            };
-            let choice = AgentChoice::Trained {
-                map: Box::new(map),
-                seeds,
-                config: Box::new(config),
-                cache,
-            };
-            Ok((choice, axis, identity))
-        };
-        let (agents, train_seeds, agents_identity) = if self.method.is_scripted() {
-            (AgentChoice::None, vec![None], SCRIPTED_METHOD.to_string())
-        } else {
-            let given = match (given, &self.agent) {
-                (Some(bundle), _) => Some(bundle),
-                (None, Some(file)) => Some(crate::training::agent_file::load(file)?),
-                (None, None) => None,
-            };
-            match (&self.train_seeds, given) {
-                (Some(seeds), _) => trained(seeds.0.clone(), self.cache.clone())?,
-                (None, Some(bundle)) => {
-                    let identity = agent_file_identity(&bundle);
-                    let agent = Agent::from_bundle(bundle);
-                    let axis = vec![agent.train_seed];
-                    (AgentChoice::Given(Box::new(agent)), axis, identity)
-                }
-                // One agent trained with the run seed, not cached.
-                (None, None) => trained(vec![self.seed], None)?,
-            }
-        };
+        let (agents, train_seeds, agents_identity) = AgentFields {
+            agent: self.agent.as_deref(),
+            train_seeds: self.train_seeds.as_ref(),
+            train_map: DEFAULT_TRAIN_MAP,
+            train_episodes: self.train_episodes,
+            timeout_as: self.timeout_as,
+            cache: self.cache.as_ref(),
+            seed: self.seed,
+        }
+        .choose(
+            given,
+            self.method.is_scripted().then_some(SCRIPTED_METHOD),
+            "search with one agent",
+        )?;
         Ok(SearchSetup {
             request: self.clone(),
             space,
