@@ -195,26 +195,31 @@ pub(crate) struct AgentFields<'a> {
 }
 
 impl AgentFields<'_> {
-    /// The agents, their training-seed axis and what determines them: `given` (an agent
-    /// given loaded) or the agent file; one per training seed; none when `scripted` (the
-    /// identity of a run with scripted methods only) is given and no agent is; else one
-    /// trained with the run seed, not cached. `one_agent` says what one agent does, for
-    /// the error when both `train_seeds` and an agent are given.
-    pub fn choose(
-        &self,
-        given: Option<AgentBundle>,
-        scripted: Option<&str>,
-        one_agent: &str,
-    ) -> Result<(AgentChoice, Vec<Option<u64>>, String), Error> {
-        if self.train_seeds.is_some() && (self.agent.is_some() || given.is_some()) {
+    /// Checks that the fields and an agent given loaded (`given`) name one choice of
+    /// agents; `one_agent` says what one agent does, for the error when both
+    /// `train_seeds` and an agent are given. Reads no file.
+    pub fn check(&self, given: bool, one_agent: &str) -> Result<(), Error> {
+        if self.train_seeds.is_some() && (self.agent.is_some() || given) {
             return Err(Error::request(
                 "train_seeds",
                 format!("give train_seeds or agent, not both (train one agent per seed, or {one_agent})"),
             ));
         }
-        if self.agent.is_some() && given.is_some() {
+        if self.agent.is_some() && given {
             return Err(Error::request("agent", "give one agent"));
         }
+        Ok(())
+    }
+
+    /// The agents ([`AgentFields::check`]ed), their training-seed axis and what
+    /// determines them: `given` (an agent given loaded) or the agent file; one per
+    /// training seed; none when `scripted` (the identity of a run with scripted methods
+    /// only) is given and no agent is; else one trained with the run seed, not cached.
+    pub fn choose(
+        &self,
+        given: Option<AgentBundle>,
+        scripted: Option<&str>,
+    ) -> Result<(AgentChoice, Vec<Option<u64>>, String), Error> {
         let trained = |seeds: Vec<u64>, cache: Option<PathBuf>| -> Result<_, Error> {
             let map = crate::maps::load(self.train_map)?;
             let axis: Vec<Option<u64>> = seeds.iter().map(|&s| Some(s)).collect();
@@ -270,6 +275,16 @@ impl BatchRequest {
         if self.stream.is_some() && !self.maps.is_empty() {
             return Err(Error::request("stream", "give maps or a stream, not both"));
         }
+        let agent_fields = AgentFields {
+            agent: self.agent.as_deref(),
+            train_seeds: self.train_seeds.as_ref(),
+            train_map: &self.train_map,
+            train_episodes: self.train_episodes,
+            timeout_as: self.timeout_as,
+            cache: self.cache.as_ref(),
+            seed: self.seed,
+        };
+        agent_fields.check(given.is_some(), "run one agent")?;
         let scenarios = match &self.stream {
             Some(file) => vec![load_stream_scenario(file)?],
             None => load_scenarios(&self.maps)?,
@@ -282,16 +297,8 @@ impl BatchRequest {
         let params = checked_sweep(&self.sets)?;
         let protocols = self.protocol.protocols();
         let scripted_only = methods.iter().all(|m| m.is_scripted());
-        let (agents, train_seeds, agents_identity) = AgentFields {
-            agent: self.agent.as_deref(),
-            train_seeds: self.train_seeds.as_ref(),
-            train_map: &self.train_map,
-            train_episodes: self.train_episodes,
-            timeout_as: self.timeout_as,
-            cache: self.cache.as_ref(),
-            seed: self.seed,
-        }
-        .choose(given, scripted_only.then_some(SCRIPTED_ONLY), "run one agent")?;
+        let (agents, train_seeds, agents_identity) =
+            agent_fields.choose(given, scripted_only.then_some(SCRIPTED_ONLY))?;
         Ok(BatchSetup {
             scenarios,
             methods,

@@ -144,10 +144,7 @@ impl SearchRequest {
                 "give a space file, e.g. maps/spaces/jaywalk.ron",
             ));
         }
-        let base = crate::maps::load(&self.map)?;
-        let space = Space::load(&self.space, &base)?;
-        SearchConfig::check_arguments(&space, self.budget, self.sobol_share)?;
-        let (agents, train_seeds, agents_identity) = AgentFields {
+        let agent_fields = AgentFields {
             agent: self.agent.as_deref(),
             train_seeds: self.train_seeds.as_ref(),
             train_map: DEFAULT_TRAIN_MAP,
@@ -155,12 +152,13 @@ impl SearchRequest {
             timeout_as: self.timeout_as,
             cache: self.cache.as_ref(),
             seed: self.seed,
-        }
-        .choose(
-            given,
-            self.method.is_scripted().then_some(SCRIPTED_METHOD),
-            "search with one agent",
-        )?;
+        };
+        agent_fields.check(given.is_some(), "search with one agent")?;
+        let base = crate::maps::load(&self.map)?;
+        let space = Space::load(&self.space, &base)?;
+        SearchConfig::check_arguments(&space, self.budget, self.sobol_share)?;
+        let (agents, train_seeds, agents_identity) =
+            agent_fields.choose(given, self.method.is_scripted().then_some(SCRIPTED_METHOD))?;
         Ok(SearchSetup {
             request: self.clone(),
             space,
