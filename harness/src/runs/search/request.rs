@@ -53,7 +53,7 @@ pub struct SearchRequest {
     pub rounds: usize,
     /// Failures minimised and written as maps. Default [`DEFAULT_MAX_FAILURES`].
     pub max_failures: usize,
-    /// Worker threads, 1 to [`MAX_JOBS`]; results do not depend on it. Default: none,
+    /// Worker threads, 1 to [`MAX_JOBS`](crate::limits::MAX_JOBS); results do not depend on it. Default: none,
     /// which takes every core of the machine.
     pub jobs: Option<usize>,
     /// Evaluate only this shard of the Sobol stage. Default: none.
