@@ -21,7 +21,7 @@ use crate::episodes::protocol::Protocol;
 use crate::episodes::runner::EpisodeResult;
 use crate::error::Error;
 use crate::progress::Progress;
-use crate::runs::batch::{ResultLine, Scenario};
+use crate::runs::batch::{ResultLine, Scenario, UnitLabel};
 
 /// A method given from outside, as the runner and its lines know it.
 #[derive(Debug, Clone)]
@@ -111,8 +111,7 @@ pub fn evaluate_external(
             seed,
             progress,
         )?;
-        let agg = Aggregate::of(&results);
-        let line = ResultLine {
+        let label = UnitLabel {
             unit: place.first_unit + i,
             scenario: scenario.name().to_string(),
             source: scenario.source.clone(),
@@ -124,19 +123,8 @@ pub fn evaluate_external(
             train_seed: place.train_seed,
             train_episodes: place.train_episodes,
             seed,
-            episodes,
-            mean_reward: agg.mean_reward,
-            success_rate: agg.success_rate,
-            collision_rate: agg.collision_rate,
-            timeout_rate: agg.timeout_rate,
-            red_light_rate: agg.red_light_rate,
-            inference_rate: agg.inference_rate,
-            efe_matvecs_per_tick: agg.inference_rate * tree as f64,
-            mean_ticks: agg.mean_ticks,
-            checks: Vec::new(),
-            timing_us_per_tick: agg.us_per_tick,
-            per_map: Vec::new(),
         };
+        let line = ResultLine::new(label, &Aggregate::of(&results), tree, Vec::new(), Vec::new());
         out.push(ExternalRun {
             line,
             episodes: results,

@@ -7,6 +7,7 @@ use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_sim::Map;
 
+use crate::episodes::metrics::efe_prefix_tree;
 use crate::episodes::reference::{BrakeOnPedestrian, NeverBrake};
 use crate::error::Error;
 
@@ -179,6 +180,12 @@ impl Method {
                 | Method::ScaledOneStepGate
                 | Method::ScaledGateLearnsAll
         )
+    }
+
+    /// The expected-free-energy mat-vecs one reasoning tick of the method costs: the
+    /// planning tree ([`efe_prefix_tree`]) of a method that plans by EFE, 0 for any other.
+    pub fn reasoning_tree(self, params: &ScaledParams) -> usize {
+        if self.is_scaled() { efe_prefix_tree(params) } else { 0 }
     }
 
     /// Whether the method carries state from one episode to the next (test-time

@@ -49,7 +49,7 @@ pub use expectations::{Check, check_expectations};
 pub use identity::{RunIdentity, SCRIPTED_ONLY, agent_file_identity, trained_agents_identity};
 pub use plan::{BatchConfig, Plan};
 pub use request::{AgentChoice, BatchJob, BatchReport, BatchRequest, BatchSetup, Workers, survivability_warnings};
-pub use result_line::{MapFigures, ResultLine, UnitKey};
+pub use result_line::{MapFigures, ResultLine, UnitKey, UnitLabel};
 pub use results_file::{KeptLine, MAX_FIGURE, ResultsFile, read_lines, read_results, resume_lines};
 pub use run::{run, run_plan, run_unit, run_unit_with};
 pub use scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};

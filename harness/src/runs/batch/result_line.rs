@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::Protocol;
 
 use super::expectations::Check;
@@ -91,6 +92,95 @@ pub struct MapFigures {
     pub mean_ticks: f64,
     /// Wall-clock µs per decision tick.
     pub timing_us_per_tick: f64,
+}
+
+/// What a result line says of its unit, beside the figures: where it sits in the run,
+/// what ran and with which agent and seeds.
+#[derive(Debug, Clone)]
+pub struct UnitLabel {
+    /// Position in the canonical unit order of the whole run.
+    pub unit: usize,
+    /// Scenario (map) name.
+    pub scenario: String,
+    /// Map file or `embedded:NAME`.
+    pub source: String,
+    /// Method name.
+    pub method: String,
+    /// Parameter set label (`default` when no overrides).
+    pub param_set: String,
+    /// The overrides, key -> value.
+    pub params: Vec<(String, String)>,
+    /// The protocol the unit ran under.
+    pub protocol: Protocol,
+    /// Every protocol these results hold for.
+    pub covers: Vec<Protocol>,
+    /// Training seed of the agent.
+    pub train_seed: Option<u64>,
+    /// Training episodes of the agent.
+    pub train_episodes: Option<u64>,
+    /// Evaluation seed.
+    pub seed: u64,
+}
+
+impl ResultLine {
+    /// The one builder of a result line (the batch's units, the search's evaluations and
+    /// methods given from outside all make theirs here): `label`, the figures of `agg`
+    /// with the reasoning compute of a method whose reasoning tick costs `reasoning_tree`
+    /// EFE mat-vecs ([`Method::reasoning_tree`](crate::episodes::methods::Method::reasoning_tree)),
+    /// the map's `checks`, and for a stream the figures `per_map`.
+    pub fn new(
+        label: UnitLabel,
+        agg: &Aggregate,
+        reasoning_tree: usize,
+        checks: Vec<Check>,
+        per_map: Vec<MapFigures>,
+    ) -> ResultLine {
+        ResultLine {
+            unit: label.unit,
+            scenario: label.scenario,
+            source: label.source,
+            method: label.method,
+            param_set: label.param_set,
+            params: label.params,
+            protocol: label.protocol,
+            covers: label.covers,
+            train_seed: label.train_seed,
+            train_episodes: label.train_episodes,
+            seed: label.seed,
+            episodes: agg.episodes as u64,
+            mean_reward: agg.mean_reward,
+            success_rate: agg.success_rate,
+            collision_rate: agg.collision_rate,
+            timeout_rate: agg.timeout_rate,
+            red_light_rate: agg.red_light_rate,
+            inference_rate: agg.inference_rate,
+            efe_matvecs_per_tick: agg.inference_rate * reasoning_tree as f64,
+            mean_ticks: agg.mean_ticks,
+            checks,
+            timing_us_per_tick: agg.us_per_tick,
+            per_map,
+        }
+    }
+}
+
+impl MapFigures {
+    /// The figures of `map` within a stream unit: those of `agg`, its episodes on the
+    /// map, with the reasoning compute as in [`ResultLine::new`].
+    pub fn new(map: String, agg: &Aggregate, reasoning_tree: usize) -> MapFigures {
+        MapFigures {
+            map,
+            episodes: agg.episodes as u64,
+            mean_reward: agg.mean_reward,
+            success_rate: agg.success_rate,
+            collision_rate: agg.collision_rate,
+            timeout_rate: agg.timeout_rate,
+            red_light_rate: agg.red_light_rate,
+            inference_rate: agg.inference_rate,
+            efe_matvecs_per_tick: agg.inference_rate * reasoning_tree as f64,
+            mean_ticks: agg.mean_ticks,
+            timing_us_per_tick: agg.us_per_tick,
+        }
+    }
 }
 
 impl ResultLine {

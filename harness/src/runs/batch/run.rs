@@ -5,7 +5,6 @@ use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
-use unforeseen_sim::Action;
 
 use crate::episodes::experiments::{evaluate_scripted, evaluate_under};
 use crate::episodes::metrics::Aggregate;
@@ -16,7 +15,7 @@ use crate::runs::stream::{evaluate_stream, per_map};
 
 use super::expectations::check_expectations;
 use super::plan::{BatchConfig, Plan};
-use super::result_line::{MapFigures, ResultLine};
+use super::result_line::{MapFigures, ResultLine, UnitLabel};
 use super::results_file::KeptLine;
 use super::scenario::ScenarioKind;
 use super::units::Unit;
@@ -43,16 +42,7 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
     }
     let bundle = agent.map(|a| &a.bundle);
     let params = unit.params.scaled_params()?;
-    let actions = Action::ALL.len();
-    let tree: usize = (1..=params.planning.horizon).map(|k| actions.pow(k as u32)).sum();
-    // Reasoning compute: the inference rate times the prefix tree, for the planner by EFE.
-    let efe = |agg: &Aggregate| {
-        if unit.method.is_scaled() {
-            agg.inference_rate * tree as f64
-        } else {
-            0.0
-        }
-    };
+    let tree = unit.method.reasoning_tree(&params);
     let (agg, per_map_figures) = match &scenario.kind {
         ScenarioKind::Map(map) => {
             let results = match bundle {
@@ -84,22 +74,7 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
             let results: Vec<EpisodeResult> = episodes.iter().map(|e| e.result.clone()).collect();
             let figures = per_map(stream, &episodes)
                 .into_iter()
-                .map(|row| {
-                    let a = &row.aggregate;
-                    MapFigures {
-                        efe_matvecs_per_tick: efe(a),
-                        map: row.map,
-                        episodes: a.episodes as u64,
-                        mean_reward: a.mean_reward,
-                        success_rate: a.success_rate,
-                        collision_rate: a.collision_rate,
-                        timeout_rate: a.timeout_rate,
-                        red_light_rate: a.red_light_rate,
-                        inference_rate: a.inference_rate,
-                        mean_ticks: a.mean_ticks,
-                        timing_us_per_tick: a.us_per_tick,
-                    }
-                })
+                .map(|row| MapFigures::new(row.map, &row.aggregate, tree))
                 .collect();
             (Aggregate::of(&results), figures)
         }
@@ -110,7 +85,7 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
         Some(map) if unit.params.0.is_empty() => check_expectations(map, unit.method, &unit.covers, &agg),
         _ => Vec::new(),
     };
-    Ok(ResultLine {
+    let label = UnitLabel {
         unit: unit.index,
         scenario: scenario.name().to_string(),
         source: scenario.source.clone(),
@@ -122,19 +97,8 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
         train_seed: unit.train_seed,
         train_episodes: agent.and_then(|a| a.train_episodes),
         seed: cfg.seed,
-        episodes: cfg.episodes,
-        mean_reward: agg.mean_reward,
-        success_rate: agg.success_rate,
-        collision_rate: agg.collision_rate,
-        timeout_rate: agg.timeout_rate,
-        red_light_rate: agg.red_light_rate,
-        inference_rate: agg.inference_rate,
-        efe_matvecs_per_tick: efe(&agg),
-        mean_ticks: agg.mean_ticks,
-        checks,
-        timing_us_per_tick: agg.us_per_tick,
-        per_map: per_map_figures,
-    })
+    };
+    Ok(ResultLine::new(label, &agg, tree, checks, per_map_figures))
 }
 
 fn to_line(r: &ResultLine) -> String {

@@ -59,7 +59,7 @@ use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_sim::{Action, Map};
+use unforeseen_sim::Map;
 
 use crate::episodes::experiments::{evaluate_scripted, evaluate_under};
 use crate::episodes::methods::Method;
@@ -68,7 +68,7 @@ use crate::episodes::protocol::{Protocol, covered};
 use crate::episodes::survivability::careful_witness;
 use crate::error::Error;
 use crate::progress::{CancelOnly, NoProgress, Progress};
-use crate::runs::batch::{ResultLine, Shard};
+use crate::runs::batch::{ResultLine, Shard, UnitLabel};
 use crate::training::seed_agents::Agent;
 
 pub use fairness::Fairness;
@@ -739,10 +739,7 @@ fn result_line(
     params: &ScaledParams,
     agg: &Aggregate,
 ) -> ResultLine {
-    let tree: usize = (1..=params.planning.horizon)
-        .map(|k| Action::ALL.len().pow(k as u32))
-        .sum();
-    ResultLine {
+    let label = UnitLabel {
         unit: candidate.index,
         scenario: map.name.clone(),
         source: format!("search:{}", cfg.space.source),
@@ -754,23 +751,8 @@ fn result_line(
         train_seed,
         train_episodes: agent.and_then(|a| a.train_episodes),
         seed: cfg.seed,
-        episodes: cfg.episodes,
-        mean_reward: agg.mean_reward,
-        success_rate: agg.success_rate,
-        collision_rate: agg.collision_rate,
-        timeout_rate: agg.timeout_rate,
-        red_light_rate: agg.red_light_rate,
-        inference_rate: agg.inference_rate,
-        efe_matvecs_per_tick: if method.is_scaled() {
-            agg.inference_rate * tree as f64
-        } else {
-            0.0
-        },
-        mean_ticks: agg.mean_ticks,
-        checks: Vec::new(),
-        timing_us_per_tick: agg.us_per_tick,
-        per_map: Vec::new(),
-    }
+    };
+    ResultLine::new(label, agg, method.reasoning_tree(params), Vec::new(), Vec::new())
 }
 
 /// The lines of a candidate, complete: two witnesses and one method line per seed.
