@@ -115,7 +115,7 @@ if dqn is not None:
 
 # 5. The paper's table: the methods on the test map, over independently trained agents.
 agents = unforeseen.train_agents([1, 2] if SMALL else list(range(1, 11)), episodes=TRAIN_EPISODES)
-report = unforeseen.compare(agents=agents, episodes=EVAL_EPISODES, protocols=["zero-shot"])
+report = unforeseen.compare(agents=agents, episodes=EVAL_EPISODES, protocol="zero-shot")
 print(f"5. the paper's table ({len(agents)} agents, zero-shot, {report['test_map']}), as `unforeseen compare` prints it:")
 print(report)  # in a notebook, report alone shows it as an HTML table
 scaled = next(r for r in report.to_records() if r["method"] == "scaled")

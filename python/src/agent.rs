@@ -11,10 +11,10 @@ use pyo3::types::{PyBool, PyDict};
 use unforeseen_agent::controller::{Controller, Decision, Ending};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_harness::episodes::experiments::evaluate_map;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::limits::check_episodes;
+use unforeseen_harness::runs::evaluate::EvalRequest;
 
 use crate::errors;
 use crate::reports::EvalResult;
@@ -370,33 +370,24 @@ fn eval_seeds(seed: u64, map: &str, method: &str, episode: u64) -> PyResult<(u64
     Ok((s.world, s.controller))
 }
 
-/// `unforeseen eval` in the library, with the GIL released: its report
-/// ([`EvalResult`]), built by the one builder the command line uses ([`evaluate_map`]).
+/// `unforeseen eval`: the eval `request` (JSON text of its fields, the library's
+/// `EvalRequest`) planned, its agent trained or loaded and its episodes run by the
+/// library with the GIL released, as the command line runs it, writing the same
+/// eval.json into `out` (when the request has one); `agent` is an agent given loaded
+/// instead of the request's agent file. Returns its report ([`EvalResult`]).
 #[pyfunction]
-#[pyo3(signature = (map, method, episodes, seed = 7, agent = None, protocol = "zero-shot", **params))]
-#[allow(clippy::too_many_arguments)]
-fn evaluate_report(
-    py: Python<'_>,
-    map: &str,
-    method: &str,
-    episodes: u64,
-    seed: u64,
-    agent: Option<&PyAgent>,
-    protocol: &str,
-    params: Option<&Bound<'_, PyDict>>,
-) -> PyResult<EvalResult> {
-    let m = self::method(method)?;
-    let proto = self::protocol(protocol)?;
-    let p = scaled_params(params)?;
-    let map = crate::maps::load(map, None)?;
-    check_episodes("episodes", episodes).map_err(errors::to_py)?;
-    if !m.is_scripted() && agent.is_none() {
-        return Err(errors::value(format!("{method} needs a trained agent: pass agent=...")));
-    }
-    let report = crate::interrupt::interruptible(py, |progress| {
-        evaluate_map(&map, m, proto, agent.map(|a| &a.bundle), &p, episodes, seed, progress)
+#[pyo3(signature = (request, agent = None))]
+fn evaluate(py: Python<'_>, request: &str, agent: Option<&PyAgent>) -> PyResult<EvalResult> {
+    let request: EvalRequest = crate::units::request(request)?;
+    let given = agent.map(|a| a.bundle.clone());
+    let outcome = crate::interrupt::interruptible(py, |progress| {
+        let job = request.plan(given)?;
+        let bundle = job.agent(progress)?;
+        let outcome = job.run(bundle.as_ref(), progress)?;
+        job.write(&outcome)?;
+        Ok(outcome)
     })?;
-    EvalResult::new(&report)
+    EvalResult::new(&outcome)
 }
 
 /// Registers the classes and functions.
@@ -408,6 +399,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(train_agents, m)?)?;
     m.add_function(wrap_pyfunction!(scripted_controller, m)?)?;
     m.add_function(wrap_pyfunction!(eval_seeds, m)?)?;
-    m.add_function(wrap_pyfunction!(evaluate_report, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate, m)?)?;
     Ok(())
 }

@@ -10,10 +10,10 @@ use pyo3::exceptions::{PyImportError, PyKeyError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use serde_json::{Map, Value};
-use unforeseen_harness::episodes::experiments::EvalReport;
 use unforeseen_harness::reports::tables::{self, Document};
 use unforeseen_harness::runs::batch::{ResultLine, summarize};
 use unforeseen_harness::runs::compare::CompareReport;
+use unforeseen_harness::runs::evaluate::EvalOutcome;
 
 use crate::errors;
 
@@ -285,8 +285,8 @@ report_class!(
 );
 
 impl EvalResult {
-    /// The Python object of an eval report.
-    pub fn new(report: &EvalReport) -> PyResult<Self> {
+    /// The Python object of an eval report (of a map or of a stream).
+    pub fn new(report: &EvalOutcome) -> PyResult<Self> {
         let data = report.document().map_err(errors::to_py)?;
         let rows = data
             .get("episodes")
@@ -296,7 +296,7 @@ impl EvalResult {
         Ok(EvalResult {
             report: Report {
                 data,
-                doc: tables::eval(report),
+                doc: report.table(),
                 rows,
             },
         })

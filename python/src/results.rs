@@ -1,20 +1,17 @@
-//! `compare` and `batch` from Python, through the library functions the command line
-//! runs ([`unforeseen_harness::runs::compare::run_study`], [`unforeseen_harness::runs::batch::BatchRequest`]),
+//! `compare` and `batch` from Python, through the requests the command line runs
+//! ([`CompareRequest`], [`BatchRequest`]),
 //! returned as the report objects of [`crate::reports`]: the data the command line's files
 //! hold, built by the same library functions, and the table it prints.
 
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::runs::batch::{BatchRequest, ResultLine};
-use unforeseen_harness::runs::compare::{CompareReport, StudySetup};
+use unforeseen_harness::runs::compare::CompareRequest;
 use unforeseen_harness::runs::outputs::{Guarded, Outputs};
 use unforeseen_harness::training::seed_agents::Agent;
 
-use crate::agent::{PyAgent, protocol, scaled_params};
+use crate::agent::PyAgent;
 use crate::errors;
 use crate::reports::{BatchResult, CompareResult};
 
@@ -32,48 +29,27 @@ fn agents_of(agents: &Bound<'_, PyAny>) -> PyResult<Vec<Agent>> {
     Ok(list.iter().map(|a| Agent::from_bundle(a.bundle.clone())).collect())
 }
 
-fn protocols(names: Vec<String>) -> PyResult<Vec<Protocol>> {
-    names.iter().map(|n| protocol(n)).collect()
-}
-
-/// `unforeseen compare`: its report ([`CompareResult`]), built by the one builder the
-/// command line uses ([`CompareReport::new`]).
+/// `unforeseen compare`: the compare `request` (JSON text of its fields, the library's
+/// `CompareRequest`) planned, its agents trained or loaded and the study run by the
+/// library, as the command line runs it, writing the same files into `out` (when the
+/// request has one); `agents` are agents given loaded (an `Agent` or a list) instead of
+/// the request's agent file or training seeds. Returns its report ([`CompareResult`]).
+/// Ctrl-C raises `KeyboardInterrupt` at the next episode.
 #[pyfunction]
-#[pyo3(signature = (agents, train_map = "intersection", test_map = "jaywalk", episodes = 100, seed = 7, protocols = vec!["zero-shot".to_string(), "continual".to_string()], ablations = false, **params))]
-#[allow(clippy::too_many_arguments)]
-fn compare_report(
-    py: Python<'_>,
-    agents: &Bound<'_, PyAny>,
-    train_map: &str,
-    test_map: &str,
-    episodes: u64,
-    seed: u64,
-    protocols: Vec<String>,
-    ablations: bool,
-    params: Option<&Bound<'_, PyDict>>,
-) -> PyResult<CompareResult> {
-    let agents = agents_of(agents)?;
-    let protocols = self::protocols(protocols)?;
-    let p = scaled_params(params)?;
-    let train = crate::maps::load(train_map, None)?;
-    let test = crate::maps::load(test_map, None)?;
-    let mut methods = Method::PAPER.to_vec();
-    if ablations {
-        methods.extend(Method::ABLATIONS);
-    }
-    let setup = StudySetup {
-        train_map: &train,
-        test_map: &test,
-        params: &p,
-        methods: &methods,
-        protocols: &protocols,
-        episodes,
-        seed,
+#[pyo3(signature = (request, agents = None))]
+fn compare(py: Python<'_>, request: &str, agents: Option<&Bound<'_, PyAny>>) -> PyResult<CompareResult> {
+    let request: CompareRequest = crate::units::request(request)?;
+    let given = match agents {
+        Some(a) => agents_of(a)?,
+        None => Vec::new(),
     };
-    let tables = crate::interrupt::interruptible(py, |progress| {
-        unforeseen_harness::runs::compare::run_study(&setup, &agents, progress)
+    let report = crate::interrupt::interruptible(py, |progress| {
+        let job = request.plan(given)?;
+        let agents = job.agents(progress)?;
+        let report = job.run(&agents, progress)?;
+        job.write(&report)?;
+        Ok(report)
     })?;
-    let report = CompareReport::new(&setup, &agents, tables, None, None).map_err(errors::to_py)?;
     CompareResult::new(&report)
 }
 
@@ -137,7 +113,7 @@ impl ResultsGuard {
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ResultsGuard>()?;
-    m.add_function(wrap_pyfunction!(compare_report, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch_result, m)?)?;
     Ok(())

@@ -82,14 +82,6 @@ impl Built {
     }
 }
 
-/// The fields of the search request with their defaults, as JSON text (what
-/// `unforeseen.search` and `unforeseen.distributed.run_search` take).
-#[pyfunction]
-fn search_request_defaults() -> PyResult<String> {
-    let defaults = unforeseen_harness::runs::request::defaults::<SearchRequest>().map_err(errors::to_py)?;
-    Ok(defaults.to_string())
-}
-
 /// Checks the search `request` (JSON text of its fields: arguments, base map, space file)
 /// before any task runs, as `unforeseen search` does; `agent` is an agent given loaded
 /// instead of the request's agent file. Returns JSON text: `spec` (the request, for
@@ -260,7 +252,6 @@ fn drive_search(
 
 /// Registers the search units.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(search_request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(plan_search, m)?)?;
     m.add_function(wrap_pyfunction!(search, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate_search_candidates, m)?)?;

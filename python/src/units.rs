@@ -63,12 +63,23 @@ where
     unforeseen_harness::runs::request::from_fields(fields).map_err(errors::to_py)
 }
 
-/// The fields of the batch request with their defaults, as JSON text (what
-/// `unforeseen.batch` and `unforeseen.distributed.run_batch` take).
+/// The fields of the request of `job` (`batch`, `search`, `compare` or `eval`) with
+/// their defaults, as JSON text: what the Python functions of that job take.
 #[pyfunction]
-fn batch_request_defaults() -> PyResult<String> {
-    let defaults = unforeseen_harness::runs::request::defaults::<BatchRequest>().map_err(errors::to_py)?;
-    Ok(defaults.to_string())
+fn request_defaults(job: &str) -> PyResult<String> {
+    use unforeseen_harness::runs::request::defaults;
+    let defaults = match job {
+        "batch" => defaults::<BatchRequest>(),
+        "search" => defaults::<unforeseen_harness::runs::search::SearchRequest>(),
+        "compare" => defaults::<unforeseen_harness::runs::compare::CompareRequest>(),
+        "eval" => defaults::<unforeseen_harness::runs::evaluate::EvalRequest>(),
+        other => {
+            return Err(errors::value(format!(
+                "job: no request named '{other}'; the jobs are batch, search, compare, eval"
+            )));
+        }
+    };
+    Ok(defaults.map_err(errors::to_py)?.to_string())
 }
 
 /// Plans the batch `request` (JSON text of its fields) as `unforeseen batch` does (the
@@ -314,7 +325,7 @@ fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<String> {
 
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(batch_request_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(plan_batch, m)?)?;
     m.add_function(wrap_pyfunction!(train_agent, m)?)?;
     m.add_function(wrap_pyfunction!(run_units, m)?)?;

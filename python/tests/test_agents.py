@@ -57,9 +57,9 @@ def test_scaled_decision_record(agent):
     "method,protocol", [("scaled", "continual"), ("scaled", "zero-shot"), ("bayes-rl", "continual"), ("q-learning", "zero-shot")]
 )
 def test_python_rollout_equals_the_library_evaluation(agent, method, protocol):
-    params = {"epsilon": 0.3} if method == "scaled" else {}
-    py = unforeseen.rollout("jaywalk", method, episodes=6, seed=7, agent=agent, protocol=protocol, **params)
-    lib = unforeseen.evaluate_builtin("jaywalk", method, episodes=6, seed=7, agent=agent, protocol=protocol, **params)
+    sets = ["epsilon=0.3"] if method == "scaled" else []
+    py = unforeseen.rollout("jaywalk", method, episodes=6, seed=7, agent=agent, protocol=protocol, sets=sets)
+    lib = unforeseen.evaluate_builtin("jaywalk", method, episodes=6, seed=7, agent=agent, protocol=protocol, sets=sets)
     assert [{k: e[k] for k in FIELDS} for e in lib["episodes"]] == py
 
 
@@ -102,7 +102,8 @@ def test_python_rollout_equals_the_command_line(agent_file, tmp_path, map_name, 
     )
     report = json.loads((out / "eval.json").read_text())
     agent = unforeseen.load_agent(str(agent_file))
-    py = unforeseen.rollout(map_name, "scaled", episodes=5, seed=9, agent=agent, protocol=protocol, horizon=3)
+    py = unforeseen.rollout(map_name, "scaled", episodes=5, seed=9, agent=agent, protocol=protocol,
+                             sets=["horizon=3"])
     assert [{k: e[k] for k in FIELDS} for e in report["episodes"]] == py
     # The figures `eval` prints are the means of those episodes.
     assert report["aggregate"]["success_rate"] == sum(e["success"] for e in py) / len(py)

@@ -38,7 +38,7 @@ def test_1_a_wrapper_told_not_to_learn_does_not_learn_across_episodes(agent):
 
 
 def test_2_compare_json_from_python_has_the_command_lines_paper_rows_and_columns(agent):
-    report = unforeseen.compare(agents=agent, episodes=2, protocols=["zero-shot"])
+    report = unforeseen.compare(agents=agent, episodes=2, protocol="zero-shot")
     assert [p["method"] for p in report["paper"]] == ["q-learning", "bayes-rl", "scaled"]
     for row in report["paper"]:
         assert "red_light_rate" in row and row["red_light_rate"] is None, row

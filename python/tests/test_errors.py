@@ -92,9 +92,13 @@ def test_bad_agent_file(tmp_path):
         (lambda: unforeseen.VectorEnv("jaywalk", 2, num_threads=0), "num_threads 0"),
         (lambda: unforeseen.train(episodes=0), "episodes 0"),
         (lambda: unforeseen.scripted_controller("scaled"), "needs a trained agent"),
-        (lambda: unforeseen.evaluate_builtin("jaywalk", "scaled", episodes=2), "needs a trained agent"),
-        (lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=2, protocol="x"), "unknown protocol"),
+        (lambda: unforeseen.evaluate_builtin("jaywalk", "scaled", episodes=2, agent="no-such-agent.ron"),
+         "no-such-agent.ron"),
+        (lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=2, protocol="x"), "^protocol: "),
+        (lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=0), "^episodes"),
         (lambda: unforeseen.compare(agents=[]), "at least one agent"),
+        (lambda: unforeseen.compare(protocol="twice"), "^protocol: "),
+        (lambda: unforeseen.compare(sets=["epsilon=2"]), "epsilon"),
     ],
 )
 def test_bad_input_raises_value_error_never_a_panic(call, message):

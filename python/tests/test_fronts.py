@@ -111,6 +111,47 @@ def test_local_and_ray_take_the_request_with_the_librarys_defaults(job: str):
         assert given_nothing[field] == default, field
 
 
+@pytest.mark.parametrize("job", ["compare", "eval"])
+def test_compare_and_eval_take_the_request_with_the_librarys_defaults(job: str):
+    from unforeseen.requests import COMPARE_DEFAULTS, EVAL_DEFAULTS
+
+    function, defaults, given_loaded = {
+        "compare": (unforeseen.compare, COMPARE_DEFAULTS, {"agents"}),
+        "eval": (unforeseen.evaluate_builtin, EVAL_DEFAULTS, set()),
+    }[job]
+    taken = {k: _as_json(v) for k, v in _request_parameters(function, given_loaded).items()}
+    assert taken == defaults, "the request's fields, names and defaults"
+
+
+def test_the_same_compare_and_eval_through_python_and_the_command_line_write_the_same_files(agent_file, tmp_path):
+    cli = required_cli()
+    common = ["--agent", str(agent_file), "--episodes", "2", "--seed", "5", "--set", "horizon=2", "--quiet"]
+    subprocess.run([str(cli), "compare", *common, "--protocol", "zero-shot", "--out", str(tmp_path / "c-cli")],
+                   check=True, capture_output=True, timeout=300)
+    unforeseen.compare(agent=agent_file, episodes=2, seed=5, sets=["horizon=2"], protocol="zero-shot",
+                       out=tmp_path / "c-py")
+    subprocess.run([str(cli), "eval", *common, "--map", "two_pedestrians", "--protocol", "continual",
+                    "--out", str(tmp_path / "e-cli")], check=True, capture_output=True, timeout=300)
+    unforeseen.evaluate_builtin("two_pedestrians", agent=agent_file, episodes=2, seed=5, sets=["horizon=2"],
+                                protocol="continual", out=tmp_path / "e-py")
+    for folder, name in [("c", "compare.json"), ("e", "eval.json")]:
+        on_cli, on_py = (_untimed(json.loads((tmp_path / f"{folder}-{front}" / name).read_text()))
+                         for front in ("cli", "py"))
+        assert on_cli == on_py, name
+    seeds = [(tmp_path / f"c-{front}" / "compare_seeds.csv").read_text().splitlines() for front in ("cli", "py")]
+    assert seeds[0][0] == seeds[1][0] and len(seeds[0]) == len(seeds[1]) > 1
+
+
+def _untimed(value: Any) -> Any:
+    """A report's data without the wall-clock figures (every key that measures µs or ns)."""
+    if isinstance(value, dict):
+        timed = ("us_per", "_ns")
+        return {k: _untimed(v) for k, v in value.items() if not any(t in k for t in timed)}
+    if isinstance(value, list):
+        return [_untimed(v) for v in value]
+    return value
+
+
 def test_a_bad_field_names_the_field_in_python_and_the_flag_on_the_command_line(tmp_path: Path):
     with pytest.raises(ValueError, match="^train_seeds: '3..1': the range runs backwards"):
         unforeseen.batch("jaywalk", train_seeds="3..1", out=tmp_path / "r.jsonl")

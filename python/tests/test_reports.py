@@ -37,7 +37,7 @@ def test_compare_prints_the_command_lines_tables(agent_file, tmp_path):
     printed = cli("compare", "--agent", str(agent_file), "--episodes", "3", "--protocol", "both",
                   "--set", "horizon=2", "--quiet", "--out", str(tmp_path / "c"))
     agent = unforeseen.load_agent(str(agent_file))
-    result = unforeseen.compare(agents=agent, episodes=3, protocols=["zero-shot", "continual"], horizon=2)
+    result = unforeseen.compare(agents=agent, episodes=3, protocol="both", sets=["horizon=2"])
     assert isinstance(result, unforeseen.CompareResult)
     assert untimed(str(result)) == untimed(printed)
     assert "== zero-shot protocol" in str(result) and "== continual protocol" in str(result)
@@ -71,7 +71,7 @@ def test_batch_prints_the_command_lines_summary_byte_for_byte(agent_file, tmp_pa
 
 
 def test_markdown_and_html_show_the_same_table(agent):
-    result = unforeseen.compare(agents=agent, episodes=2, protocols=["zero-shot", "continual"])
+    result = unforeseen.compare(agents=agent, episodes=2, protocol="both")
     md = result._repr_markdown_()
     assert "#### zero-shot protocol" in md and "#### continual protocol" in md
     # The two header lines joined into one header cell per column.
@@ -90,7 +90,7 @@ def test_markdown_and_html_show_the_same_table(agent):
 
 
 def test_the_data_keeps_its_keys(agent):
-    result = unforeseen.compare(agents=agent, episodes=2, protocols=["zero-shot"])
+    result = unforeseen.compare(agents=agent, episodes=2, protocol="zero-shot")
     data = result.to_dict()
     assert sorted(data) == result.keys()
     assert result["tables"] == data["tables"] == result.tables

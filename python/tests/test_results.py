@@ -8,7 +8,7 @@ import unforeseen
 
 
 def test_compare(agent):
-    report = unforeseen.compare(agents=agent, episodes=3, protocols=["zero-shot"])
+    report = unforeseen.compare(agents=agent, episodes=3, protocol="zero-shot")
     assert report["schema"] == 2 and report["protocols"] == ["zero-shot"]
     (table,) = report["tables"]
     assert [m["method"] for m in table["methods"]] == ["q-learning", "bayes-rl", "scaled"]
@@ -34,8 +34,8 @@ def test_train_agents_trains_each_seed_once_and_caches_them(tmp_path):
     again = unforeseen.train_agents([3, 4], episodes=60, cache=str(cache))
     assert [a.meta for a in again] == [a.meta for a in agents]
     one = unforeseen.train("intersection", episodes=60, seed=3)
-    table = unforeseen.compare(agents=[agents[0]], episodes=3, protocols=["zero-shot"])
-    again_table = unforeseen.compare(agents=[one], episodes=3, protocols=["zero-shot"])
+    table = unforeseen.compare(agents=[agents[0]], episodes=3, protocol="zero-shot")
+    again_table = unforeseen.compare(agents=[one], episodes=3, protocol="zero-shot")
     rows = lambda t: [(m["method"], m["per_seed"][0]["test_reward"], m["per_seed"][0]["success_rate"]) for m in t["tables"][0]["methods"]]
     assert [r[0] for r in rows(table)] == ["q-learning", "bayes-rl", "scaled"]
     assert rows(table) == rows(again_table), "seed 3 from train_agents is seed 3 of train"

@@ -121,57 +121,88 @@ def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int
 
 
 def evaluate_builtin(
-    map: str,
+    map: str = "jaywalk",
     method: str = "scaled",
+    *,
+    stream: str | os.PathLike[str] | None = None,
     episodes: int = 100,
-    seed: int = 7,
-    agent: Agent | None = None,
     protocol: str = "zero-shot",
-    **params: Any,
+    sets: Sequence[str] = (),
+    seed: int = 7,
+    out: str | os.PathLike[str] | None = "out/eval",
+    agent: str | os.PathLike[str] | Agent | None = None,
 ) -> EvalResult:
-    """``unforeseen eval`` run by the Rust library. Returns an :class:`EvalResult`:
-    ``print(result)`` gives the line ``eval`` prints, ``result["aggregate"]`` and
-    ``result["episodes"]`` (or ``to_dict()``) eval.json's data, and ``to_pandas()`` one
-    row per episode. ``params`` are the ``--set`` keys."""
-    return _unforeseen.evaluate_report(map, method, episodes, seed, agent, protocol, **params)
+    """``unforeseen eval`` in this process: the same request, planned and run by the
+    library as the command line runs it, writing the same ``eval.json`` into ``out``
+    (None: no file). ``method`` runs on ``map`` (or over the maps of the deployment
+    ``stream`` file) for ``episodes`` episodes from ``seed`` under ``protocol``
+    (``"zero-shot"`` or ``"continual"``), with the scaled agent's overrides ``sets``
+    (``"KEY=VALUE"`` each, the ``--set`` keys). ``agent`` is an agent file or an
+    :class:`Agent`; without one, a method that needs an agent trains one on
+    ``intersection`` with ``seed`` (scripted references need none). A bad argument
+    raises ``ValueError`` naming it. Returns an :class:`EvalResult`: ``print(result)``
+    gives the line ``eval`` prints, ``result["aggregate"]`` and ``result["episodes"]``
+    (or ``to_dict()``) eval.json's data, and ``to_pandas()`` one row per episode."""
+    fields = dict(locals())
+    given = fields.pop("agent") if isinstance(agent, Agent) else None
+    return _unforeseen.evaluate(request_json(fields), given)
 
 
 def rollout(
-    map: str,
+    map: str = "jaywalk",
     method: str = "scaled",
+    *,
     episodes: int = 100,
-    seed: int = 7,
-    agent: Agent | None = None,
     protocol: str = "zero-shot",
-    **params: Any,
+    sets: Sequence[str] = (),
+    seed: int = 7,
+    agent: str | os.PathLike[str] | Agent | None = None,
 ) -> list[dict[str, Any]]:
     """The episodes of :func:`evaluate_builtin` (the library's evaluation, as ``unforeseen
-    eval`` runs it) without the fields that measure time: per episode ``ret``,
-    ``success``, ``collision``, ``timeout``, ``ticks``, ``reasoning_ticks`` and
+    eval`` runs it; no file written) without the fields that measure time: per episode
+    ``ret``, ``success``, ``collision``, ``timeout``, ``ticks``, ``reasoning_ticks`` and
     ``jaywalk_surprise``. To evaluate a Python policy, see :func:`evaluate`."""
-    report = evaluate_builtin(map, method, episodes, seed, agent, protocol, **params)
+    report = evaluate_builtin(map, method, episodes=episodes, protocol=protocol, sets=sets, seed=seed, out=None,
+                              agent=agent)
     keys = ("ret", "success", "collision", "timeout", "ticks", "reasoning_ticks", "jaywalk_surprise")
     return [{k: e[k] for k in keys} for e in report["episodes"]]
 
 
 def compare(
-    agents: Agent | Sequence[Agent],
+    agents: Agent | Sequence[Agent] | None = None,
+    *,
     train_map: str = "intersection",
     test_map: str = "jaywalk",
+    train_episodes: int = 6000,
     episodes: int = 100,
-    seed: int = 7,
-    protocols: Sequence[str] = ("zero-shot", "continual"),
     ablations: bool = False,
-    **params: Any,
+    protocol: str = "both",
+    sets: Sequence[str] = (),
+    seed: int = 7,
+    out: str | os.PathLike[str] | None = "out/compare",
+    agent: str | os.PathLike[str] | None = None,
+    train_seeds: Iterable[int] | str | None = None,
+    timeout_as: str = "truncation",
+    cache: str | os.PathLike[str] | None = "out/agents",
 ) -> CompareResult:
-    """``unforeseen compare`` in the library: the paper's table (§VI) of ``agents`` (one
-    agent, or several from :func:`train_agents`, summarized over them), trained on
-    ``train_map`` and tested on ``test_map``, one table per protocol. Returns a
-    :class:`CompareResult`: ``print(result)`` gives the tables ``compare`` prints,
-    ``result["tables"]`` (or ``to_dict()``) compare.json's data, and ``to_pandas()`` one
-    row per (protocol, method). ``params`` are the ``--set`` keys."""
-    return _unforeseen.compare_report(agents, train_map, test_map, episodes, seed, list(protocols), ablations,
-                                      **params)
+    """``unforeseen compare`` in this process: the paper's table (§VI), the same request
+    planned, trained and run by the library as the command line runs it, writing the
+    same compare.json, compare.csv, compare_seeds.csv and compare.svg into ``out``
+    (None: no files). The agents: ``agents`` (an :class:`Agent`, or several from
+    :func:`train_agents`, summarized over them), ``agent`` (an agent file),
+    ``train_seeds`` (one agent per seed, ``range(1, 5)`` or ``"1..4"``, trained on
+    ``train_map`` for ``train_episodes`` and kept in the agent cache ``cache``, None for
+    none), or none of them (one agent trained with ``seed``). They are tested on
+    ``test_map`` for ``episodes`` episodes per method under ``protocol``
+    (``"zero-shot"``, ``"continual"`` or ``"both"``), with the ablations when
+    ``ablations``, and the scaled agent's overrides ``sets`` (``"KEY=VALUE"`` each). A
+    bad argument raises ``ValueError`` naming it. Returns a :class:`CompareResult`:
+    ``print(result)`` gives the tables ``compare`` prints, ``result["tables"]`` (or
+    ``to_dict()``) compare.json's data, and ``to_pandas()`` one row per (protocol,
+    method)."""
+    fields = dict(locals())
+    given = fields.pop("agents")
+    return _unforeseen.compare(request_json(fields), given)
 
 
 def batch(

@@ -24,11 +24,11 @@ __all__ = [
     "VectorEnv",
     "batch",
     "batch_result",
-    "compare_report",
+    "compare",
     "embedded_maps",
     "eval_seeds",
+    "evaluate",
     "evaluate_policy",
-    "evaluate_report",
     "load_agent",
     "q_table_habit",
     "rust_loop",
@@ -213,35 +213,26 @@ class PolicyRun:
     @property
     def episodes(self) -> list[dict[str, Any]]:
         """Every episode, in order, as eval.json holds them."""
-def evaluate_report(
-    map: str,
-    method: str,
-    episodes: int,
-    seed: int = 7,
-    agent: Agent | None = None,
-    protocol: str = "zero-shot",
-    **params: Any,
-) -> EvalResult:
-    """``unforeseen eval``: its report."""
-def compare_report(
-    agents: Agent | Sequence[Agent],
-    train_map: str = "intersection",
-    test_map: str = "jaywalk",
-    episodes: int = 100,
-    seed: int = 7,
-    protocols: Sequence[str] = ("zero-shot", "continual"),
-    ablations: bool = False,
-    **params: Any,
-) -> CompareResult:
-    """``unforeseen compare``: its report."""
+def evaluate(request: str, agent: Agent | None = None) -> EvalResult:
+    """``unforeseen eval`` in this process: the eval request (JSON text of its fields;
+    :func:`unforeseen.evaluate_builtin` writes it) planned and run by the library as the
+    command line runs it, writing eval.json into its ``out``; ``agent`` is an agent
+    given loaded instead of the request's agent file. A bad field raises ``ValueError``
+    naming it."""
+def compare(request: str, agents: Agent | Sequence[Agent] | None = None) -> CompareResult:
+    """``unforeseen compare`` in this process: the compare request (JSON text of its
+    fields; :func:`unforeseen.compare` writes it) planned, trained and run by the library
+    as the command line runs it, writing its four files into its ``out``; ``agents`` are
+    agents given loaded. A bad field raises ``ValueError`` naming it."""
 def batch(request: str, agent: Agent | None = None) -> BatchResult:
     """``unforeseen batch`` in this process: the batch request (JSON text of its fields;
     :func:`unforeseen.batch` writes it), planned, trained and run by the library as the
     command line runs it, writing its results file and summary; ``agent`` is an agent
     given loaded instead of the request's agent file. A bad field raises ``ValueError``
     naming it."""
-def batch_request_defaults() -> str:
-    """The batch request's fields with their defaults (JSON text)."""
+def request_defaults(job: str) -> str:
+    """The fields of the request of ``job`` (``"batch"``, ``"search"``, ``"compare"`` or
+    ``"eval"``) with their defaults (JSON text)."""
 def batch_result(lines: str) -> BatchResult:
     """The report of result lines (the JSON text of their list) that ``evaluate`` wrote,
     summarized and printed as ``unforeseen batch`` does its own."""
@@ -399,8 +390,6 @@ def finish_batch(out: str) -> str:
     """Rewrites a driver's results file in canonical order with its summary; JSON text of
     ``lines``, ``summary`` (its path), ``checked``, ``failed``, ``failures`` and ``table``
     (the summary table ``unforeseen batch`` prints)."""
-def search_request_defaults() -> str:
-    """The search request's fields with their defaults (JSON text)."""
 def plan_search(request: str, agent: Agent | None = None) -> str:
     """The search request (JSON text of its fields) checked as ``unforeseen search`` checks
     it (arguments, base map, space file), before any task; JSON text of ``spec`` (the

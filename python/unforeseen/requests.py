@@ -1,15 +1,16 @@
-"""The requests of jobs (``batch``, ``search``) as the extension reads them: keyword
-arguments to the JSON text of the library's request (``BatchRequest``,
-``SearchRequest``), whose defaults, checks, agent choice and run identity are the
-command line's. A bad field raises ``ValueError`` naming the field (``train_seeds:
+"""The requests of jobs (``batch``, ``search``, ``compare``, ``eval``) as the extension
+reads them: keyword arguments to the JSON text of the library's request
+(``BatchRequest``, ``SearchRequest``, ``CompareRequest``, ``EvalRequest``), whose
+defaults, checks, agent choice and run identity are the command line's. A bad field raises ``ValueError`` naming the field (``train_seeds:
 ...``); ``python -m unforeseen.distributed`` spells it as its flag (:func:`flag_message`).
 
-:data:`BATCH_DEFAULTS` and :data:`SEARCH_DEFAULTS` are the requests' fields with their
-defaults, read from the library: :func:`unforeseen.batch`,
-:func:`unforeseen.distributed.run_batch`, :func:`unforeseen.search` and
-:func:`unforeseen.distributed.run_search` take these fields with these defaults (a test
-checks their signatures against them), and the Ray driver's command line derives its
-options from them.
+:data:`BATCH_DEFAULTS`, :data:`SEARCH_DEFAULTS`, :data:`COMPARE_DEFAULTS` and
+:data:`EVAL_DEFAULTS` are the requests' fields with their defaults, read from the
+library: :func:`unforeseen.batch`, :func:`unforeseen.distributed.run_batch`,
+:func:`unforeseen.search`, :func:`unforeseen.distributed.run_search`,
+:func:`unforeseen.compare` and :func:`unforeseen.evaluate_builtin` take these fields with
+these defaults (a test checks their signatures against them), and the Ray driver's
+command line derives its options from them.
 """
 
 from __future__ import annotations
@@ -22,10 +23,16 @@ from typing import Any
 from . import _unforeseen
 
 #: The batch request's fields and their defaults (``unforeseen batch``'s).
-BATCH_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.batch_request_defaults())
+BATCH_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("batch"))
 
 #: The search request's fields and their defaults (``unforeseen search``'s).
-SEARCH_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.search_request_defaults())
+SEARCH_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("search"))
+
+#: The compare request's fields and their defaults (``unforeseen compare``'s).
+COMPARE_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("compare"))
+
+#: The eval request's fields and their defaults (``unforeseen eval``'s).
+EVAL_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("eval"))
 
 #: Fields whose flag is not ``--`` and the field with ``-`` for ``_``.
 _FLAGS = {"maps": "MAP", "methods": "--method", "sets": "--set"}

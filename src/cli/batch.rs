@@ -11,7 +11,6 @@ use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::ProtocolChoice;
 use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::batch::{AgentChoice, BatchRequest, ScenarioKind, Shard, SummaryRow, stream_learning};
-use unforeseen_harness::runs::outputs::missing_folder;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `batch`.
@@ -124,33 +123,24 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let quiet = args.quiet;
     let out = &args.out;
     // The folder the run creates for --out, if any, said once the guard has passed.
-    let creates = missing_folder(out.parent().unwrap_or(Path::new("")));
+    let creates = super::outputs::to_create(out.parent().unwrap_or(Path::new("")));
     // One run at a time per results file: the job holds the lock until it is dropped.
     let job = args.request().plan(None)?;
-    if let Some(top) = creates {
-        errln!(
-            "note: --out: creating the folder {} (it does not exist yet)",
-            top.display()
-        );
-    }
+    super::outputs::creating("--out", creates);
     let setup = &job.setup;
     let to_train = job.to_train();
     if let AgentChoice::Trained { map, .. } = &setup.agents
         && !to_train.is_empty()
     {
-        let what = match &args.seeds.train_seeds {
-            Some(_) => format!(
-                "training {} agent(s) for {} episodes on '{}' (or loading them from the cache), one line each",
-                to_train.len(),
-                args.train_episodes,
-                map.name
-            ),
-            None => format!(
-                "training {} episodes on '{}' (seed {})",
-                args.train_episodes, map.name, args.seed
-            ),
-        };
-        progress::phase(quiet, what);
+        let per_seed = args.seeds.train_seeds.is_some();
+        progress::training(
+            quiet,
+            per_seed,
+            to_train.len(),
+            args.train_episodes,
+            &map.name,
+            args.seed,
+        );
     }
     let agents = job.agents(&Bars::counting(quiet, "episodes"))?;
     let workers = job.workers(&agents);

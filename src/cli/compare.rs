@@ -5,17 +5,13 @@
 use clap::Args;
 use std::path::{Path, PathBuf};
 
+use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
-use unforeseen_harness::episodes::methods::{Method, PaperFigures};
-use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::episodes::protocol::ProtocolChoice;
-use unforeseen_harness::maps;
-use unforeseen_harness::reports::figures::{BarPanel, BarRow, bar_key, grouped_bars};
-use unforeseen_harness::reports::files::{Csv, num, write_json};
-use unforeseen_harness::reports::tables::{self, seed_text};
-use unforeseen_harness::runs::compare::{CompareReport, METRICS, ProtocolTable, StudySetup, run_study};
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::reports::tables;
+use unforeseen_harness::runs::batch::AgentChoice;
+use unforeseen_harness::runs::compare::{COMPARE_FILES, CompareRequest};
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `compare`.
@@ -79,213 +75,53 @@ impl Default for CompareArgs {
     }
 }
 
-/// Runs `compare`.
-pub fn run(args: CompareArgs) -> anyhow::Result<()> {
-    args.agent.check_out_dir(
-        &args.out,
-        &["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"],
-        &[&args.train_map, &args.test_map],
-        None,
-    )?;
-    let train_map = maps::load(&args.train_map)?;
-    let test_map = maps::load(&args.test_map)?;
-    let params = args.agent.params()?;
-    let agents = match &args.seeds.train_seeds {
-        Some(seeds) => args
-            .seeds
-            .train(&seeds.0, &args.train_map, args.train_episodes, args.agent.quiet)?,
-        None => vec![Agent::from_bundle(
-            args.agent.bundle_trained_on(&args.train_map, args.train_episodes)?,
-        )],
-    };
-    let mut methods: Vec<Method> = Method::PAPER.to_vec();
-    if args.ablations {
-        methods.extend(Method::ABLATIONS);
+impl CompareArgs {
+    /// The library's request of these arguments ([`CompareRequest`]).
+    pub fn request(&self) -> CompareRequest {
+        CompareRequest {
+            train_map: self.train_map.clone(),
+            test_map: self.test_map.clone(),
+            train_episodes: self.train_episodes,
+            episodes: self.episodes,
+            ablations: self.ablations,
+            protocol: self.protocol,
+            sets: self.agent.set.clone(),
+            seed: self.agent.seed,
+            out: Some(self.out.clone()),
+            agent: self.agent.agent.clone(),
+            train_seeds: self.seeds.train_seeds.clone(),
+            timeout_as: self.seeds.timeout_as,
+            cache: self.seeds.cache_dir().map(Path::to_path_buf),
+        }
     }
-    let protocols = args.protocol.protocols();
-    let setup = StudySetup {
-        train_map: &train_map,
-        test_map: &test_map,
-        params: &params,
-        methods: &methods,
-        protocols: &protocols,
-        episodes: args.episodes,
-        seed: args.agent.seed,
-    };
-    let tables = run_study(&setup, &agents, &super::progress::Bars::new(args.agent.quiet))?;
-    let agent_cache = (args.seeds.train_seeds.is_some())
-        .then(|| args.seeds.cache_dir().map(|p| p.display().to_string()))
-        .flatten();
-    let agent_file = args.agent.agent.as_ref().map(|p| p.display().to_string());
-    let report = CompareReport::new(&setup, &agents, tables, agent_file, agent_cache)?;
+}
+
+/// Runs `compare`: the request of the arguments, planned, its agents trained or loaded
+/// and the study run by the library ([`CompareRequest::plan`]), then the tables printed
+/// and the files written.
+pub fn run(args: CompareArgs) -> anyhow::Result<()> {
+    let quiet = args.agent.quiet;
+    let creates = super::outputs::to_create(&args.out);
+    let job = args.request().plan(Vec::new())?;
+    super::outputs::creating("--out", creates);
+    if let AgentChoice::Trained { map, seeds, .. } = &job.agents {
+        let per_seed = args.seeds.train_seeds.is_some();
+        progress::training(
+            quiet,
+            per_seed,
+            seeds.len(),
+            args.train_episodes,
+            &map.name,
+            args.agent.seed,
+        );
+    }
+    let agents = job.agents(&Bars::counting(quiet, "episodes"))?;
+    let report = job.run(&agents, &Bars::new(quiet))?;
     outln!("{}", tables::compare(&report));
     let dir = &args.out;
-    let files = ["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"];
-    warn_replacing(dir, &files);
-    super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
-    // All four or none: a failed write (a full disk) leaves the previous run's set.
-    unforeseen_harness::reports::files::all_or_none(|| -> anyhow::Result<()> {
-        write_json(&dir.join("compare.json"), &report)?;
-        let maps = (report.train_map.as_str(), report.test_map.as_str());
-        summary_csv(&report.tables, maps).write(&dir.join("compare.csv"))?;
-        seeds_csv(&report.tables, maps).write(&dir.join("compare_seeds.csv"))?;
-        plot(&dir.join("compare.svg"), &report.tables)?;
-        Ok(())
-    })?;
-    outln!(
-        "wrote {}/compare.json, compare.csv, compare_seeds.csv, compare.svg",
-        dir.display()
-    );
+    warn_replacing(dir, &COMPARE_FILES);
+    progress::phase(quiet, format_args!("writing {}", dir.display()));
+    job.write(&report)?;
+    outln!("wrote {}/{}", dir.display(), COMPARE_FILES.join(", "));
     Ok(())
-}
-
-/// Formats an optional number for CSV (empty when absent).
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map(|x| num(x, digits)).unwrap_or_default()
-}
-
-/// Training seeds as one CSV cell, space-separated.
-fn seeds_cell(seeds: &[Option<u64>]) -> String {
-    let s: Vec<String> = seeds.iter().map(|&s| seed_text(s)).collect();
-    s.join(" ")
-}
-
-/// `compare.csv`: one row per (protocol, method), every metric as mean, 95% interval,
-/// min and max over agents, and the worst seed.
-fn summary_csv(tables: &[ProtocolTable], (train_map, test_map): (&str, &str)) -> Csv {
-    let mut header: Vec<String> = [
-        "protocol",
-        "method",
-        "computed_under",
-        "agents",
-        "train_seeds",
-        "train_episodes",
-        "episodes",
-        "seed",
-        "train_map",
-        "test_map",
-    ]
-    .map(String::from)
-    .to_vec();
-    for (name, _) in METRICS {
-        for suffix in ["", "_ci95_low", "_ci95_high", "_min", "_max"] {
-            header.push(format!("{name}{suffix}"));
-        }
-    }
-    header.extend(["worst_seed", "worst_seed_success_rate", "worst_seed_test_reward"].map(String::from));
-    let mut csv = Csv::new(&header.iter().map(String::as_str).collect::<Vec<_>>());
-    for m in tables.iter().flat_map(|t| &t.methods) {
-        let mut row = vec![
-            m.protocol.to_string(),
-            m.method.clone(),
-            m.computed_under.to_string(),
-            m.train_seeds.len().to_string(),
-            seeds_cell(&m.train_seeds),
-            m.train_episodes.map(|e| e.to_string()).unwrap_or_default(),
-            m.episodes.to_string(),
-            m.seed.to_string(),
-            train_map.to_string(),
-            test_map.to_string(),
-        ];
-        for (name, _) in METRICS {
-            let s = m.stat(name);
-            row.extend([
-                num(s.mean, 4),
-                opt(s.ci95_low, 4),
-                opt(s.ci95_high, 4),
-                num(s.min, 4),
-                num(s.max, 4),
-            ]);
-        }
-        row.extend([
-            m.worst_seed.train_seed.map(|s| s.to_string()).unwrap_or_default(),
-            num(m.worst_seed.success_rate, 4),
-            num(m.worst_seed.test_reward, 4),
-        ]);
-        csv.row(row);
-    }
-    csv
-}
-
-/// `compare_seeds.csv`: one row per (protocol, method, training seed).
-fn seeds_csv(tables: &[ProtocolTable], (train_map, test_map): (&str, &str)) -> Csv {
-    let mut header = vec![
-        "protocol",
-        "method",
-        "computed_under",
-        "train_seed",
-        "train_map",
-        "test_map",
-    ];
-    header.extend(METRICS.iter().map(|(name, _)| *name));
-    let mut csv = Csv::new(&header);
-    for m in tables.iter().flat_map(|t| &t.methods) {
-        for r in &m.per_seed {
-            let mut row = vec![
-                m.protocol.to_string(),
-                m.method.clone(),
-                m.computed_under.to_string(),
-                r.train_seed.map(|s| s.to_string()).unwrap_or_default(),
-                train_map.to_string(),
-                test_map.to_string(),
-            ];
-            row.extend(METRICS.iter().map(|(_, f)| num(f(r), 4)));
-            csv.row(row);
-        }
-    }
-    csv
-}
-
-/// `compare.svg`: one row of bar panels per protocol (train reward, test reward, success,
-/// inference rate), ours with 95% interval whiskers over agents beside the paper's.
-fn plot(path: &Path, tables: &[ProtocolTable]) -> anyhow::Result<()> {
-    type PaperOf = fn(&PaperFigures) -> f64;
-    let panels: [(&str, &str, PaperOf); 4] = [
-        ("train reward (training map)", "train_reward", |p| p.train_reward),
-        ("test reward (test map)", "test_reward", |p| p.test_reward),
-        ("success rate (test map)", "success_rate", |p| p.success_rate),
-        ("inference rate (test map)", "inference_rate", |p| p.inference_rate),
-    ];
-    let labels: Vec<Vec<String>> = tables
-        .iter()
-        .map(|t| t.methods.iter().map(|m| m.method.clone()).collect())
-        .collect();
-    let rows: Vec<BarRow<'_>> = tables
-        .iter()
-        .zip(&labels)
-        .map(|(t, labels)| {
-            let n = t.methods.first().map_or(0, |m| m.train_seeds.len());
-            BarRow {
-                title: format!("{} protocol: {}", t.protocol, t.protocol.meaning()),
-                key: bar_key(n, t.protocol == Protocol::ZeroShot),
-                panels: panels
-                    .iter()
-                    .map(|&(title, metric, paper)| BarPanel {
-                        title,
-                        labels,
-                        ours: t.methods.iter().map(|m| m.stat(metric).mean).collect(),
-                        interval: t
-                            .methods
-                            .iter()
-                            .map(|m| m.stat(metric).ci95_low.zip(m.stat(metric).ci95_high))
-                            .collect(),
-                        paper: t
-                            .methods
-                            .iter()
-                            .map(|m| {
-                                let p = m
-                                    .method
-                                    .parse::<Method>()
-                                    .ok()
-                                    .and_then(Method::paper)
-                                    .filter(|_| t.protocol == Protocol::ZeroShot);
-                                p.as_ref().map(paper)
-                            })
-                            .collect(),
-                    })
-                    .collect(),
-            }
-        })
-        .collect();
-    Ok(grouped_bars(path, &rows)?)
 }

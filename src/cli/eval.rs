@@ -5,13 +5,11 @@ use std::path::PathBuf;
 
 use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
-use unforeseen_harness::episodes::experiments::evaluate_map;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::maps;
 use unforeseen_harness::progress::Progress;
-use unforeseen_harness::reports::files::write_json;
-use unforeseen_harness::reports::tables;
+use unforeseen_harness::runs::batch::AgentChoice;
+use unforeseen_harness::runs::evaluate::{EVAL_FILE, EvalRequest, EvalScene};
 
 /// Arguments of `eval`.
 #[derive(Debug, Clone, Args)]
@@ -45,102 +43,53 @@ pub struct EvalArgs {
     pub agent: AgentArgs,
 }
 
-/// Runs `eval`.
-pub fn run(args: EvalArgs) -> anyhow::Result<()> {
-    if let Some(file) = &args.stream {
-        return run_stream(&args, file);
+impl EvalArgs {
+    /// The library's request of these arguments ([`EvalRequest`]).
+    pub fn request(&self) -> EvalRequest {
+        EvalRequest {
+            map: self.map.clone(),
+            stream: self.stream.clone(),
+            method: self.method,
+            episodes: self.episodes,
+            protocol: self.protocol,
+            sets: self.agent.set.clone(),
+            seed: self.agent.seed,
+            out: Some(self.out.clone()),
+            agent: self.agent.agent.clone(),
+        }
     }
-    args.agent
-        .check_out_dir(&args.out, &["eval.json"], &[&args.map], None)?;
-    let map = maps::load(&args.map)?;
-    let params = args.agent.params()?;
-    let bars = Bars::new(args.agent.quiet);
-    let label = format!("{} {}", args.method, map.name);
-    let evaluating = format!(
-        "evaluating {} on '{}' ({}, {} episodes)",
-        args.method, map.name, args.protocol, args.episodes
-    );
-    // The scripted references need no agent: they decode the map's own observations.
-    let bundle = if args.method.is_scripted() {
-        None
-    } else {
-        Some(args.agent.bundle()?)
-    };
-    progress::phase(args.agent.quiet, &evaluating);
-    bars.phase(&label, args.episodes);
-    let report = evaluate_map(
-        &map,
-        args.method,
-        args.protocol,
-        bundle.as_ref(),
-        &params,
-        args.episodes,
-        args.agent.seed,
-        &bars,
-    )?;
-    bars.finish();
-    outln!("{}", tables::eval(&report));
-    let dir = &args.out;
-    warn_replacing(dir, &["eval.json"]);
-    progress::phase(
-        args.agent.quiet,
-        format_args!("writing {}", dir.join("eval.json").display()),
-    );
-    write_json(&dir.join("eval.json"), &report.document()?)?;
-    outln!("wrote {}/eval.json", dir.display());
-    Ok(())
 }
 
-/// `eval --stream FILE`: the episodes over the stream's maps, one row per map.
-fn run_stream(args: &EvalArgs, file: &std::path::Path) -> anyhow::Result<()> {
-    use unforeseen_harness::runs::stream::{Stream, StreamEvalReport, evaluate_stream};
-    let stream = Stream::load(file)?;
-    let inputs = unforeseen_harness::runs::outputs::Outputs::new().stream("--stream", file, &stream);
-    args.agent.check_out_dir(&args.out, &["eval.json"], &[], Some(inputs))?;
-    let params = args.agent.params()?;
-    let bundle = if args.method.is_scripted() {
-        None
-    } else {
-        Some(args.agent.bundle()?)
-    };
-    let bars = Bars::new(args.agent.quiet);
-    progress::phase(
-        args.agent.quiet,
-        format_args!(
-            "evaluating {} on stream '{}' ({} maps, {}, {} episodes)",
-            args.method,
+/// Runs `eval`: the request of the arguments, planned, its agent trained or loaded and
+/// the episodes run by the library ([`EvalRequest::plan`]), then the line printed and
+/// eval.json written.
+pub fn run(args: EvalArgs) -> anyhow::Result<()> {
+    let quiet = args.agent.quiet;
+    let creates = super::outputs::to_create(&args.out);
+    let job = args.request().plan(None)?;
+    super::outputs::creating("--out", creates);
+    if let AgentChoice::Trained { map, config, .. } = &job.agent {
+        progress::training(quiet, false, 1, config.episodes, &map.name, args.agent.seed);
+    }
+    let bundle = job.agent(&Bars::counting(quiet, "episodes"))?;
+    let (m, p, n) = (args.method, args.protocol, args.episodes);
+    let what = match &job.scene {
+        EvalScene::Map(map) => format!("evaluating {m} on '{}' ({p}, {n} episodes)", map.name),
+        EvalScene::Stream(stream, _) => format!(
+            "evaluating {m} on stream '{}' ({} maps, {p}, {n} episodes)",
             stream.name,
-            stream.maps.len(),
-            args.protocol,
-            args.episodes
+            stream.maps.len()
         ),
-    );
-    bars.phase(&format!("{} {}", args.method, stream.name), args.episodes);
-    let episodes = evaluate_stream(
-        &stream,
-        bundle.as_ref(),
-        &params,
-        args.method,
-        args.protocol,
-        args.episodes,
-        args.agent.seed,
-        &bars,
-    )?;
+    };
+    progress::phase(quiet, &what);
+    let bars = Bars::new(quiet);
+    let outcome = job.run(bundle.as_ref(), &bars)?;
     bars.finish();
-    let report = StreamEvalReport::new(
-        &stream,
-        file,
-        args.method,
-        args.protocol,
-        &params,
-        args.agent.seed,
-        bundle.as_ref(),
-        episodes,
-    );
-    outln!("{}", tables::eval_stream(&report));
+    outln!("{}", outcome.table());
     let dir = &args.out;
-    warn_replacing(dir, &["eval.json"]);
-    write_json(&dir.join("eval.json"), &report.document()?)?;
-    outln!("wrote {}/eval.json", dir.display());
+    warn_replacing(dir, &[EVAL_FILE]);
+    progress::phase(quiet, format_args!("writing {}", dir.join(EVAL_FILE).display()));
+    job.write(&outcome)?;
+    outln!("wrote {}/{EVAL_FILE}", dir.display());
     Ok(())
 }

@@ -10,7 +10,18 @@ use unforeseen_harness::runs::outputs::{Outputs, Own, missing_folder};
 
 /// Says on stderr which folder a run writing into `dir` creates, if any.
 pub fn note_created(flag: &str, dir: &Path) {
-    if let Some(top) = missing_folder(dir) {
+    creating(flag, missing_folder(dir));
+}
+
+/// The folder a run writing into `dir` would create, found before the run's output guard
+/// creates it; [`creating`] says so once the guard has passed.
+pub fn to_create(dir: &Path) -> Option<std::path::PathBuf> {
+    missing_folder(dir)
+}
+
+/// Says on stderr that the run creates the folder `top` for `flag` (from [`to_create`]).
+pub fn creating(flag: &str, top: Option<std::path::PathBuf>) {
+    if let Some(top) = top {
         errln!(
             "note: {flag}: creating the folder {} (it does not exist yet)",
             top.display()

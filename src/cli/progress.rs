@@ -34,6 +34,25 @@ pub fn phase(quiet: bool, what: impl Display) {
     }
 }
 
+/// The phase line of a run that trains its agents first: `count` agents, one per training
+/// seed (`per_seed`; loaded from the agent cache where it has them), or the one agent
+/// trained with the run `seed`, for `episodes` episodes on the map named `map`.
+pub fn training(quiet: bool, per_seed: bool, count: usize, episodes: u64, map: &str, seed: u64) {
+    if per_seed {
+        phase(
+            quiet,
+            format_args!(
+                "training {count} agent(s) for {episodes} episodes on '{map}' (or loading them from the cache), one line each"
+            ),
+        );
+    } else {
+        phase(
+            quiet,
+            format_args!("training {episodes} episodes on '{map}' (seed {seed})"),
+        );
+    }
+}
+
 /// A progress bar over `len` items labelled `what`, counting `unit` (e.g. `episodes`;
 /// empty for none); hidden when stderr is not a terminal or when `quiet` is set (see
 /// [`phase`] for what is printed then).

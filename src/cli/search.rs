@@ -9,7 +9,6 @@ use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::runs::batch::Shard;
-use unforeseen_harness::runs::outputs::missing_folder;
 use unforeseen_harness::runs::search::{self, SearchRequest, Summary};
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
@@ -111,30 +110,16 @@ impl SearchArgs {
 /// search run by the library ([`SearchRequest::plan`]).
 pub fn run(args: SearchArgs) -> anyhow::Result<()> {
     let quiet = args.quiet;
-    let creates = missing_folder(&args.out);
+    let creates = super::outputs::to_create(&args.out);
     // Every output checked, the folder created and locked, before any work.
     let job = args.request().plan(None)?;
-    if let Some(top) = creates {
-        errln!(
-            "note: --out: creating the folder {} (it does not exist yet)",
-            top.display()
-        );
-    }
+    super::outputs::creating("--out", creates);
     let setup = &job.setup;
     let to_train = setup.to_train();
     if !to_train.is_empty() {
-        let what = match &args.seeds.train_seeds {
-            Some(_) => format!(
-                "training {} agent(s) for {} episodes on '{DEFAULT_TRAIN_MAP}' (or loading them from the cache), one line each",
-                to_train.len(),
-                args.train_episodes
-            ),
-            None => format!(
-                "training {} episodes on '{DEFAULT_TRAIN_MAP}' (seed {})",
-                args.train_episodes, args.seed
-            ),
-        };
-        progress::phase(quiet, what);
+        let per_seed = args.seeds.train_seeds.is_some();
+        let episodes = args.train_episodes;
+        progress::training(quiet, per_seed, to_train.len(), episodes, DEFAULT_TRAIN_MAP, args.seed);
     }
     let agents = setup.agents(&Bars::counting(quiet, "episodes"))?;
     let command = std::iter::once("unforeseen".to_string())

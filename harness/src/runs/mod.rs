@@ -1,4 +1,5 @@
-//! What runs many episodes: scenario suites and sweeps ([`batch`]), deployment streams
+//! What runs many episodes: one method's evaluation on a map or a stream ([`evaluate`]),
+//! scenario suites and sweeps ([`batch`]), deployment streams
 //! ([`stream`]), the paper's comparison over agents and protocols ([`compare`]), the
 //! merge of shard files ([`merge`]) and the search for fair failing scenarios
 //! ([`search`]); the guard all of them pass before any work ([`outputs`]: no output
@@ -7,6 +8,7 @@
 
 pub mod batch;
 pub mod compare;
+pub mod evaluate;
 pub mod merge;
 pub mod outputs;
 pub mod request;

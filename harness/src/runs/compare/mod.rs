@@ -1,7 +1,14 @@
 //! Comparison studies: the paper's table (Fig. 8, zero-shot) and its continual
 //! counterpart (Fig. 9 setting), every method with every trained agent (training seed)
 //! under every protocol asked, summarized over agents as a mean with a 95% interval,
-//! the range and the worst seed. The per-agent rows are kept.
+//! the range and the worst seed. The per-agent rows are kept. A study is asked for by
+//! one [`CompareRequest`] ([`request`]) from every front, and writes its files
+//! ([`files`]).
+
+pub mod files;
+pub mod request;
+
+pub use request::{COMPARE_FILES, CompareJob, CompareRequest};
 
 use rayon::prelude::*;
 use serde::Serialize;
