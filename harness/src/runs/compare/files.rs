@@ -12,8 +12,10 @@ use crate::reports::figures::{BarPanel, BarRow, bar_key, grouped_bars};
 use crate::reports::files::{Csv, all_or_none, num, write_json};
 use crate::reports::tables::seed_text;
 
-use super::request::COMPARE_FILES;
 use super::{CompareReport, METRICS, ProtocolTable};
+
+/// The files a study writes into its folder, in order.
+pub const COMPARE_FILES: [&str; 4] = ["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"];
 
 /// Writes the report's four files into `dir` ([`COMPARE_FILES`]), all or none: a failed
 /// write (a full disk) leaves the previous run's set. The paths written, in order.

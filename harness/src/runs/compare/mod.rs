@@ -8,7 +8,8 @@
 pub mod files;
 pub mod request;
 
-pub use request::{COMPARE_FILES, CompareJob, CompareRequest};
+pub use files::COMPARE_FILES;
+pub use request::{CompareJob, CompareRequest};
 
 use rayon::prelude::*;
 use serde::Serialize;

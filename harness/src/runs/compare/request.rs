@@ -21,10 +21,8 @@ use crate::runs::outputs::{Outputs, Own};
 use crate::training::seed_agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
 use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs};
 
+use super::files::COMPARE_FILES;
 use super::{CompareReport, StudySetup, run_study};
-
-/// The files a study writes into its folder, in order.
-pub const COMPARE_FILES: [&str; 4] = ["compare.json", "compare.csv", "compare_seeds.csv", "compare.svg"];
 
 /// Every choice of a comparison study, with its defaults ([`CompareRequest::default`]:
 /// the paper's table, as `unforeseen` with no command runs it).
