@@ -304,8 +304,9 @@ impl EvalResult {
 }
 
 report_class!(
-    /// `batch`'s report: the results file's lines (`lines`) and the summary over
-    /// training seeds (`summary`), printed as the command line's summary table. Rows: one
+    /// `batch`'s report: the results file's lines (`lines`), the summary over training
+    /// seeds (`summary`) and the expectations checked and failed on its mean (`checked`,
+    /// `failures`), printed as the command line's summary table. Rows: one
     /// per summary row.
     BatchResult,
     "BatchResult",
@@ -321,6 +322,19 @@ report_class!(
         fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
             self.report.item(py, "summary")
         }
+
+        /// The expectations checked on the mean over training seeds.
+        #[getter]
+        fn checked<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+            self.report.item(py, "checked")
+        }
+
+        /// One message per expectation failed on the mean over training seeds, in
+        /// `unforeseen batch`'s words (the command exits 1 on any).
+        #[getter]
+        fn failures<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+            self.report.item(py, "failures")
+        }
     }
 );
 
@@ -332,6 +346,9 @@ impl BatchResult {
         let mut data = Map::new();
         data.insert("lines".into(), serde_json::to_value(lines).map_err(errors::to_py)?);
         data.insert("summary".into(), rows.clone());
+        let checked: usize = summary.iter().map(|r| r.checks.len()).sum();
+        data.insert("checked".into(), checked.into());
+        data.insert("failures".into(), tables::expectation_failures(&summary).into());
         let data = Value::Object(data);
         Ok(BatchResult {
             report: Report {

@@ -22,7 +22,6 @@ use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::progress::NoProgress;
-use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::batch::{
     AgentChoice, BatchConfig, BatchRequest, RunIdentity, Scenario, checked_sweep, run_unit,
 };
@@ -31,6 +30,7 @@ use unforeseen_harness::training::{TimeoutAs, TrainConfig};
 
 use crate::agent::PyAgent;
 use crate::errors;
+use crate::reports::BatchResult;
 
 pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
     unforeseen_harness::limits::check_episodes(what, n).map_err(errors::to_py)?;
@@ -296,31 +296,18 @@ fn run_units(
 /// Joins the results file `out` a driver wrote (the plan's `head`, then the new lines in
 /// the order they finished) into the file one machine writes: every unit once, in
 /// canonical order, and its summary beside it, both atomically ([`unforeseen_harness::runs::merge`]).
-/// Returns JSON text: `lines` (the result lines), `summary` (its path), `checked`,
-/// `failed`, `failures` (one message per expectation failed on the mean over seeds) and
-/// `table` (the summary table `unforeseen batch` prints), both as the command line has them
-/// ([`unforeseen_harness::reports::tables`]).
+/// Returns the report `unforeseen.batch` returns ([`BatchResult`]) of its lines.
 #[pyfunction]
-fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<String> {
+fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<BatchResult> {
     let parts = [out.clone()];
-    let report = py
+    let merged = py
         .detach(|| {
             let merged = unforeseen_harness::runs::merge::merge(&parts)?;
-            let report = unforeseen_harness::runs::merge::write_merged(&merged, &out)?;
-            Ok::<_, unforeseen_harness::error::Error>((merged, report))
+            unforeseen_harness::runs::merge::write_merged(&merged, &out)?;
+            Ok::<_, unforeseen_harness::error::Error>(merged)
         })
         .map_err(errors::to_py)?;
-    let (merged, report) = report;
-    let failures = tables::expectation_failures(&report.rows);
-    serde_json::to_string(&json!({
-        "lines": merged.results(),
-        "summary": report.summary.display().to_string(),
-        "checked": report.checked,
-        "failed": report.failed,
-        "failures": failures,
-        "table": tables::batch_summary(&report.rows).to_string(),
-    }))
-    .map_err(errors::to_py)
+    BatchResult::new(&merged.results())
 }
 
 /// Registers the functions.

@@ -27,15 +27,9 @@ MAPS = [str(REPO / "maps" / "jaywalk.ron"), str(REPO / "maps" / "stop_midway.ron
 METHODS = ["scaled", "q-learning", "brake-on-pedestrian"]
 
 
-def _cli(*args: str) -> None:
+def _cli(*args: str) -> str:
     cli = required_cli()
-    subprocess.run([str(cli), *args], check=True, capture_output=True, timeout=300)
-
-
-def _untimed(lines: list[dict]) -> list[dict]:
-    for line in lines:
-        line.pop("timing_us_per_tick", None)
-    return lines
+    return subprocess.run([str(cli), *args], check=True, capture_output=True, text=True, timeout=300).stdout
 
 
 def _file_lines(path: Path) -> list[dict]:
@@ -72,8 +66,27 @@ def test_one_batch_request_gives_the_same_file_through_every_front(agent_file: P
     from unforeseen.distributed import run_batch
 
     ray_out = tmp_path / "ray.jsonl"
-    run_batch(MAPS, out=ray_out, quiet=True, **request)
+    on_ray = run_batch(MAPS, out=ray_out, quiet=True, **request)
     assert _untimed_text(ray_out) == expected
+    # The same report from both: one batch API.
+    assert type(on_ray) is type(library)
+    assert _untimed(list(on_ray.lines)) == _untimed(list(library.lines))
+    assert on_ray.failures == library.failures and on_ray.checked == library.checked
+
+
+def test_the_ray_drivers_command_prints_what_batch_prints(agent_file: Path, tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch, capsys):
+    monkeypatch.setitem(sys.modules, "ray", _InlineRay())
+    from unforeseen import distributed
+
+    args = [*MAPS, "--agent", str(agent_file), "--method", "never-brake", "--episodes", "2", "--seed", "5"]
+    cli = _cli("batch", *args, "-q", "--out", str(tmp_path / "cli.jsonl"))
+    code = distributed.main(["batch", *args, "--quiet", "--out", str(tmp_path / "ray.jsonl")])
+    printed = capsys.readouterr().out
+    assert code == 0
+    # The table, then the line saying what was written (its paths differ).
+    assert printed.split("\nwrote ")[0] == cli.split("\nwrote ")[0]
+    assert "expectation(s) checked on the mean over training seeds, 0 failed" in printed
 
 
 def _request_parameters(function: Any, ray_only: set[str]) -> dict[str, Any]:

@@ -145,6 +145,6 @@ def test_the_ray_drivers_join_prints_the_batchs_table_and_failures(agent_file, t
     failed = [l.removeprefix("expectation failed: ") for l in run.stderr.splitlines()
               if l.startswith("expectation failed: ")]
     assert failed, "the small agent should fail an expectation here"
-    joined = json.loads(_unforeseen.finish_batch(str(out)))
-    assert joined["table"] == printed
-    assert joined["failures"] == failed
+    joined = _unforeseen.finish_batch(str(out))
+    assert str(joined) == printed
+    assert joined.failures == joined["failures"] == failed

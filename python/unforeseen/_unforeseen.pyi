@@ -336,6 +336,12 @@ class BatchResult:
     def lines(self) -> list[dict[str, Any]]:
         """The result lines, one per unit."""
     @property
+    def checked(self) -> int:
+        """The expectations checked on the mean over training seeds."""
+    @property
+    def failures(self) -> list[str]:
+        """One message per expectation failed on the mean over training seeds."""
+    @property
     def summary(self) -> list[dict[str, Any]]:
         """The summary's rows over training seeds."""
 
@@ -386,10 +392,9 @@ def train_agent(seed: int, episodes: int, train_map: str = "intersection", timeo
     """The agent of one training seed (agent-file text), trained on ``train_map`` with the GIL released."""
 def run_units(spec: str, agents: Sequence[tuple[int | None, bytes]], units: Sequence[int], threads: int = 1) -> list[str]:
     """The result lines (JSON text) of units of a planned run, with the GIL released."""
-def finish_batch(out: str) -> str:
-    """Rewrites a driver's results file in canonical order with its summary; JSON text of
-    ``lines``, ``summary`` (its path), ``checked``, ``failed``, ``failures`` and ``table``
-    (the summary table ``unforeseen batch`` prints)."""
+def finish_batch(out: str) -> BatchResult:
+    """Rewrites a driver's results file in canonical order with its summary; its report,
+    as :func:`unforeseen.batch` returns it."""
 def plan_search(request: str, agent: Agent | None = None) -> str:
     """The search request (JSON text of its fields) checked as ``unforeseen search`` checks
     it (arguments, base map, space file), before any task; JSON text of ``spec`` (the

@@ -257,7 +257,7 @@ def run_batch(
     address: str | None = "auto",
     max_retries: int = DEFAULT_MAX_RETRIES,
     quiet: bool = False,
-) -> dict[str, Any]:
+) -> _unforeseen.BatchResult:
     """``unforeseen batch`` on a Ray cluster (see the module's documentation): the
     arguments of :func:`unforeseen.batch` (the batch request, planned by the library as
     the command line plans it), and the same results file ``out`` and summary, timing
@@ -268,10 +268,11 @@ def run_batch(
     Ray's own: ``units_per_task`` (default: about 4 tasks per CPU), ``address`` (connects
     with ``ray.init(address)`` unless Ray is connected already), ``max_retries`` and
     ``quiet``. A bad argument raises ``ValueError`` naming it before any task runs.
-    Returns the finished file's ``lines`` (dicts), ``summary`` (its path), ``checked``,
-    ``failed``, ``failures`` (the expectations failed on the mean over training seeds,
-    in ``batch``'s words; the command exits 1 on any, as ``batch`` does) and ``table``
-    (the summary table ``batch`` prints, which the command prints too).
+    Returns the report :func:`unforeseen.batch` returns (a :class:`BatchResult`) of the
+    finished file: ``print(result)`` gives the summary table ``batch`` prints,
+    ``result.lines`` the file's lines, ``result.summary`` the summary's rows, and
+    ``result.failures`` the expectations failed on the mean over training seeds, in
+    ``batch``'s words (the command exits 1 on any, as ``batch`` does).
     """
     fields = {k: v for k, v in locals().items() if k in BATCH_DEFAULTS}
     if shard is not None:
@@ -323,7 +324,7 @@ def run_batch(
                 _drive(ray, blocks, submit, sink)
             finally:
                 progress.finish()
-        return json.loads(_unforeseen.finish_batch(str(out)))
+        return _unforeseen.finish_batch(str(out))
     finally:
         lock.close()
 
@@ -516,14 +517,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (RuntimeError, ConnectionError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
-    print(report["table"])
+    print(report)
+    summary = Path(args.out).with_suffix(".summary.json")
     print(
-        f"wrote {args.out} ({len(report['lines'])} lines) and {report['summary']}; "
-        f"{report['checked']} expectation(s) checked on the mean over training seeds, {report['failed']} failed"
+        f"wrote {args.out} ({len(report.lines)} lines) and {summary}; "
+        f"{report.checked} expectation(s) checked on the mean over training seeds, {len(report.failures)} failed"
     )
-    for f in report["failures"]:
+    for f in report.failures:
         print(f"expectation failed: {f}", file=sys.stderr)
-    return 1 if report["failed"] else 0
+    return 1 if report.failures else 0
 
 
 if __name__ == "__main__":

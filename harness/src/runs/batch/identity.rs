@@ -12,21 +12,27 @@ use crate::error::Error;
 use super::scenario::Scenario;
 use super::sweep::ParamSet;
 
-/// What determines agents trained on `train_map` for `episodes` episodes with each of
-/// `seeds` and the default training configuration, for a run's identity: their cache
-/// keys (training map contents, episodes, seed, training configuration, version and
-/// training code; [`crate::training::seed_agents::cache_key`]).
-pub fn trained_agents_identity(train_map: &Map, seeds: &[Option<u64>], episodes: u64) -> Result<String, Error> {
+/// What determines agents trained on `train_map` with `config` and each of `seeds` (the
+/// config's seed replaced by each), for a run's identity: their cache keys (training map
+/// contents, episodes, seed, training configuration such as what a time-out is to the
+/// learners, version and training code; [`crate::training::seed_agents::cache_key`]).
+pub fn trained_agents_identity(
+    train_map: &Map,
+    seeds: &[Option<u64>],
+    config: &crate::training::TrainConfig,
+) -> Result<String, Error> {
     let keys = seeds
         .iter()
         .flatten()
         .map(|&seed| {
-            crate::training::seed_agents::cache_key(train_map, &crate::training::TrainConfig::new(episodes, seed))
+            let config = crate::training::TrainConfig { seed, ..config.clone() };
+            crate::training::seed_agents::cache_key(train_map, &config)
         })
         .collect::<Result<Vec<_>, Error>>()?;
     Ok(format!(
-        "trained on {} for {episodes} episodes, agents {}",
+        "trained on {} for {} episodes, agents {}",
         train_map.name,
+        config.episodes,
         crate::seeds::content_hash(keys.join(",").as_bytes())
     ))
 }

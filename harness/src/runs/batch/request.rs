@@ -223,11 +223,11 @@ impl AgentFields<'_> {
         let trained = |seeds: Vec<u64>, cache: Option<PathBuf>| -> Result<_, Error> {
             let map = crate::maps::load(self.train_map)?;
             let axis: Vec<Option<u64>> = seeds.iter().map(|&s| Some(s)).collect();
-            let identity = trained_agents_identity(&map, &axis, self.train_episodes)?;
             let config = TrainConfig {
                 timeout_as: self.timeout_as,
                 ..TrainConfig::new(self.train_episodes, 0)
             };
+            let identity = trained_agents_identity(&map, &axis, &config)?;
             let choice = AgentChoice::Trained {
                 map: Box::new(map),
                 seeds,
@@ -553,6 +553,22 @@ mod tests {
         let r = BatchRequest::from_fields(fields(serde_json::json!({"train_seeds": [1, 2], "shard": "1/2"}))).unwrap();
         assert_eq!(r.train_seeds.map(|s| s.0), Some(vec![1, 2]));
         assert_eq!(r.shard, Some(Shard { index: 1, count: 2 }));
+    }
+
+    #[test]
+    fn what_a_time_out_is_to_the_learners_is_part_of_the_agents_identity() {
+        let identity = |timeout_as| {
+            BatchRequest {
+                train_seeds: Some(TrainSeeds(vec![1, 2])),
+                timeout_as,
+                ..BatchRequest::default()
+            }
+            .setup(None)
+            .unwrap()
+            .agents_identity
+        };
+        // Agents trained otherwise are other agents: a file of one run does not resume the other.
+        assert_ne!(identity(TimeoutAs::Truncation), identity(TimeoutAs::Termination));
     }
 
     #[test]
