@@ -123,12 +123,6 @@ impl EvalOutcome {
 }
 
 impl EvalRequest {
-    /// The request with `fields` set (a JSON object, such as Python's keyword
-    /// arguments), the others at their defaults; errors name the field.
-    pub fn from_fields(fields: serde_json::Map<String, serde_json::Value>) -> Result<Self, Error> {
-        crate::runs::request::from_fields(fields)
-    }
-
     /// Checks the request and resolves it before any work: the episodes, the map or
     /// stream, the overrides, the agent (`given`: an agent given loaded, such as
     /// Python's, instead of the file `agent`) and the output folder (eval.json not an
@@ -254,11 +248,12 @@ impl EvalJob {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::runs::request::from_fields;
 
     #[test]
     fn a_bad_field_is_named_by_the_request() {
         let fields = |v: serde_json::Value| v.as_object().cloned().unwrap();
-        let e = EvalRequest::from_fields(fields(serde_json::json!({"method": "swerve"}))).unwrap_err();
+        let e = from_fields::<EvalRequest>(fields(serde_json::json!({"method": "swerve"}))).unwrap_err();
         assert!(e.to_string().starts_with("method: "), "{e}");
         let e = EvalRequest {
             episodes: 0,

@@ -257,13 +257,6 @@ impl AgentFields<'_> {
 }
 
 impl BatchRequest {
-    /// The request with `fields` set (a JSON object of field names and values, such as
-    /// Python's keyword arguments) and the other fields at their defaults; an unknown
-    /// field or a bad value is an [`Error::Request`] naming the field.
-    pub fn from_fields(fields: serde_json::Map<String, serde_json::Value>) -> Result<Self, Error> {
-        crate::runs::request::from_fields(fields)
-    }
-
     /// Checks the request and resolves it: loads the scenarios (and the agent file),
     /// expands the sweep, chooses the agents and says what determines them. `given` is
     /// an agent given loaded instead of the file `agent` (Python's `Agent`). Writes
@@ -529,6 +522,7 @@ pub fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> V
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::runs::request::from_fields;
 
     #[test]
     fn jobs_are_bounded_by_the_memory_of_the_learners_copies() {
@@ -543,14 +537,15 @@ mod tests {
     #[test]
     fn a_bad_field_is_named_by_the_request() {
         let fields = |v: serde_json::Value| v.as_object().cloned().unwrap();
-        let e = BatchRequest::from_fields(fields(serde_json::json!({"train_seeds": "3..1"}))).unwrap_err();
+        let e = from_fields::<BatchRequest>(fields(serde_json::json!({"train_seeds": "3..1"}))).unwrap_err();
         assert!(e.to_string().starts_with("train_seeds: "), "{e}");
         assert!(e.is_user_input());
-        let e = BatchRequest::from_fields(fields(serde_json::json!({"protocol": "sometimes"}))).unwrap_err();
+        let e = from_fields::<BatchRequest>(fields(serde_json::json!({"protocol": "sometimes"}))).unwrap_err();
         assert!(e.to_string().starts_with("protocol: "), "{e}");
-        let e = BatchRequest::from_fields(fields(serde_json::json!({"episodez": 3}))).unwrap_err();
+        let e = from_fields::<BatchRequest>(fields(serde_json::json!({"episodez": 3}))).unwrap_err();
         assert!(e.to_string().starts_with("episodez: not a field"), "{e}");
-        let r = BatchRequest::from_fields(fields(serde_json::json!({"train_seeds": [1, 2], "shard": "1/2"}))).unwrap();
+        let r =
+            from_fields::<BatchRequest>(fields(serde_json::json!({"train_seeds": [1, 2], "shard": "1/2"}))).unwrap();
         assert_eq!(r.train_seeds.map(|s| s.0), Some(vec![1, 2]));
         assert_eq!(r.shard, Some(Shard { index: 1, count: 2 }));
     }

@@ -104,12 +104,6 @@ pub struct CompareJob {
 }
 
 impl CompareRequest {
-    /// The request with `fields` set (a JSON object, such as Python's keyword
-    /// arguments), the others at their defaults; errors name the field.
-    pub fn from_fields(fields: serde_json::Map<String, serde_json::Value>) -> Result<Self, Error> {
-        crate::runs::request::from_fields(fields)
-    }
-
     /// Checks the request and resolves it before any work: the episodes, the maps, the
     /// overrides, the agents (`given`: agents given loaded, such as Python's, instead of
     /// `agent` or `train_seeds`) and the output folder (none of its files an input).
@@ -214,6 +208,7 @@ impl CompareJob {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::runs::request::from_fields;
 
     fn fields(v: serde_json::Value) -> serde_json::Map<String, serde_json::Value> {
         v.as_object().cloned().unwrap()
@@ -221,9 +216,9 @@ mod tests {
 
     #[test]
     fn a_bad_field_is_named_by_the_request() {
-        let e = CompareRequest::from_fields(fields(serde_json::json!({"protocol": "twice"}))).unwrap_err();
+        let e = from_fields::<CompareRequest>(fields(serde_json::json!({"protocol": "twice"}))).unwrap_err();
         assert!(e.to_string().starts_with("protocol: "), "{e}");
-        let e = CompareRequest::from_fields(fields(serde_json::json!({"agents": 3}))).unwrap_err();
+        let e = from_fields::<CompareRequest>(fields(serde_json::json!({"agents": 3}))).unwrap_err();
         assert!(e.to_string().starts_with("agents: not a field"), "{e}");
         let e = CompareRequest {
             episodes: 0,

@@ -124,12 +124,6 @@ pub struct SearchSetup {
 }
 
 impl SearchRequest {
-    /// The request with `fields` set (a JSON object of field names and values) and the
-    /// other fields at their defaults; errors name the field.
-    pub fn from_fields(fields: serde_json::Map<String, serde_json::Value>) -> Result<Self, Error> {
-        crate::runs::request::from_fields(fields)
-    }
-
     /// Checks the request and resolves it: loads the base map, the space (and the agent
     /// file), checks the budget and the Sobol share, chooses the agents and says what
     /// determines them. `given` is an agent given loaded instead of the file `agent`.
@@ -257,13 +251,14 @@ impl SearchJob {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::runs::request::from_fields;
 
     #[test]
     fn a_bad_field_is_named_by_the_request() {
         let fields = |v: serde_json::Value| v.as_object().cloned().unwrap();
-        let e = SearchRequest::from_fields(fields(serde_json::json!({"protocol": "both"}))).unwrap_err();
+        let e = from_fields::<SearchRequest>(fields(serde_json::json!({"protocol": "both"}))).unwrap_err();
         assert!(e.to_string().starts_with("protocol: "), "{e}");
-        let e = SearchRequest::from_fields(fields(serde_json::json!({"budget": -1}))).unwrap_err();
+        let e = from_fields::<SearchRequest>(fields(serde_json::json!({"budget": -1}))).unwrap_err();
         assert!(e.to_string().starts_with("budget: "), "{e}");
         let e = SearchRequest::default().setup(None).unwrap_err();
         assert!(e.to_string().starts_with("space: "), "{e}");
