@@ -233,6 +233,31 @@ def _lock(out: Path) -> Any:
     return f
 
 
+def _task_request(job: str, fields: dict[str, Any], per_task_name: str, per_task: int | None, max_retries: int,
+                  shards_instead: str) -> tuple[int, _unforeseen.Agent | None]:
+    """The request of ``job`` as the driver takes it (``fields``, changed in place): the shard
+    refused (the cluster splits the run itself; ``shards_instead`` says how shards run
+    elsewhere end), the task options checked, and an agent given loaded taken out of the
+    fields. Returns the threads of each task and that agent."""
+    shard = fields.get("shard")
+    if shard is not None:
+        raise ValueError(
+            f"shard {shard}: the cluster splits the run itself; run it whole here, "
+            f"or run `unforeseen {job} --shard I/N` on separate machines and {shards_instead}"
+        )
+    jobs = fields.get("jobs")
+    threads = 1 if jobs is None else jobs
+    _check_task_options(threads, per_task_name, per_task, max_retries)
+    given = fields.pop("agent") if isinstance(fields.get("agent"), _unforeseen.Agent) else None
+    return threads, given
+
+
+def _connect(ray: Any, address: str | None) -> None:
+    """Connects to the cluster at ``address`` unless Ray is connected already."""
+    if not ray.is_initialized():
+        ray.init(address=address, include_dashboard=False, log_to_driver=False)
+
+
 def run_batch(
     maps: str | os.PathLike[str] | Sequence[str | os.PathLike[str]] = (),
     *,
@@ -275,22 +300,15 @@ def run_batch(
     ``batch``'s words (the command exits 1 on any, as ``batch`` does).
     """
     fields = {k: v for k, v in locals().items() if k in BATCH_DEFAULTS}
-    if shard is not None:
-        raise ValueError(
-            f"shard {shard}: the cluster splits the run itself; run it whole here, "
-            "or run `unforeseen batch --shard I/N` on separate machines and `unforeseen merge` the parts"
-        )
-    threads = 1 if jobs is None else jobs
-    _check_task_options(threads, "units_per_task", units_per_task, max_retries)
-    given = fields.pop("agent") if isinstance(agent, _unforeseen.Agent) else None
+    threads, given = _task_request("batch", fields, "units_per_task", units_per_task, max_retries,
+                                   "`unforeseen merge` the parts")
     out = Path(out)
     plan = json.loads(_unforeseen.plan_batch(request_json(fields), given))
     ray = _ray()
     lock = _lock(out)
     try:
         _write_atomic(out, plan["head"])
-        if not ray.is_initialized():
-            ray.init(address=address, include_dashboard=False, log_to_driver=False)
+        _connect(ray, address)
         options = _task_options(max_retries)
         # One agent per training seed the remaining units need, in the object store.
         if plan["agent"] is not None:
@@ -373,21 +391,14 @@ def run_search(
     fields = {k: v for k, v in locals().items() if k in SEARCH_DEFAULTS}
     if space is None:
         fields.pop("space")
-    if shard is not None:
-        raise ValueError(
-            f"shard {shard}: the cluster splits the run itself; run it whole here, "
-            "or run `unforeseen search --shard I/N` on separate machines and finish with --resume"
-        )
-    threads = 1 if jobs is None else jobs
-    _check_task_options(threads, "candidates_per_task", candidates_per_task, max_retries)
-    given = fields.pop("agent") if isinstance(agent, _unforeseen.Agent) else None
+    threads, given = _task_request("search", fields, "candidates_per_task", candidates_per_task, max_retries,
+                                   "finish with --resume")
     # The request, maps and space checked before any task runs.
     plan = json.loads(_unforeseen.plan_search(request_json(fields), given))
     spec = plan["spec"]
     from_file = plan["agent"] is not None
     ray = _ray()
-    if not ray.is_initialized():
-        ray.init(address=address, include_dashboard=False, log_to_driver=False)
+    _connect(ray, address)
     options = _task_options(max_retries)
     pairs: list[tuple[int | None, Any]]
     if from_file:
