@@ -3,7 +3,7 @@
 
 use crate::load::{Diagnostic, MapError};
 use crate::map::Map;
-pub use crate::shipped::{
+pub use crate::map_texts::{
     FAR_APPEARANCE, INTERSECTION, JAYWALK, JAYWALK_LATE, LATE_FAST, LONG_PAUSE, NEAR_KERB, SLOW_WALKER, STOP_MIDWAY,
     STUCK_GREEN, TWO_PEDESTRIANS, names, source,
 };

@@ -31,7 +31,7 @@ pub mod embedded;
 pub mod light;
 mod load;
 pub mod map;
-mod shipped;
+mod map_texts;
 mod validate;
 pub mod world;
 

@@ -151,7 +151,7 @@ impl Map {
                 }
             }
             let name = base.strip_suffix(".ron").unwrap_or(base);
-            crate::shipped::source(name).map(|text| {
+            crate::map_texts::source(name).map(|text| {
                 let origin = format!("{EMBEDDED_PREFIX}{name}");
                 Resolved {
                     text: check_text(&origin, text).map(|()| text.to_string()),
@@ -410,7 +410,7 @@ fn build(origin: &str, src: &str, resolve: &Resolver, chain: &mut Vec<String>) -
                     format!("base map {base_name:?} not found"),
                     Some(format!(
                         "a base is a file name relative to this map's folder, e.g. \"intersection.ron\", or an embedded map ({})",
-                        crate::shipped::names().join(", ")
+                        crate::map_texts::names().join(", ")
                     )),
                 )));
             };
@@ -675,8 +675,8 @@ mod doc_tests {
 
     #[test]
     fn summary_mentions_the_essentials() {
-        let shipped = |base: &str| crate::shipped::source(base).map(|s| (base.to_string(), s.to_string()));
-        let m = Map::from_str_named("jaywalk.ron", crate::shipped::JAYWALK, &shipped).unwrap();
+        let shipped = |base: &str| crate::map_texts::source(base).map(|s| (base.to_string(), s.to_string()));
+        let m = Map::from_str_named("jaywalk.ron", crate::map_texts::JAYWALK, &shipped).unwrap();
         let s = m.summary();
         for needle in [
             "map jaywalk",
