@@ -1,6 +1,7 @@
 //! Requests read field by field: a job's request ([`batch::BatchRequest`](super::batch::BatchRequest),
-//! [`search::SearchRequest`](super::search::SearchRequest)) from a JSON object, such as
-//! Python's keyword arguments, with each field's error naming that field.
+//! [`search::SearchRequest`](super::search::SearchRequest), and every other job's
+//! `from_fields`: evaluate, compare, learn, trace) from a JSON object, such as Python's
+//! keyword arguments, with each field's error naming that field.
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
