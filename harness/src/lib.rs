@@ -28,11 +28,14 @@
 //! * [`runs`]: what runs many episodes — [`batch`](runs::batch) (scenario suites and
 //!   sweeps, in parallel and in shards), deployment [`stream`](runs::stream)s, the
 //!   [`compare`](runs::compare) study (the paper's table over agents and protocols),
+//!   test-time [`learn`](runs::learn)ing curves, an episode's [`trace`](runs::trace),
 //!   [`merge`](runs::merge) of shard files and the [`search`](runs::search) for fair
-//!   failing scenarios; a batch and a search are each asked for by one typed request
-//!   ([`BatchRequest`](runs::batch::BatchRequest), [`SearchRequest`](runs::search::SearchRequest)),
-//!   the same value from every front, whose planning owns defaults, checks, agents and
-//!   identity;
+//!   failing scenarios; each job is asked for by one typed request
+//!   ([`EvalRequest`](runs::evaluate::EvalRequest), [`CompareRequest`](runs::compare::CompareRequest),
+//!   [`BatchRequest`](runs::batch::BatchRequest), [`SearchRequest`](runs::search::SearchRequest),
+//!   [`LearnRequest`](runs::learn::LearnRequest), [`TraceRequest`](runs::trace::TraceRequest)),
+//!   the same value from every front, whose planning owns defaults, checks, agents, the
+//!   output guard and identity, and whose job writes its files;
 //! * [`external`]: methods given from outside the library (a Python policy), evaluated
 //!   by the same runner and reported as the batch's result lines;
 //! * [`reports`]: result [`files`](reports::files) written atomically, SVG

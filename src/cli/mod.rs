@@ -186,7 +186,7 @@ pub fn error_message(err: &anyhow::Error) -> String {
 
 /// The fields of a request that the output guard names (inputs and outputs), longest
 /// first.
-const GUARDED_FIELDS: [&str; 6] = ["stream", "agent", "space", "maps", "map", "out"];
+const GUARDED_FIELDS: [&str; 7] = ["stream", "agent", "space", "maps", "html", "map", "out"];
 
 /// A message of the output guard with the fields it names (at its start, in "given as
 /// FIELD" and in "give FIELD ...") spelt as their flags.
@@ -254,14 +254,21 @@ pub struct AgentArgs {
 }
 
 impl AgentArgs {
-    /// Loads the agent file, or trains one on the embedded training map.
+    /// Loads the agent file, or trains one on the embedded training map
+    /// (`intersection`) for the default episodes with `--seed` (`export-model`; the other
+    /// commands choose their agent in the library's request).
     pub fn bundle(&self) -> anyhow::Result<AgentBundle> {
-        self.bundle_trained_on(DEFAULT_TRAIN_MAP, unforeseen_harness::training::DEFAULT_TRAIN_EPISODES)
-    }
-
-    /// Loads the agent file, or trains one on `map` (file or embedded name).
-    pub fn bundle_trained_on(&self, map: &str, episodes: u64) -> anyhow::Result<AgentBundle> {
-        load_or_train(self.agent.as_deref(), map, episodes, self.seed, self.quiet)
+        if let Some(path) = &self.agent {
+            return Ok(unforeseen_harness::training::agent_file::load(path)?);
+        }
+        let (seed, episodes) = (self.seed, unforeseen_harness::training::DEFAULT_TRAIN_EPISODES);
+        let map = unforeseen_harness::maps::load(DEFAULT_TRAIN_MAP)?;
+        progress::training(self.quiet, false, 1, episodes, &map.name, seed);
+        let bars = progress::Bars::new(self.quiet);
+        bars.phase("training", episodes);
+        let trained = train_with_progress(&map, &TrainConfig::new(episodes, seed), &bars);
+        bars.finish();
+        Ok(trained?.0)
     }
 
     /// The input files among these options (`--agent`), for the output guard.
@@ -271,25 +278,6 @@ impl AgentArgs {
             Some(p) => guard.input("--agent", p),
             None => guard,
         }
-    }
-
-    /// Checks the output folder `dir` (`--out`) and the files `names` in it before any
-    /// work: none of them is an input (`--agent`, the map files `maps`, or the inputs
-    /// already in `extra`, e.g. a stream and its maps).
-    pub fn check_out_dir(
-        &self,
-        dir: &std::path::Path,
-        names: &[&str],
-        maps: &[&str],
-        extra: Option<unforeseen_harness::runs::outputs::Outputs>,
-    ) -> anyhow::Result<()> {
-        let guard = maps.iter().fold(extra.unwrap_or_default(), |g, m| g.input("--map", m));
-        let guard = match &self.agent {
-            Some(p) => guard.input("--agent", p),
-            None => guard,
-        };
-        outputs::dir("--out", dir, names, guard)?;
-        Ok(())
     }
 
     /// The scaled agent's parameters with the `--set` overrides applied.
@@ -341,33 +329,6 @@ pub fn episodes(s: &str) -> Result<u64, String> {
             "at most {MAX_EPISODES} per run (split larger runs with --shard or several --seed values)"
         )),
         Err(_) => Err(format!("'{s}' is not a whole number of episodes")),
-    }
-}
-
-/// Loads the agent file `agent`, or trains one for `episodes` episodes with `seed` on `map`
-/// (a file or embedded name).
-pub fn load_or_train(
-    agent: Option<&std::path::Path>,
-    map: &str,
-    episodes: u64,
-    seed: u64,
-    quiet: bool,
-) -> anyhow::Result<AgentBundle> {
-    match agent {
-        Some(path) => Ok(unforeseen_harness::training::agent_file::load(path)?),
-        None => {
-            let map = unforeseen_harness::maps::load(map)?;
-            progress::phase(
-                quiet,
-                format_args!("training {episodes} episodes on '{}' (seed {seed})", map.name),
-            );
-            let cfg = TrainConfig::new(episodes, seed);
-            let bars = progress::Bars::new(quiet);
-            bars.phase("training", episodes);
-            let trained = train_with_progress(&map, &cfg, &bars);
-            bars.finish();
-            Ok(trained?.0)
-        }
     }
 }
 

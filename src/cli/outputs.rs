@@ -37,15 +37,3 @@ pub fn file(out_flag: &str, out: &Path, guard: Outputs) -> Result<(), Error> {
     note_created(out_flag, out.parent().unwrap_or(Path::new("")));
     Ok(())
 }
-
-/// Checks the output folder `dir` and the files `names` in it before any work: a folder
-/// or not there yet, that can hold files, none of the files one of the inputs `guard`
-/// holds.
-pub fn dir(flag: &str, dir: &Path, names: &[&str], guard: Outputs) -> Result<(), Error> {
-    let guard = names
-        .iter()
-        .fold(guard.place(flag, dir), |g, n| g.file(flag, dir.join(n), Own::Any));
-    guard.check(true)?;
-    note_created(flag, dir);
-    Ok(())
-}

@@ -1,16 +1,17 @@
-//! `unforeseen trace`: one episode step by step (paper Figs. 6-7).
+//! `unforeseen trace`: one episode step by step (paper Figs. 6-7): the arguments mapped
+//! to the library's request ([`TraceRequest`]), which plans, runs and writes; the table
+//! printed here.
 
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
-use unforeseen_harness::episodes::experiments::trace;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::maps;
-use unforeseen_harness::reports::figures::{filmstrip, theta_trace};
-use unforeseen_harness::reports::files::{Csv, num, write_atomic};
-use unforeseen_harness::reports::replay_page::replay_html;
+use unforeseen_harness::reports::files::num;
+use unforeseen_harness::runs::batch::AgentChoice;
+use unforeseen_harness::runs::trace::{TRACE_FILES, TraceReport, TraceRequest, mode, surprise_bits};
 
 /// Arguments of `trace`.
 #[derive(Debug, Clone, Args)]
@@ -43,43 +44,66 @@ pub struct TraceArgs {
     pub agent: AgentArgs,
 }
 
-fn mode(reasoned: bool) -> &'static str {
-    if reasoned { "reasoning" } else { "feed-forward" }
+impl TraceArgs {
+    /// The library's request of these arguments ([`TraceRequest`]).
+    pub fn request(&self) -> TraceRequest {
+        TraceRequest {
+            map: self.map.clone(),
+            method: self.method,
+            episode: self.episode,
+            protocol: self.protocol,
+            sets: self.agent.set.clone(),
+            seed: self.agent.seed,
+            out: Some(self.out.clone()),
+            html: self.html.clone(),
+            agent: self.agent.agent.clone(),
+        }
+    }
 }
 
-/// Runs `trace`.
+/// Runs `trace`: the request of the arguments, planned, its agent trained or loaded and
+/// the episode run by the library ([`TraceRequest::plan`]), then the table printed and
+/// the files written.
 pub fn run(args: TraceArgs) -> anyhow::Result<()> {
-    if let Some(html) = &args.html {
-        super::outputs::file("--html", html, args.agent.inputs().input("--map", &args.map))?;
+    let quiet = args.agent.quiet;
+    let creates_html = args
+        .html
+        .as_deref()
+        .and_then(|html| super::outputs::to_create(html.parent().unwrap_or(Path::new(""))));
+    let creates = super::outputs::to_create(&args.out);
+    let job = args.request().plan(None)?;
+    super::outputs::creating("--html", creates_html);
+    super::outputs::creating("--out", creates);
+    if let AgentChoice::Trained { map, config, .. } = &job.agent {
+        progress::training(quiet, false, 1, config.episodes, &map.name, args.agent.seed);
     }
-    args.agent.check_out_dir(
-        &args.out,
-        &["trace.csv", "theta.svg", "filmstrip.svg"],
-        &[&args.map],
-        None,
-    )?;
-    let map = maps::load(&args.map)?;
-    let params = args.agent.params()?;
-    let bundle = args.agent.bundle()?;
-    let (result, ticks) = trace(
-        &bundle,
-        &params,
-        args.method,
-        &map,
-        args.agent.seed,
-        args.protocol,
-        args.episode,
-    )?;
-    let bits = |x: Option<f64>| x.map(|s| s / std::f64::consts::LN_2);
-    let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
+    let bundle = job.agent(&Bars::counting(quiet, "episodes"))?;
+    let report = job.run(&bundle)?;
     outln!(
         "{} on '{}', seed {}, episode {} ({})",
         args.method,
-        map.name,
+        job.map.name,
         args.agent.seed,
         args.episode,
         args.protocol
     );
+    print_ticks(&report);
+    outln!("{}", report.summary());
+    let dir = &args.out;
+    warn_replacing(dir, &TRACE_FILES);
+    progress::phase(quiet, format_args!("writing {}", dir.display()));
+    job.write(&report)?;
+    outln!("wrote {}/{}", dir.display(), TRACE_FILES.join(", "));
+    if let Some(html) = &args.html {
+        outln!("wrote {} (open it in a browser)", html.display());
+    }
+    Ok(())
+}
+
+/// The decision ticks as a table: the state, the action and how it was chosen, the
+/// surprise and theta, the reward, the policy and psi.
+fn print_ticks(report: &TraceReport) {
+    let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
     let dist = |x: &[f64]| x.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join("/");
     outln!(
         "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}  {:<14} {:<14}",
@@ -96,25 +120,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         "policy",
         "psi"
     );
-    let mut csv = Csv::new(&[
-        "step",
-        "d",
-        "v",
-        "L",
-        "p",
-        "action",
-        "mode",
-        "surprise_bits",
-        "theta",
-        "reward",
-        "policy",
-        "psi",
-        "car_x",
-        "car_speed",
-        "light",
-    ]);
-    let decided = &ticks[..ticks.len().saturating_sub(1)];
-    for t in decided {
+    for t in report.decided() {
         let s = t.state;
         outln!(
             "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8.2}  {:<14} {:<14}",
@@ -125,79 +131,11 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
             s.p,
             t.action.to_string(),
             mode(t.reasoned),
-            opt(bits(t.surprise), 3),
+            opt(surprise_bits(t), 3),
             opt(t.theta, 3),
             t.reward,
             dist(&t.policy),
             t.psi.as_deref().map(dist).unwrap_or_else(|| "-".into()),
         );
-        csv.row(vec![
-            t.step.to_string(),
-            s.d.to_string(),
-            s.v.to_string(),
-            s.l.to_string(),
-            s.p.to_string(),
-            t.action.to_string(),
-            mode(t.reasoned).into(),
-            opt(bits(t.surprise), 6),
-            opt(t.theta, 6),
-            num(t.reward, 4),
-            t.policy.iter().map(|p| num(*p, 6)).collect::<Vec<_>>().join(" "),
-            t.psi
-                .as_deref()
-                .map(|x| x.iter().map(|p| num(*p, 6)).collect::<Vec<_>>().join(" "))
-                .unwrap_or_default(),
-            num(t.snapshot.car_x, 3),
-            num(t.snapshot.car_speed, 3),
-            format!("{:?}", t.snapshot.light),
-        ]);
     }
-    let outcome = if result.success {
-        "reached the destination"
-    } else if result.collision {
-        "hit a pedestrian"
-    } else {
-        "ran out of time"
-    };
-    outln!(
-        "{outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
-        result.ticks,
-        result.ret,
-        result.reasoning_ticks
-    );
-    let dir = &args.out;
-    warn_replacing(dir, &["trace.csv", "theta.svg", "filmstrip.svg"]);
-    super::progress::phase(args.agent.quiet, format_args!("writing {}", dir.display()));
-    csv.write(&dir.join("trace.csv"))?;
-    let points: Vec<_> = decided
-        .iter()
-        .map(|t| (t.step, t.theta, t.reasoned, t.action.to_string()))
-        .collect();
-    theta_trace(
-        &dir.join("theta.svg"),
-        &format!("{} on {}: normalized surprise", args.method, map.name),
-        &points,
-        params.gate.epsilon,
-    )?;
-    filmstrip(
-        &dir.join("filmstrip.svg"),
-        &format!(
-            "{} on {}, seed {}: {outcome} after {} ticks (from above, one strip per decision tick)",
-            args.method, map.name, args.agent.seed, result.ticks
-        ),
-        &map,
-        &ticks,
-    )?;
-    outln!("wrote {}/trace.csv, theta.svg, filmstrip.svg", dir.display());
-    if let Some(html) = &args.html {
-        let title = format!("{} on {}, seed {}", args.method, map.name, args.agent.seed);
-        let outcome = format!(
-            "{} {outcome} after {} ticks, return {:.2}, reasoned on {} ticks",
-            args.method, result.ticks, result.ret, result.reasoning_ticks
-        );
-        let page = replay_html(&title, &outcome, &map, &ticks, params.gate.epsilon)?;
-        write_atomic(html, page.as_bytes())?;
-        outln!("wrote {} (open it in a browser)", html.display());
-    }
-    Ok(())
 }

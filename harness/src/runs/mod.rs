@@ -1,16 +1,23 @@
 //! What runs many episodes: one method's evaluation on a map or a stream ([`evaluate`]),
 //! scenario suites and sweeps ([`batch`]), deployment streams
-//! ([`stream`]), the paper's comparison over agents and protocols ([`compare`]), the
+//! ([`stream`]), the paper's comparison over agents and protocols ([`compare`]),
+//! test-time learning curves ([`learn`]), one episode step by step ([`trace`]), the
 //! merge of shard files ([`merge`]) and the search for fair failing scenarios
 //! ([`search`]); the guard all of them pass before any work ([`outputs`]: no output
 //! replaces an input or another program's file, one writer at a time). Jobs are asked
-//! for by typed requests, read field by field from other fronts by [`request`].
+//! for by typed requests ([`EvalRequest`](evaluate::EvalRequest),
+//! [`CompareRequest`](compare::CompareRequest), [`BatchRequest`](batch::BatchRequest),
+//! [`SearchRequest`](search::SearchRequest), [`LearnRequest`](learn::LearnRequest),
+//! [`TraceRequest`](trace::TraceRequest)), read field by field from other fronts by
+//! [`request`].
 
 pub mod batch;
 pub mod compare;
 pub mod evaluate;
+pub mod learn;
 pub mod merge;
 pub mod outputs;
 pub mod request;
 pub mod search;
 pub mod stream;
+pub mod trace;

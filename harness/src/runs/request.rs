@@ -1,6 +1,7 @@
 //! Requests read field by field: a job's request ([`EvalRequest`](super::evaluate::EvalRequest),
 //! [`CompareRequest`](super::compare::CompareRequest), [`BatchRequest`](super::batch::BatchRequest),
-//! [`SearchRequest`](super::search::SearchRequest)) from a JSON object, such as Python's
+//! [`SearchRequest`](super::search::SearchRequest), [`LearnRequest`](super::learn::LearnRequest),
+//! [`TraceRequest`](super::trace::TraceRequest)) from a JSON object, such as Python's
 //! keyword arguments, with each field's error naming that field.
 
 use serde::Serialize;
