@@ -47,7 +47,7 @@ impl Key {
 }
 
 /// Keys accepted besides the table's: `(alias, key)`. `sample=true|false` is
-/// `action_selection=sample|mode`.
+/// `action_selection=sample|outcome-mode` (the default mode).
 pub const ALIASES: &[(&str, &str)] = &[("sample", "action_selection")];
 
 fn tree(p: &ScaledParams) -> Value {
@@ -315,7 +315,7 @@ mod tests {
         p.set_str("sample", "true").unwrap();
         assert_eq!(p.get("action_selection").unwrap(), json!("sample"));
         p.set_str("sample", "no").unwrap();
-        assert_eq!(p.get("action_selection").unwrap(), json!("mode"));
+        assert_eq!(p.get("action_selection").unwrap(), json!("outcome-mode"));
         p.set_str("gate", "one-step").unwrap();
         assert_eq!(p.gate.mode, GateMode::OneStep);
         p.set_str("persistence_ignores", "none").unwrap();

@@ -126,9 +126,18 @@ pub enum ScalingMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum ActionSelection {
-    /// The mode (ties: lowest index). Default in evaluation.
+    /// The mode over the outcomes the model tells apart (beyond the paper; default in
+    /// evaluation): on a reasoning tick each action's probability is pooled with that of
+    /// every action whose predicted next state overlaps its own,
+    /// `π̃(u) = Σ_w (1 - TV(B[u] q_t, B[w] q_t)) π'(w)`, and the agent acts on the mode of
+    /// `π̃` (ties: lowest index), so that two actions the model cannot tell apart
+    /// (maintain and speed up in the top speed bin, maintain and slow down at a
+    /// standstill) do not split the mass of one choice between them. Feed-forward ticks
+    /// act on the mode of `π_o`, as [`ActionSelection::Mode`] does.
     #[default]
     #[serde(alias = "false", alias = "no", alias = "0")]
+    OutcomeMode,
+    /// The mode of the policy acted upon (ties: lowest index): the paper's rule (ablation).
     Mode,
     /// Sample with the agent's seeded ChaCha8 RNG.
     #[serde(alias = "true", alias = "yes", alias = "1")]
@@ -304,7 +313,7 @@ pub enum CrashPlanning {
 /// | `scaling` | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
 /// | `scaling` | `max_scaling_iters` | 50 | 1..=10000 | cap of the scaling loop |
 /// | `scaling` | `scaling_mode` | `iterative` | `iterative`, `closed-form` | Theorem 1 iterative / closed form ([`ScalingMode`]) |
-/// | `scaling` | `action_selection` | `mode` | `mode`, `sample` | act on the mode of the policy or sample it ([`ActionSelection`]) |
+/// | `scaling` | `action_selection` | `outcome-mode` | `outcome-mode`, `mode`, `sample` | act on the mode over the outcomes the model tells apart, on the policy's mode (the paper's, ablation) or sample it ([`ActionSelection`]) |
 /// | `scaling` | `reasoning` | `triggered` | `triggered`, `always` | reason when θ > ε, or on every tick (ablation) ([`ReasoningMode`]) |
 /// | `learning` | `learning` | true | true, false | test-time learning §V at episode end |
 /// | `learning` | `learning_rate` | 1.0 | finite and >= 0 | multiplies the expected counts added in §V |
@@ -469,7 +478,7 @@ impl Default for ScalingParams {
             kappa_pi: 1.0,
             max_scaling_iters: 50,
             scaling_mode: ScalingMode::Iterative,
-            action_selection: ActionSelection::Mode,
+            action_selection: ActionSelection::OutcomeMode,
             reasoning: ReasoningMode::Triggered,
         }
     }

@@ -104,6 +104,9 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     hist_declined: Vec<bool>,
     /// The competence check's scratch: one action per state, the held action's policy.
     held_policy: Vec<usize>,
+    /// [`ActionSelection::OutcomeMode`]'s scratch: `B[u] q_t` per action, `[u * n + s]`.
+    next_pred: Vec<f64>,
+    pred_scratch: Vec<f64>,
     final_obs: Option<usize>,
     /// One-hot index of the last posterior, if it was one-hot.
     prev_one_hot: Option<usize>,
@@ -246,6 +249,8 @@ impl<H: Habit> ScaledAgent<H> {
             hist_checked: Vec::with_capacity(256),
             hist_declined: Vec::with_capacity(256),
             held_policy: vec![0; n],
+            next_pred: vec![0.0; n * na],
+            pred_scratch: Vec::new(),
             final_obs: None,
             prev_one_hot: None,
             last: ReasoningTrace::default(),
@@ -418,9 +423,27 @@ impl<H: Habit> ScaledAgent<H> {
         &self.last
     }
 
+    /// [`ActionSelection::OutcomeMode`] on a reasoning tick: the mode of
+    /// `π̃(u) = Σ_w (1 - TV(B[u] q_t, B[w] q_t)) π'(w)` under the learned `B`, the policy
+    /// pooled over actions whose predicted next states overlap.
+    fn outcome_mode(&mut self, dist: &[f64]) -> usize {
+        let gm = self.model.generative();
+        let (n, na) = (self.n_states, self.n_actions);
+        self.next_pred.resize(n * na, 0.0);
+        for u in 0..na {
+            gm.transition_into(
+                u,
+                &self.q_cur,
+                &mut self.next_pred[u * n..(u + 1) * n],
+                &mut self.pred_scratch,
+            );
+        }
+        argmax(&pooled_over_outcomes(&self.next_pred, n, dist))
+    }
+
     fn select(&mut self, dist: &[f64]) -> usize {
         match self.params.scaling.action_selection {
-            ActionSelection::Mode => argmax(dist),
+            ActionSelection::OutcomeMode | ActionSelection::Mode => argmax(dist),
             ActionSelection::Sample => {
                 let r: f64 = self.rng.random();
                 let mut acc = 0.0;
@@ -613,7 +636,12 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             }
         }
         let pi = std::mem::take(&mut self.pi);
-        let action = self.select(&pi);
+        // On a reasoning tick, the mode over the outcomes the model tells apart (default).
+        let action = if reasoned && self.params.scaling.action_selection == ActionSelection::OutcomeMode {
+            self.outcome_mode(&pi)
+        } else {
+            self.select(&pi)
+        };
         self.pi = pi;
         self.prev_one_hot = if self.q_cur[obs] == 1.0 { Some(obs) } else { None };
         self.hist_obs.push(obs);
@@ -728,9 +756,48 @@ fn endorsement(pi_scaled: &[f64], a: usize) -> f64 {
     if best > 0.0 { pi_scaled[a] / best } else { 0.0 }
 }
 
+/// The policy `dist` pooled over the actions' predicted next states `pred`
+/// (`[u * n + s]`, each a distribution): `π̃(u) = Σ_w (1 - TV(pred_u, pred_w)) dist(w)`
+/// ([`ActionSelection::OutcomeMode`]). Actions with disjoint predictions keep their own
+/// probability; actions with the same prediction share the sum of theirs.
+fn pooled_over_outcomes(pred: &[f64], n: usize, dist: &[f64]) -> Vec<f64> {
+    let of = |u: usize| &pred[u * n..(u + 1) * n];
+    (0..dist.len())
+        .map(|u| {
+            (0..dist.len())
+                .map(|w| {
+                    let tv = of(u).iter().zip(of(w)).map(|(x, y)| (x - y).abs()).sum::<f64>() / 2.0;
+                    (1.0 - tv).max(0.0) * dist[w]
+                })
+                .sum()
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pooling_over_outcomes_by_hand() {
+        // Maintain and speed up predict the same next state (the top speed bin), slow down
+        // another: "keep going" (0.26 + 0.26) outweighs "slow down" (0.48).
+        let pred = [0.0, 1.0, 0.0, 1.0, 1.0, 0.0];
+        let pooled = pooled_over_outcomes(&pred, 2, &[0.26, 0.26, 0.48]);
+        assert!((pooled[0] - 0.52).abs() < 1e-12 && (pooled[1] - 0.52).abs() < 1e-12);
+        assert!((pooled[2] - 0.48).abs() < 1e-12);
+        assert_eq!(argmax(&pooled), 0);
+        // Disjoint predictions: the policy itself, so its mode.
+        let pred = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        assert_eq!(
+            pooled_over_outcomes(&pred, 3, &[0.26, 0.26, 0.48]),
+            vec![0.26, 0.26, 0.48]
+        );
+        // Half-overlapping predictions share half.
+        let pred = [0.5, 0.5, 0.0, 1.0];
+        let pooled = pooled_over_outcomes(&pred, 2, &[0.4, 0.6]);
+        assert!((pooled[0] - 0.7).abs() < 1e-12 && (pooled[1] - 0.8).abs() < 1e-12);
+    }
 
     #[test]
     fn endorsement_by_hand() {

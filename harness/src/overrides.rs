@@ -39,7 +39,7 @@ pub fn help() -> String {
     format!(
         "Scaled-agent parameter overrides, e.g. `--set omega=0.3 --set horizon=2` or `--set gate.epsilon=0.1` \
          (ranges: agent/src/params.rs). Keys and defaults by group: {}. Also `sample=true|false` \
-         (action_selection=sample|mode).",
+         (action_selection=sample|outcome-mode).",
         lines.join("; ")
     )
 }

@@ -10,7 +10,7 @@
 
 use crate::common;
 use std::fmt::Write;
-use unforeseen_agent::params::{CompetenceCheck, CrashPlanning, ScaledParams};
+use unforeseen_agent::params::{ActionSelection, CompetenceCheck, CrashPlanning, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::experiments::trace;
 use unforeseen_harness::episodes::methods::Method;
@@ -123,14 +123,16 @@ fn noisy_jaywalk(papers: bool) -> unforeseen_sim::Map {
     map
 }
 
-/// The paper's agent (docs/ARCHITECTURE.md §4.3, §4.11): the scaled agent's default
-/// parameters without the competence check (`competence = surprise-only`) and with the
-/// paper's crash-risk states (`crash_model = states`), whose decisions the digests below
-/// recorded before either was added.
+/// The paper's agent (docs/ARCHITECTURE.md §4.3, §4.9, §4.11): the scaled agent's default
+/// parameters without the competence check (`competence = surprise-only`), with the
+/// paper's crash-risk states (`crash_model = states`) and acting on the mode of the policy
+/// (`action_selection = mode`), whose decisions the digests below recorded before any of
+/// these was added.
 fn papers_agent() -> ScaledParams {
     let mut params = ScaledParams::default();
     params.gate.competence = CompetenceCheck::SurpriseOnly;
     params.planning.crash_model = CrashPlanning::States;
+    params.scaling.action_selection = ActionSelection::Mode;
     params
 }
 
@@ -201,25 +203,36 @@ fn the_competence_check_decisions_are_recorded() {
     assert_eq!(papers_digests(common::papers_bundle(), &params), GOLDEN_COMPETENCE);
 }
 
+/// The default agent's digests on the default maps with the scaled agent's parameters
+/// `params`.
+fn default_digests(params: &ScaledParams) -> [String; 4] {
+    let bundle = common::bundle();
+    [
+        agent_digest(bundle),
+        episodes_digest(bundle, &unforeseen_harness::maps::load("intersection").unwrap(), params),
+        episodes_digest(bundle, &unforeseen_harness::maps::load("jaywalk").unwrap(), params),
+        episodes_digest(bundle, &noisy_jaywalk(false), params),
+    ]
+}
+
 /// The default agent on the default maps: distance edges anchored at the crosswalk's near
-/// edge, the first speed edge at 0.5 m/s, the crash model and the competence check
-/// (digests recorded when the speed edge became the default; the agent's tables are
-/// those of the speed edge at 1.5 m/s: no training car drives between 0.5 and 1.5 m/s).
+/// edge, the first speed edge at 0.5 m/s, the crash model, the competence check and the
+/// mode over the outcomes the model tells apart (digests recorded when that mode became
+/// the default; the agent's tables are those of the speed edge at 1.5 m/s: no training
+/// car drives between 0.5 and 1.5 m/s).
 #[test]
 fn the_default_agent_decisions_are_recorded() {
-    let bundle = common::bundle();
-    let params = ScaledParams::default();
-    let digests = [
-        agent_digest(bundle),
-        episodes_digest(
-            bundle,
-            &unforeseen_harness::maps::load("intersection").unwrap(),
-            &params,
-        ),
-        episodes_digest(bundle, &unforeseen_harness::maps::load("jaywalk").unwrap(), &params),
-        episodes_digest(bundle, &noisy_jaywalk(false), &params),
-    ];
-    assert_eq!(digests, GOLDEN_DEFAULT);
+    assert_eq!(default_digests(&ScaledParams::default()), GOLDEN_DEFAULT);
+}
+
+/// The default agent acting on the mode of the policy (`action_selection = mode`, the
+/// ablation) decides exactly as the default did before the mode over outcomes: the
+/// digests recorded when the speed edge at 0.5 m/s became the default.
+#[test]
+fn the_policy_mode_ablation_reproduces_the_default_of_before() {
+    let mut params = ScaledParams::default();
+    params.scaling.action_selection = ActionSelection::Mode;
+    assert_eq!(default_digests(&params), GOLDEN_DEFAULT_POLICY_MODE);
 }
 
 /// On a map whose episodes often time out (the tiny map: 12 ticks), the two settings
@@ -278,6 +291,15 @@ const GOLDEN_COMPETENCE: [&str; 4] = [
 
 /// Digests of [`the_default_agent_decisions_are_recorded`].
 const GOLDEN_DEFAULT: [&str; 4] = [
+    "9be644aee445c8c1",
+    "2e6b2cd9a66dc19a",
+    "e7b071d234a24639",
+    "27c78f87316b00c7",
+];
+
+/// Digests of [`the_policy_mode_ablation_reproduces_the_default_of_before`]: those of the
+/// default agent before the mode over outcomes ([`GOLDEN_DEFAULT`] until then).
+const GOLDEN_DEFAULT_POLICY_MODE: [&str; 4] = [
     "9be644aee445c8c1",
     "2e6b2cd9a66dc19a",
     "9c7508c681ca9542",
