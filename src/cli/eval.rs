@@ -8,7 +8,6 @@ use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::progress::Progress;
-use unforeseen_harness::runs::batch::AgentChoice;
 use unforeseen_harness::runs::evaluate::{EVAL_FILE, EvalRequest, EvalScene};
 
 /// Arguments of `eval`.
@@ -68,9 +67,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
     let creates = super::outputs::to_create(&args.out);
     let job = args.request().plan(None)?;
     super::outputs::creating("--out", creates);
-    if let AgentChoice::Trained { map, config, .. } = &job.agent {
-        progress::training(quiet, false, 1, config.episodes, &map.name, args.agent.seed);
-    }
+    progress::training_one(quiet, &job.agent, args.agent.seed);
     let bundle = job.agent(&Bars::counting(quiet, "episodes"))?;
     let (m, p, n) = (args.method, args.protocol, args.episodes);
     let what = match &job.scene {

@@ -8,7 +8,6 @@ use std::path::PathBuf;
 use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::reports::tables::Grid;
-use unforeseen_harness::runs::batch::AgentChoice;
 use unforeseen_harness::runs::learn::{LEARN_FILES, LearnReport, LearnRequest, MapLearning};
 
 /// Arguments of `learn`.
@@ -58,9 +57,7 @@ pub fn run(args: LearnArgs) -> anyhow::Result<()> {
     let creates = super::outputs::to_create(&args.out);
     let job = args.request().plan(None)?;
     super::outputs::creating("--out", creates);
-    if let AgentChoice::Trained { map, config, .. } = &job.agent {
-        progress::training(quiet, false, 1, config.episodes, &map.name, args.agent.seed);
-    }
+    progress::training_one(quiet, &job.agent, args.agent.seed);
     let bundle = job.agent(&Bars::counting(quiet, "episodes"))?;
     let on = job.on();
     progress::phase(

@@ -10,6 +10,7 @@ use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
 use unforeseen_harness::progress::{Message, Progress};
+use unforeseen_harness::runs::batch::AgentChoice;
 
 /// When the clock of the phase lines started.
 static START: OnceLock<Instant> = OnceLock::new();
@@ -50,6 +51,14 @@ pub fn training(quiet: bool, per_seed: bool, count: usize, episodes: u64, map: &
             quiet,
             format_args!("training {episodes} episodes on '{map}' (seed {seed})"),
         );
+    }
+}
+
+/// The phase line of a job that runs one agent ([`AgentChoice::one`]), when that agent
+/// is trained here with the run `seed`.
+pub fn training_one(quiet: bool, agent: &AgentChoice, seed: u64) {
+    if let AgentChoice::Trained { map, config, .. } = agent {
+        training(quiet, false, 1, config.episodes, &map.name, seed);
     }
 }
 

@@ -10,7 +10,6 @@ use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::reports::files::num;
-use unforeseen_harness::runs::batch::AgentChoice;
 use unforeseen_harness::runs::trace::{TRACE_FILES, TraceReport, TraceRequest, mode, surprise_bits};
 
 /// Arguments of `trace`.
@@ -74,9 +73,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
     let job = args.request().plan(None)?;
     super::outputs::creating("--html", creates_html);
     super::outputs::creating("--out", creates);
-    if let AgentChoice::Trained { map, config, .. } = &job.agent {
-        progress::training(quiet, false, 1, config.episodes, &map.name, args.agent.seed);
-    }
+    progress::training_one(quiet, &job.agent, args.agent.seed);
     let bundle = job.agent(&Bars::counting(quiet, "episodes"))?;
     let report = job.run(&bundle)?;
     outln!(

@@ -21,10 +21,8 @@ use crate::reports::files::write_json;
 use crate::reports::tables::{self, Document};
 use crate::runs::batch::request::AgentFields;
 use crate::runs::batch::{AgentChoice, SCRIPTED_ONLY};
-use crate::runs::outputs::{Outputs, Own};
+use crate::runs::outputs::Outputs;
 use crate::runs::stream::{Stream, StreamEvalReport, evaluate_stream};
-use crate::training::seed_agents::train_agents;
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs};
 
 /// The file an evaluation writes into its folder.
 pub const EVAL_FILE: &str = "eval.json";
@@ -73,13 +71,37 @@ impl Default for EvalRequest {
     }
 }
 
-/// Where an evaluation runs.
+/// Where an evaluation, or test-time learning ([`crate::runs::learn`]), runs: one map or a stream.
 #[derive(Debug, Clone)]
 pub enum EvalScene {
     /// One map.
     Map(Box<Map>),
     /// A deployment stream, read from its file.
     Stream(Box<Stream>, PathBuf),
+}
+
+impl EvalScene {
+    /// The scene of a job: the deployment `stream` file when given, else `map` (a file or
+    /// an embedded name).
+    pub fn load(map: &str, stream: Option<&PathBuf>) -> Result<EvalScene, Error> {
+        Ok(match stream {
+            Some(file) => EvalScene::Stream(Box::new(Stream::load(file)?), file.clone()),
+            None => EvalScene::Map(Box::new(crate::maps::load(map)?)),
+        })
+    }
+
+    /// The scene's input files for the output guard (the stream and its maps, or the
+    /// map given as `map`), with the agent file `agent` if any.
+    pub fn inputs(&self, map: &str, agent: Option<&PathBuf>) -> Outputs {
+        let guard = match self {
+            EvalScene::Stream(stream, file) => Outputs::new().stream("stream", file, stream),
+            EvalScene::Map(_) => Outputs::new().input("map", map),
+        };
+        match agent {
+            Some(agent) => guard.input("agent", agent),
+            None => guard,
+        }
+    }
 }
 
 /// An evaluation planned ([`EvalRequest::plan`]).
@@ -129,31 +151,13 @@ impl EvalRequest {
     /// input). Trains and writes nothing.
     pub fn plan(&self, given: Option<AgentBundle>) -> Result<EvalJob, Error> {
         check_episodes("episodes", self.episodes)?;
-        let fields = AgentFields {
-            agent: self.agent.as_deref(),
-            train_seeds: None,
-            train_map: DEFAULT_TRAIN_MAP,
-            train_episodes: DEFAULT_TRAIN_EPISODES,
-            timeout_as: TimeoutAs::Truncation,
-            cache: None,
-            seed: self.seed,
-        };
+        let fields = AgentFields::one(self.agent.as_deref(), self.seed);
         fields.check(given.is_some(), "evaluate one agent")?;
-        let scene = match &self.stream {
-            Some(file) => EvalScene::Stream(Box::new(Stream::load(file)?), file.clone()),
-            None => EvalScene::Map(Box::new(crate::maps::load(&self.map)?)),
-        };
+        let scene = EvalScene::load(&self.map, self.stream.as_ref())?;
         if let Some(dir) = &self.out {
-            let mut guard = match &scene {
-                EvalScene::Stream(stream, file) => Outputs::new().stream("stream", file, stream),
-                EvalScene::Map(_) => Outputs::new().input("map", &self.map),
-            };
-            if let Some(agent) = &self.agent {
-                guard = guard.input("agent", agent);
-            }
-            guard
-                .place("out", dir)
-                .file("out", dir.join(EVAL_FILE), Own::Any)
+            scene
+                .inputs(&self.map, self.agent.as_ref())
+                .files_in("out", dir, &[EVAL_FILE])
                 .check(true)?;
         }
         let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
@@ -173,14 +177,7 @@ impl EvalJob {
     /// The agent the evaluation needs: none for a scripted reference, the one given, or
     /// one trained (one phase of `progress`).
     pub fn agent(&self, progress: &dyn Progress) -> Result<Option<AgentBundle>, Error> {
-        match &self.agent {
-            AgentChoice::None => Ok(None),
-            AgentChoice::Given(agent) => Ok(Some(agent.bundle.clone())),
-            AgentChoice::Trained { map, seeds, config, .. } => Ok(train_agents(map, seeds, config, None, progress)?
-                .into_iter()
-                .next()
-                .map(|a| a.bundle)),
-        }
+        self.agent.one(progress)
     }
 
     /// What the evaluation is, for a progress phase: `scaled jaywalk`.

@@ -22,10 +22,7 @@ use crate::reports::files::{Csv, all_or_none, num, write_json};
 use crate::runs::batch::AgentChoice;
 use crate::runs::batch::request::AgentFields;
 use crate::runs::evaluate::EvalScene;
-use crate::runs::outputs::{Outputs, Own};
-use crate::runs::stream::{Stream, learn_stream};
-use crate::training::seed_agents::train_agents;
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs};
+use crate::runs::stream::learn_stream;
 
 /// The files test-time learning writes into its folder, in order.
 pub const LEARN_FILES: [&str; 3] = ["learn.csv", "learn.json", "learn.svg"];
@@ -131,31 +128,13 @@ impl LearnRequest {
     /// `agent`). Trains and writes nothing.
     pub fn plan(&self, given: Option<AgentBundle>) -> Result<LearnJob, Error> {
         check_episodes("episodes", self.episodes)?;
-        let fields = AgentFields {
-            agent: self.agent.as_deref(),
-            train_seeds: None,
-            train_map: DEFAULT_TRAIN_MAP,
-            train_episodes: DEFAULT_TRAIN_EPISODES,
-            timeout_as: TimeoutAs::Truncation,
-            cache: None,
-            seed: self.seed,
-        };
+        let fields = AgentFields::one(self.agent.as_deref(), self.seed);
         fields.check(given.is_some(), "learn with one agent")?;
-        let scene = match &self.stream {
-            Some(file) => EvalScene::Stream(Box::new(Stream::load(file)?), file.clone()),
-            None => EvalScene::Map(Box::new(crate::maps::load(&self.map)?)),
-        };
+        let scene = EvalScene::load(&self.map, self.stream.as_ref())?;
         if let Some(dir) = &self.out {
-            let mut guard = match &scene {
-                EvalScene::Stream(stream, file) => Outputs::new().stream("stream", file, stream),
-                EvalScene::Map(_) => Outputs::new().input("map", &self.map),
-            };
-            if let Some(agent) = &self.agent {
-                guard = guard.input("agent", agent);
-            }
-            LEARN_FILES
-                .iter()
-                .fold(guard.place("out", dir), |g, n| g.file("out", dir.join(n), Own::Any))
+            scene
+                .inputs(&self.map, self.agent.as_ref())
+                .files_in("out", dir, &LEARN_FILES)
                 .check(true)?;
         }
         let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
@@ -172,19 +151,10 @@ impl LearnRequest {
 impl LearnJob {
     /// The agent that learns: the one given, or one trained (one phase of `progress`).
     pub fn agent(&self, progress: &dyn Progress) -> Result<AgentBundle, Error> {
-        let trained = match &self.agent {
-            AgentChoice::Given(agent) => return Ok(agent.bundle.clone()),
-            AgentChoice::Trained { map, seeds, config, .. } => train_agents(map, seeds, config, None, progress)?,
-            AgentChoice::None => Vec::new(),
-        };
-        trained
-            .into_iter()
-            .next()
-            .map(|a| a.bundle)
-            .ok_or_else(|| Error::Agent {
-                problem: "test-time learning needs a trained agent".into(),
-                fix: "give an agent file, or let one be trained".into(),
-            })
+        self.agent.one(progress)?.ok_or_else(|| Error::Agent {
+            problem: "test-time learning needs a trained agent".into(),
+            fix: "give an agent file, or let one be trained".into(),
+        })
     }
 
     /// What the agent learns on: `'jaywalk'`, or `the stream 'deployment' (6 maps)`.

@@ -243,6 +243,15 @@ impl Outputs {
         self
     }
 
+    /// The output folder `dir` given as `flag` ([`Outputs::place`]) and the files `names`
+    /// the run writes in it, whatever they hold (a job's fixed set: eval.json, compare's
+    /// four files, ...).
+    pub fn files_in(self, flag: &str, dir: &Path, names: &[&str]) -> Outputs {
+        names
+            .iter()
+            .fold(self.place(flag, dir), |g, n| g.file(flag, dir.join(n), Own::Any))
+    }
+
     /// The files with extension `ext` in the output folder `dir` (a search's
     /// `failures/*.ron`): each must be [`Own`] `own` (unless `force`); they are removed
     /// when the guard is taken, as the run writes the set anew at its end.

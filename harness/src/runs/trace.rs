@@ -25,8 +25,6 @@ use crate::reports::replay_page::replay_html;
 use crate::runs::batch::AgentChoice;
 use crate::runs::batch::request::AgentFields;
 use crate::runs::outputs::{Outputs, Own};
-use crate::training::seed_agents::train_agents;
-use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs};
 
 /// The files a trace writes into its folder, in order (the replay page goes where
 /// `html` says).
@@ -156,15 +154,7 @@ impl TraceRequest {
                 expected: format!("0..={MAX_EPISODES}"),
             });
         }
-        let fields = AgentFields {
-            agent: self.agent.as_deref(),
-            train_seeds: None,
-            train_map: DEFAULT_TRAIN_MAP,
-            train_episodes: DEFAULT_TRAIN_EPISODES,
-            timeout_as: TimeoutAs::Truncation,
-            cache: None,
-            seed: self.seed,
-        };
+        let fields = AgentFields::one(self.agent.as_deref(), self.seed);
         fields.check(given.is_some(), "trace one agent")?;
         let map = crate::maps::load(&self.map)?;
         if let (Some(html), Some(dir)) = (&self.html, &self.out) {
@@ -192,9 +182,7 @@ impl TraceRequest {
                 guard = guard.file("html", html, Own::Any);
             }
             if let Some(dir) = &self.out {
-                guard = TRACE_FILES
-                    .iter()
-                    .fold(guard.place("out", dir), |g, n| g.file("out", dir.join(n), Own::Any));
+                guard = guard.files_in("out", dir, &TRACE_FILES);
             }
             guard.check(true)?;
         }
@@ -213,19 +201,10 @@ impl TraceJob {
     /// The agent traced (a scripted method's controller is built from it too): the one
     /// given, or one trained (one phase of `progress`).
     pub fn agent(&self, progress: &dyn Progress) -> Result<AgentBundle, Error> {
-        let trained = match &self.agent {
-            AgentChoice::Given(agent) => return Ok(agent.bundle.clone()),
-            AgentChoice::Trained { map, seeds, config, .. } => train_agents(map, seeds, config, None, progress)?,
-            AgentChoice::None => Vec::new(),
-        };
-        trained
-            .into_iter()
-            .next()
-            .map(|a| a.bundle)
-            .ok_or_else(|| Error::Agent {
-                problem: "a trace needs a trained agent".into(),
-                fix: "give an agent file, or let one be trained".into(),
-            })
+        self.agent.one(progress)?.ok_or_else(|| Error::Agent {
+            problem: "a trace needs a trained agent".into(),
+            fix: "give an agent file, or let one be trained".into(),
+        })
     }
 
     /// Runs the episode (and, under the continual protocol, those before it) with

@@ -133,6 +133,21 @@ pub enum AgentChoice {
     },
 }
 
+impl AgentChoice {
+    /// The one agent of a job that runs one (eval, learn, trace): none, the one given,
+    /// or the one trained (one phase of `progress`).
+    pub fn one(&self, progress: &dyn Progress) -> Result<Option<AgentBundle>, Error> {
+        Ok(match self {
+            AgentChoice::None => None,
+            AgentChoice::Given(agent) => Some(agent.bundle.clone()),
+            AgentChoice::Trained { map, seeds, config, .. } => train_agents(map, seeds, config, None, progress)?
+                .into_iter()
+                .next()
+                .map(|a| a.bundle),
+        })
+    }
+}
+
 /// A batch request checked and resolved, before any file is written: what runs, with
 /// which agents, and the identity of those agents.
 #[derive(Debug, Clone)]
@@ -194,7 +209,21 @@ pub(crate) struct AgentFields<'a> {
     pub seed: u64,
 }
 
-impl AgentFields<'_> {
+impl<'a> AgentFields<'a> {
+    /// The fields of a job that runs one agent (eval, learn, trace): the agent file, or
+    /// none, which trains one on the default training map with the default episodes and
+    /// the run `seed`, not cached.
+    pub fn one(agent: Option<&'a std::path::Path>, seed: u64) -> Self {
+        AgentFields {
+            agent,
+            train_seeds: None,
+            train_map: DEFAULT_TRAIN_MAP,
+            train_episodes: DEFAULT_TRAIN_EPISODES,
+            timeout_as: TimeoutAs::Truncation,
+            cache: None,
+            seed,
+        }
+    }
     /// Checks that the fields and an agent given loaded (`given`) name one choice of
     /// agents; `one_agent` says what one agent does, for the error when both
     /// `train_seeds` and an agent are given. Reads no file.

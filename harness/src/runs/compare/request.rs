@@ -17,7 +17,7 @@ use crate::limits::check_episodes;
 use crate::progress::Progress;
 use crate::runs::batch::AgentChoice;
 use crate::runs::batch::request::AgentFields;
-use crate::runs::outputs::{Outputs, Own};
+use crate::runs::outputs::Outputs;
 use crate::training::seed_agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
 use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs};
 
@@ -128,10 +128,7 @@ impl CompareRequest {
             if let Some(agent) = &self.agent {
                 guard = guard.input("agent", agent);
             }
-            let guard = COMPARE_FILES
-                .iter()
-                .fold(guard.place("out", dir), |g, n| g.file("out", dir.join(n), Own::Any));
-            guard.check(true)?;
+            guard.files_in("out", dir, &COMPARE_FILES).check(true)?;
         }
         let train_map = crate::maps::load(&self.train_map)?;
         let test_map = crate::maps::load(&self.test_map)?;
