@@ -144,6 +144,24 @@ pub enum ActionSelection {
     Sample,
 }
 
+/// What the agent does with the actions its world model cannot tell apart from the one it
+/// chose (docs/ARCHITECTURE.md §4.9).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum TieBreak {
+    /// Beyond the paper (default): on every tick, among the chosen action and the actions
+    /// whose predicted next state `B[u] q_t` lies within `tie_tolerance` of its own (total
+    /// variation), the agent takes the one least likely to crash when held for
+    /// `handback_horizon` ticks (the hand-back's crash risk, [`crate::handback`]); the
+    /// chosen action keeps the tick where none is less likely. Where the model cannot tell
+    /// "speed up" from "maintain" (the top speed bin), the crash model still can: the
+    /// faster car covers more ground in a tick where a pedestrian may be.
+    #[default]
+    Safest,
+    /// Act on the chosen action (the paper's; ablation).
+    Chosen,
+}
+
 /// When reasoning (VMP + planning + scaling) runs (§II footnote, §IV; ablation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
@@ -314,6 +332,8 @@ pub enum CrashPlanning {
 /// | `scaling` | `max_scaling_iters` | 50 | 1..=10000 | cap of the scaling loop |
 /// | `scaling` | `scaling_mode` | `iterative` | `iterative`, `closed-form` | Theorem 1 iterative / closed form ([`ScalingMode`]) |
 /// | `scaling` | `action_selection` | `outcome-mode` | `outcome-mode`, `mode`, `sample` | act on the mode over the outcomes the model tells apart, on the policy's mode (the paper's, ablation) or sample it ([`ActionSelection`]) |
+/// | `scaling` | `tie_break` | `safest` | `safest`, `chosen` | among the actions whose predicted next state is within `tie_tolerance` of the chosen one's, take the one least likely to crash within `handback_horizon` ticks (beyond the paper), or the chosen one (the paper's, ablation) ([`TieBreak`]) |
+/// | `scaling` | `tie_tolerance` | 0.05 | [0, 1) | the total variation between two actions' predicted next states below which the model cannot tell them apart |
 /// | `scaling` | `reasoning` | `triggered` | `triggered`, `always` | reason when θ > ε, or on every tick (ablation) ([`ReasoningMode`]) |
 /// | `learning` | `learning` | true | true, false | test-time learning §V at episode end |
 /// | `learning` | `learning_rate` | 1.0 | finite and >= 0 | multiplies the expected counts added in §V |
@@ -467,6 +487,10 @@ pub struct ScalingParams {
     pub scaling_mode: ScalingMode,
     /// Mode or sample.
     pub action_selection: ActionSelection,
+    /// What happens to the actions the model cannot tell from the chosen one.
+    pub tie_break: TieBreak,
+    /// Total variation below which two actions' predicted next states are the same.
+    pub tie_tolerance: f64,
     /// Triggered or always.
     pub reasoning: ReasoningMode,
 }
@@ -479,6 +503,8 @@ impl Default for ScalingParams {
             max_scaling_iters: 50,
             scaling_mode: ScalingMode::Iterative,
             action_selection: ActionSelection::OutcomeMode,
+            tie_break: TieBreak::Safest,
+            tie_tolerance: 0.05,
             reasoning: ReasoningMode::Triggered,
         }
     }
@@ -609,7 +635,7 @@ pub const MAX_COMPETENCE_HORIZON: usize = 40;
 
 impl ScaledParams {
     /// Every numeric parameter's key, value and range (the table above).
-    pub fn bounds(&self) -> [(&'static str, f64, Bound); 20] {
+    pub fn bounds(&self) -> [(&'static str, f64, Bound); 21] {
         let (g, pe, pl, s, l) = (
             &self.gate,
             &self.perception,
@@ -665,6 +691,7 @@ impl ScaledParams {
                 ),
             ),
             ("varsigma", s.varsigma, Bound::NonNegative),
+            ("tie_tolerance", s.tie_tolerance, Bound::BelowOne),
             ("kappa_pi", s.kappa_pi, Bound::HalfOpenUnit),
             (
                 "max_scaling_iters",

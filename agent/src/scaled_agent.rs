@@ -24,7 +24,7 @@ use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{
     ActionSelection, CheckedScaledParams, CompetenceCheck, CrashPlanning, GateBaseline, GateLearning, GateMode,
-    HandBackRule, ReasoningMode, RootStep, ScaledParams, ScalingMode,
+    HandBackRule, ReasoningMode, RootStep, ScaledParams, ScalingMode, TieBreak,
 };
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s_into};
@@ -284,22 +284,25 @@ impl<H: Habit> ScaledAgent<H> {
     /// predicted, under the learned model, to enter a crash-risk state more likely, by more
     /// than `handback_risk`, than holding the safest action would.
     fn habit_at_risk(&mut self) -> bool {
+        let own = self.held_crash_risk(argmax(&self.pi));
+        let safest = (0..self.n_actions)
+            .map(|u| self.held_crash_risk(u))
+            .fold(f64::INFINITY, f64::min);
+        own - safest > self.params.gate.handback_risk
+    }
+
+    /// The hand-back's crash risk ([`crate::handback`]) of holding `u` for
+    /// `handback_horizon` ticks from belief `q_t`.
+    fn held_crash_risk(&mut self, u: usize) -> f64 {
         let root = match self.params.planning.root_step {
             RootStep::Learned => self.model.generative(),
             RootStep::Absorbing => self.model.planning_generative(),
         };
         let plan = self.model.planning_generative();
+        self.held_policy.fill(u);
         let horizon = self.params.gate.handback_horizon;
-        let habit = argmax(&self.pi);
-        let n = self.n_states;
-        let mut held = vec![0; n];
-        let mut risk = |u: usize| {
-            held.fill(u);
-            self.handback.crash_risk(root, plan, &self.q_cur, u, &held, horizon)
-        };
-        let own = risk(habit);
-        let safest = (0..self.n_actions).map(&mut risk).fold(f64::INFINITY, f64::min);
-        own - safest > self.params.gate.handback_risk
+        self.handback
+            .crash_risk(root, plan, &self.q_cur, u, &self.held_policy, horizon)
     }
 
     /// The hand-back check: on a tick that would hand control to the habit (whose policy is
@@ -343,13 +346,7 @@ impl<H: Habit> ScaledAgent<H> {
         // horizon (crash_risk, as the hand-back checks), the habit keeps the tick.
         let held = self.competence.held();
         let best = (0..self.n_actions).fold(habit, |b, u| if held[u] < held[b] { u } else { b });
-        let risk_horizon = self.params.gate.handback_horizon;
-        let mut risk = |u: usize| {
-            self.held_policy.fill(u);
-            self.handback
-                .crash_risk(root, plan, &self.q_cur, u, &self.held_policy, risk_horizon)
-        };
-        let safer = risk(best) - risk(habit) <= self.params.gate.handback_risk;
+        let safer = self.held_crash_risk(best) - self.held_crash_risk(habit) <= self.params.gate.handback_risk;
         safer.then(|| th.max(theta(regret, self.params.gate.omega)))
     }
 
@@ -423,10 +420,8 @@ impl<H: Habit> ScaledAgent<H> {
         &self.last
     }
 
-    /// [`ActionSelection::OutcomeMode`] on a reasoning tick: the mode of
-    /// `π̃(u) = Σ_w (1 - TV(B[u] q_t, B[w] q_t)) π'(w)` under the learned `B`, the policy
-    /// pooled over actions whose predicted next states overlap.
-    fn outcome_mode(&mut self, dist: &[f64]) -> usize {
+    /// `B[u] q_t` under the learned `B` for every action, into `self.next_pred`.
+    fn predict_all(&mut self) {
         let gm = self.model.generative();
         let (n, na) = (self.n_states, self.n_actions);
         self.next_pred.resize(n * na, 0.0);
@@ -438,7 +433,35 @@ impl<H: Habit> ScaledAgent<H> {
                 &mut self.pred_scratch,
             );
         }
-        argmax(&pooled_over_outcomes(&self.next_pred, n, dist))
+    }
+
+    /// [`ActionSelection::OutcomeMode`] on a reasoning tick: the mode of
+    /// `π̃(u) = Σ_w (1 - TV(B[u] q_t, B[w] q_t)) π'(w)` under the learned `B`, the policy
+    /// pooled over actions whose predicted next states overlap.
+    fn outcome_mode(&mut self, dist: &[f64]) -> usize {
+        self.predict_all();
+        argmax(&pooled_over_outcomes(&self.next_pred, self.n_states, dist))
+    }
+
+    /// [`TieBreak::Safest`]: among `chosen` and the actions whose predicted next states lie
+    /// within `tie_tolerance` of its own, the one least likely to crash when held for
+    /// `handback_horizon` ticks (the hand-back's crash risk, [`crate::handback`]); `chosen`
+    /// where none is less likely.
+    fn break_tie(&mut self, chosen: usize) -> usize {
+        let n = self.n_states;
+        self.predict_all();
+        let tol = self.params.scaling.tie_tolerance;
+        let tied: Vec<usize> = (0..self.n_actions)
+            .filter(|&w| w != chosen && total_variation(&self.next_pred, n, chosen, w) <= tol)
+            .collect();
+        if tied.is_empty() {
+            return chosen;
+        }
+        let own = self.held_crash_risk(chosen);
+        tied.into_iter()
+            .map(|w| (w, self.held_crash_risk(w)))
+            .fold((chosen, own), |b, w| if w.1 < b.1 { w } else { b })
+            .0
     }
 
     fn select(&mut self, dist: &[f64]) -> usize {
@@ -643,6 +666,10 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             self.select(&pi)
         };
         self.pi = pi;
+        let action = match self.params.scaling.tie_break {
+            TieBreak::Safest => self.break_tie(action),
+            TieBreak::Chosen => action,
+        };
         self.prev_one_hot = if self.q_cur[obs] == 1.0 { Some(obs) } else { None };
         self.hist_obs.push(obs);
         self.hist_act.push(action);
@@ -761,17 +788,20 @@ fn endorsement(pi_scaled: &[f64], a: usize) -> f64 {
 /// ([`ActionSelection::OutcomeMode`]). Actions with disjoint predictions keep their own
 /// probability; actions with the same prediction share the sum of theirs.
 fn pooled_over_outcomes(pred: &[f64], n: usize, dist: &[f64]) -> Vec<f64> {
-    let of = |u: usize| &pred[u * n..(u + 1) * n];
     (0..dist.len())
         .map(|u| {
             (0..dist.len())
-                .map(|w| {
-                    let tv = of(u).iter().zip(of(w)).map(|(x, y)| (x - y).abs()).sum::<f64>() / 2.0;
-                    (1.0 - tv).max(0.0) * dist[w]
-                })
+                .map(|w| (1.0 - total_variation(pred, n, u, w)).max(0.0) * dist[w])
                 .sum()
         })
         .collect()
+}
+
+/// The total variation between the predicted next states of actions `u` and `w` in `pred`
+/// (`[u * n + s]`): half the L1 distance, in [0, 1].
+fn total_variation(pred: &[f64], n: usize, u: usize, w: usize) -> f64 {
+    let of = |a: usize| &pred[a * n..(a + 1) * n];
+    of(u).iter().zip(of(w)).map(|(x, y)| (x - y).abs()).sum::<f64>() / 2.0
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 
 use crate::common;
 use std::fmt::Write;
-use unforeseen_agent::params::{ActionSelection, CompetenceCheck, CrashPlanning, ScaledParams};
+use unforeseen_agent::params::{ActionSelection, CompetenceCheck, CrashPlanning, ScaledParams, TieBreak};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::experiments::trace;
 use unforeseen_harness::episodes::methods::Method;
@@ -126,13 +126,14 @@ fn noisy_jaywalk(papers: bool) -> unforeseen_sim::Map {
 /// The paper's agent (docs/ARCHITECTURE.md §4.3, §4.9, §4.11): the scaled agent's default
 /// parameters without the competence check (`competence = surprise-only`), with the
 /// paper's crash-risk states (`crash_model = states`) and acting on the mode of the policy
-/// (`action_selection = mode`), whose decisions the digests below recorded before any of
-/// these was added.
+/// (`action_selection = mode`) as chosen (`tie_break = chosen`), whose decisions the
+/// digests below recorded before any of these was added.
 fn papers_agent() -> ScaledParams {
     let mut params = ScaledParams::default();
     params.gate.competence = CompetenceCheck::SurpriseOnly;
     params.planning.crash_model = CrashPlanning::States;
     params.scaling.action_selection = ActionSelection::Mode;
+    params.scaling.tie_break = TieBreak::Chosen;
     params
 }
 
@@ -217,21 +218,34 @@ fn default_digests(params: &ScaledParams) -> [String; 4] {
 
 /// The default agent on the default maps: distance edges anchored at the crosswalk's near
 /// edge, the first speed edge at 0.5 m/s, the crash model, the competence check and the
-/// mode over the outcomes the model tells apart (digests recorded when that mode became
-/// the default; the agent's tables are those of the speed edge at 1.5 m/s: no training
-/// car drives between 0.5 and 1.5 m/s).
+/// mode over the outcomes the model tells apart, and the safest of the actions the model
+/// cannot tell from the chosen one (digests recorded when that tie-break became the
+/// default; the agent's tables are those of the speed edge at 1.5 m/s: no training car
+/// drives between 0.5 and 1.5 m/s).
 #[test]
 fn the_default_agent_decisions_are_recorded() {
     assert_eq!(default_digests(&ScaledParams::default()), GOLDEN_DEFAULT);
 }
 
-/// The default agent acting on the mode of the policy (`action_selection = mode`, the
-/// ablation) decides exactly as the default did before the mode over outcomes: the
-/// digests recorded when the speed edge at 0.5 m/s became the default.
+/// The default agent acting on the chosen action (`tie_break = chosen`, the ablation)
+/// decides exactly as the default did before the tie-break: the digests recorded when
+/// the mode over outcomes became the default.
+#[test]
+fn the_chosen_action_ablation_reproduces_the_default_of_before() {
+    let mut params = ScaledParams::default();
+    params.scaling.tie_break = TieBreak::Chosen;
+    assert_eq!(default_digests(&params), GOLDEN_DEFAULT_CHOSEN);
+}
+
+/// The default agent acting on the mode of the policy as chosen (`action_selection =
+/// mode`, `tie_break = chosen`, the ablations) decides exactly as the default did before
+/// the mode over outcomes: the digests recorded when the speed edge at 0.5 m/s became the
+/// default.
 #[test]
 fn the_policy_mode_ablation_reproduces_the_default_of_before() {
     let mut params = ScaledParams::default();
     params.scaling.action_selection = ActionSelection::Mode;
+    params.scaling.tie_break = TieBreak::Chosen;
     assert_eq!(default_digests(&params), GOLDEN_DEFAULT_POLICY_MODE);
 }
 
@@ -291,6 +305,15 @@ const GOLDEN_COMPETENCE: [&str; 4] = [
 
 /// Digests of [`the_default_agent_decisions_are_recorded`].
 const GOLDEN_DEFAULT: [&str; 4] = [
+    "9be644aee445c8c1",
+    "77b3c08e3a53320d",
+    "8abc2112411a7bf0",
+    "ac5c9162c63e333c",
+];
+
+/// Digests of [`the_chosen_action_ablation_reproduces_the_default_of_before`]: those of the
+/// default agent before the tie-break ([`GOLDEN_DEFAULT`] until then).
+const GOLDEN_DEFAULT_CHOSEN: [&str; 4] = [
     "9be644aee445c8c1",
     "2e6b2cd9a66dc19a",
     "e7b071d234a24639",

@@ -6,4 +6,5 @@ mod hand_worked;
 mod planning_root;
 mod properties;
 mod pymdp_crossval;
+mod tie_break;
 mod transition_cost;
