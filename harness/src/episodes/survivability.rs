@@ -4,7 +4,7 @@
 //!
 //! * **survivable**: [`Method::BrakeOnPedestrian`] succeeds in at least
 //!   [`SURVIVABLE_MIN_SUCCESS`] (99%) of the episodes, cruising at the car's top speed
-//!   and at each slower cruise of [`CAREFUL_CRUISE`] ([`careful_witness`]);
+//!   and at each slower cruise of [`careful_cruises`] ([`careful_witness`]);
 //! * **dangerous**: [`Method::NeverBrake`] succeeds in at most [`DANGEROUS_MAX_SUCCESS`]
 //!   (20%) of the episodes, the same bound the shipped maps put on Q-learning
 //!   (`(method: QLearning, max_success: 0.2)`): if a car that drives on gets through
@@ -13,9 +13,13 @@
 //! Why several cruise speeds: brake-on-pedestrian speeds up to the car's top speed, and
 //! pedestrians that step out by the car's time to arrival meet it at one timing. Searches
 //! found maps that it survives at the top speed and not 5 or 10% slower (in 16% to 78% of
-//! the episodes, EXPERIMENTS.md, "Fair or knife-edge"): such a map tests when the car
-//! happens to arrive, not whether it brakes for what it sees, and a careful driver that
-//! cruises a little slower dies there. A map is survivable when care alone suffices.
+//! the episodes, EXPERIMENTS.md, "Fair or knife-edge"), and maps it survives from 90% up
+//! but not cruising lower in the top speed bin (0% to 51% there, EXPERIMENTS.md, "Actions
+//! the model cannot tell apart"): such a map tests when the car happens to arrive, not
+//! whether it brakes for what it sees, and a careful driver that cruises a little slower
+//! dies there. The agent's states cannot tell one speed of the top bin from another, so
+//! every cruise in that bin is one it may hold. A map is survivable when care alone
+//! suffices.
 //!
 //! `check-map` measures both on every map with pedestrian rules; `batch` checks its
 //! brake-on-pedestrian and never-brake units. Both report the same warnings (returned
@@ -37,8 +41,30 @@ pub const SURVIVABLE_MIN_SUCCESS: f64 = 0.99;
 pub const DANGEROUS_MAX_SUCCESS: f64 = 0.2;
 
 /// The cruise speeds, as fractions of the car's top speed, at which brake-on-pedestrian
-/// must survive a map for it to count as survivable.
+/// must survive a map for it to count as survivable (with those of [`TOP_BIN_CRUISES`]).
 pub const CAREFUL_CRUISE: [f64; 3] = [1.0, 0.95, 0.9];
+
+/// Cruises spread evenly from the lower edge of the map's top speed bin up to (not
+/// including) the slowest of [`CAREFUL_CRUISE`], where that edge is below it.
+pub const TOP_BIN_CRUISES: usize = 4;
+
+/// Every careful cruise of `map`, as fractions of its top speed: [`CAREFUL_CRUISE`], then
+/// [`TOP_BIN_CRUISES`] cruises from the lower edge of the top speed bin (the last of
+/// `bins.speed_edges`) toward 90%: speeds the map's own states cannot tell from the top
+/// speed, so that a habit holding "maintain" anywhere in that bin is a careful cruise.
+pub fn careful_cruises(map: &Map) -> Vec<f64> {
+    let mut cruises = CAREFUL_CRUISE.to_vec();
+    let slowest = CAREFUL_CRUISE[CAREFUL_CRUISE.len() - 1];
+    let top = map.vehicle.max_speed;
+    if let Some(&edge) = map.bins.speed_edges.last()
+        && top > 0.0
+        && edge / top < slowest
+    {
+        let lo = edge / top;
+        cruises.extend((0..TOP_BIN_CRUISES).map(|k| lo + (slowest - lo) * k as f64 / TOP_BIN_CRUISES as f64));
+    }
+    cruises
+}
 
 /// Default episodes per witness in `check-map`.
 pub const DEFAULT_EPISODES: u64 = 100;
@@ -104,8 +130,8 @@ pub fn at_cruise(map: &Map, fraction: f64) -> Map {
     slower
 }
 
-/// brake-on-pedestrian's [`aggregate`](Aggregate) on `map` at each cruise of
-/// [`CAREFUL_CRUISE`], and the worst of them (the lowest success; the fastest cruise on a
+/// brake-on-pedestrian's [`aggregate`](Aggregate) on `map` at each of its
+/// [`careful_cruises`], and the worst of them (the lowest success; the fastest cruise on a
 /// tie): a map is survivable when this witness succeeds in at least
 /// [`SURVIVABLE_MIN_SUCCESS`]. Each cruise's episodes derive from `seed` as
 /// [`witness`]'s do.
@@ -116,7 +142,7 @@ pub fn careful_witness(
     progress: &dyn Progress,
 ) -> Result<(Witness, Aggregate), Error> {
     let mut worst: Option<(Witness, Aggregate)> = None;
-    for fraction in CAREFUL_CRUISE {
+    for fraction in careful_cruises(map) {
         let agg = Aggregate::of(&evaluate_scripted(
             &at_cruise(map, fraction),
             Method::BrakeOnPedestrian,
@@ -132,7 +158,7 @@ pub fn careful_witness(
             worst = Some((w, agg));
         }
     }
-    Ok(worst.expect("CAREFUL_CRUISE is not empty"))
+    Ok(worst.expect("CAREFUL_CRUISE is not empty, so neither are the careful cruises"))
 }
 
 /// The warnings for map `name` given what the witnesses measured (`None`: not run).
@@ -199,6 +225,26 @@ mod tests {
             warnings("m", Some(&slower), None)[0]
                 .contains("50.0% of 100 episodes cruising at 90% of the car's top speed")
         );
+    }
+
+    #[test]
+    fn the_careful_cruises_span_the_top_speed_bin() {
+        // Default bins (top edge 7.5 m/s), top speed 9 m/s: the bin starts at 5/6 of it,
+        // and four cruises reach from there toward 90% in steps of (0.9 - 5/6) / 4.
+        let mut map = Map::default();
+        map.vehicle.max_speed = 9.0;
+        map.bins.speed_edges = vec![0.5, 4.5, 7.5];
+        let want = [1.0, 0.95, 0.9, 7.5 / 9.0, 0.85, 26.0 / 30.0, 53.0 / 60.0];
+        let got = careful_cruises(&map);
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-12, "{got:?}");
+        }
+        // A top bin that starts at 90% of the top speed or above adds nothing.
+        map.vehicle.max_speed = 8.0;
+        assert_eq!(careful_cruises(&map), CAREFUL_CRUISE.to_vec());
+        map.bins.speed_edges.clear();
+        assert_eq!(careful_cruises(&map), CAREFUL_CRUISE.to_vec());
     }
 
     #[test]

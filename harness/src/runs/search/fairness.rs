@@ -3,7 +3,8 @@
 //! [`crate::episodes::survivability`], with its thresholds):
 //!
 //! * **survivable**: brake-on-pedestrian succeeds in at least 99% of the K episodes, at
-//!   the car's top speed and at each slower careful cruise (the worst of them,
+//!   the car's top speed and at each slower careful cruise, 95% and 90% of it and four
+//!   across the top speed bin (the worst of them,
 //!   [`careful_witness`](crate::episodes::survivability::careful_witness));
 //! * **dangerous**: never-brake fails in at least 80% of them (succeeds in at most 20%).
 //!
