@@ -5,7 +5,7 @@
 use std::path::Path;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::episodes::survivability::{careful_witness, witness};
+use unforeseen_harness::episodes::survivability::{CAREFUL_CRUISE, at_cruise, careful_witness, witness};
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::Shard;
 use unforeseen_harness::runs::search::{self, Fairness, SearchConfig, Space, Value, sobol_candidates};
@@ -330,6 +330,23 @@ fn a_map_survivable_only_at_top_speed_is_not_fair() {
     // The shipped jaywalk is survivable at every careful cruise.
     let (jay, _) = careful_witness(&jaywalk(), 20, 7, &NoProgress).expect("runs");
     assert!(jay.success_rate >= 0.99, "{jay:?}");
+}
+
+/// A map that brake-on-pedestrian survives from 90% of the car's top speed up but not
+/// cruising lower in the top speed bin (found by a search, maps/search/knife_edge/) is
+/// not survivable: the agent's states cannot tell those speeds from the top speed.
+#[test]
+fn a_map_survivable_only_high_in_the_top_speed_bin_is_not_fair() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps/search/knife_edge/top_speed_c0558.ron");
+    let map = unforeseen_harness::maps::load_file(&file).expect("a shipped map");
+    for fraction in CAREFUL_CRUISE {
+        let w = witness(&at_cruise(&map, fraction), Method::BrakeOnPedestrian, 20, 7).expect("runs");
+        assert!(w.success_rate >= 0.99, "{fraction}: {w:?}");
+    }
+    let (careful, _) = careful_witness(&map, 20, 7, &NoProgress).expect("runs");
+    let edge = map.bins.speed_edges.last().expect("speed bins") / map.vehicle.max_speed;
+    assert!(careful.success_rate < 0.5, "{careful:?}");
+    assert!((edge..0.9).contains(&careful.cruise), "{careful:?}");
 }
 
 #[test]
