@@ -245,7 +245,7 @@ mod tests {
         for (i, k) in names.iter().enumerate() {
             assert!(!names[..i].contains(k), "key {k} twice");
         }
-        assert_eq!(names.len(), 33);
+        assert_eq!(names.len(), 35);
         let p = ScaledParams::default();
         for k in keys() {
             if p.get(&k.name).unwrap().is_number() {
