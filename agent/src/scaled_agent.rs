@@ -448,20 +448,21 @@ impl<H: Habit> ScaledAgent<H> {
     /// `handback_horizon` ticks (the hand-back's crash risk, [`crate::handback`]); `chosen`
     /// where none is less likely.
     fn break_tie(&mut self, chosen: usize) -> usize {
-        let n = self.n_states;
         self.predict_all();
-        let tol = self.params.scaling.tie_tolerance;
-        let tied: Vec<usize> = (0..self.n_actions)
-            .filter(|&w| w != chosen && total_variation(&self.next_pred, n, chosen, w) <= tol)
-            .collect();
-        if tied.is_empty() {
-            return chosen;
+        let (n, tol) = (self.n_states, self.params.scaling.tie_tolerance);
+        let mut best: Option<(usize, f64)> = None;
+        for w in (0..self.n_actions).filter(|&w| w != chosen) {
+            if total_variation(&self.next_pred, n, chosen, w) > tol {
+                continue;
+            }
+            let so_far = match best {
+                Some(b) => b,
+                None => (chosen, self.held_crash_risk(chosen)),
+            };
+            let risk = self.held_crash_risk(w);
+            best = Some(if risk < so_far.1 { (w, risk) } else { so_far });
         }
-        let own = self.held_crash_risk(chosen);
-        tied.into_iter()
-            .map(|w| (w, self.held_crash_risk(w)))
-            .fold((chosen, own), |b, w| if w.1 < b.1 { w } else { b })
-            .0
+        best.map_or(chosen, |(a, _)| a)
     }
 
     fn select(&mut self, dist: &[f64]) -> usize {
