@@ -485,7 +485,7 @@ pub struct ScalingParams {
     pub max_scaling_iters: u32,
     /// Iterative or closed-form scaling.
     pub scaling_mode: ScalingMode,
-    /// Mode or sample.
+    /// Mode over outcomes, mode or sample.
     pub action_selection: ActionSelection,
     /// What happens to the actions the model cannot tell from the chosen one.
     pub tie_break: TieBreak,

@@ -104,7 +104,8 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     hist_declined: Vec<bool>,
     /// The competence check's scratch: one action per state, the held action's policy.
     held_policy: Vec<usize>,
-    /// [`ActionSelection::OutcomeMode`]'s scratch: `B[u] q_t` per action, `[u * n + s]`.
+    /// This tick's `B[u] q_t` per action, `[u * n + s]` ([`ScaledAgent::predict_all`]), for
+    /// [`ActionSelection::OutcomeMode`] and [`TieBreak::Safest`].
     next_pred: Vec<f64>,
     pred_scratch: Vec<f64>,
     final_obs: Option<usize>,
@@ -436,19 +437,18 @@ impl<H: Habit> ScaledAgent<H> {
     }
 
     /// [`ActionSelection::OutcomeMode`] on a reasoning tick: the mode of
-    /// `π̃(u) = Σ_w (1 - TV(B[u] q_t, B[w] q_t)) π'(w)` under the learned `B`, the policy
-    /// pooled over actions whose predicted next states overlap.
-    fn outcome_mode(&mut self, dist: &[f64]) -> usize {
-        self.predict_all();
+    /// `π̃(u) = Σ_w (1 - TV(B[u] q_t, B[w] q_t)) π'(w)` under the learned `B` (this tick's
+    /// predictions, [`ScaledAgent::predict_all`]), the policy pooled over actions whose
+    /// predicted next states overlap.
+    fn outcome_mode(&self, dist: &[f64]) -> usize {
         argmax(&pooled_over_outcomes(&self.next_pred, self.n_states, dist))
     }
 
-    /// [`TieBreak::Safest`]: among `chosen` and the actions whose predicted next states lie
-    /// within `tie_tolerance` of its own, the one least likely to crash when held for
-    /// `handback_horizon` ticks (the hand-back's crash risk, [`crate::handback`]); `chosen`
-    /// where none is less likely.
+    /// [`TieBreak::Safest`]: among `chosen` and the actions whose predicted next states
+    /// (this tick's, [`ScaledAgent::predict_all`]) lie within `tie_tolerance` of its own,
+    /// the one least likely to crash when held for `handback_horizon` ticks (the
+    /// hand-back's crash risk, [`crate::handback`]); `chosen` where none is less likely.
     fn break_tie(&mut self, chosen: usize) -> usize {
-        self.predict_all();
         let (n, tol) = (self.n_states, self.params.scaling.tie_tolerance);
         let mut best: Option<(usize, f64)> = None;
         for w in (0..self.n_actions).filter(|&w| w != chosen) {
@@ -660,17 +660,21 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             }
         }
         let pi = std::mem::take(&mut self.pi);
-        // On a reasoning tick, the mode over the outcomes the model tells apart (default).
-        let action = if reasoned && self.params.scaling.action_selection == ActionSelection::OutcomeMode {
+        // On a reasoning tick, the mode over the outcomes the model tells apart (default);
+        // on every tick, the safest of the actions the model cannot tell from the chosen
+        // one (default). Both read this tick's predictions, made once.
+        let outcome_mode = reasoned && self.params.scaling.action_selection == ActionSelection::OutcomeMode;
+        let safest = self.params.scaling.tie_break == TieBreak::Safest;
+        if outcome_mode || safest {
+            self.predict_all();
+        }
+        let action = if outcome_mode {
             self.outcome_mode(&pi)
         } else {
             self.select(&pi)
         };
         self.pi = pi;
-        let action = match self.params.scaling.tie_break {
-            TieBreak::Safest => self.break_tie(action),
-            TieBreak::Chosen => action,
-        };
+        let action = if safest { self.break_tie(action) } else { action };
         self.prev_one_hot = if self.q_cur[obs] == 1.0 { Some(obs) } else { None };
         self.hist_obs.push(obs);
         self.hist_act.push(action);
