@@ -9,7 +9,7 @@ use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::ProtocolChoice;
-use unforeseen_harness::reports::tables;
+use unforeseen_harness::runs::batch::table as tables;
 use unforeseen_harness::runs::batch::{AgentChoice, BatchRequest, ScenarioKind, Shard, SummaryRow, stream_learning};
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 

@@ -9,8 +9,8 @@ use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::protocol::ProtocolChoice;
-use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::batch::AgentChoice;
+use unforeseen_harness::runs::compare::table as tables;
 use unforeseen_harness::runs::compare::{COMPARE_FILES, CompareRequest};
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 

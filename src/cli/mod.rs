@@ -156,13 +156,9 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
 
 /// The exit code for an error (a library error, or an [`anyhow::Error`] as `&*err`): 2
 /// when it or anything in its chain of causes is input the user can fix
-/// ([`unforeseen_harness::user_input::in_chain`]), 1 otherwise.
+/// ([`unforeseen_harness::error::in_chain`]), 1 otherwise.
 pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
-    if unforeseen_harness::user_input::in_chain(err) {
-        2
-    } else {
-        1
-    }
+    if unforeseen_harness::error::in_chain(err) { 2 } else { 1 }
 }
 
 /// A failed command's message: the error and its causes (`outer: inner: ...`), with a

@@ -9,7 +9,7 @@ use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::reports::files::num;
+use unforeseen_harness::files::num;
 use unforeseen_harness::runs::trace::{TRACE_FILES, TraceReport, TraceRequest, mode, surprise_bits};
 
 /// Arguments of `trace`.

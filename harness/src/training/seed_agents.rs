@@ -10,9 +10,9 @@ use std::time::Instant;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_sim::Map;
 
+use crate::episodes::methods::check_compatible;
 use crate::error::Error;
 use crate::progress::{Message, Progress};
-use crate::training::agent_file::check_compatible;
 use crate::training::{TrainConfig, train_with_progress};
 
 /// Most training seeds one run accepts (each agent takes seconds to train).

@@ -18,9 +18,9 @@ use crate::episodes::methods::Method;
 use crate::episodes::protocol::{Protocol, ProtocolChoice};
 use crate::episodes::survivability::{Witness, warnings};
 use crate::error::Error;
+use crate::files::write_json;
 use crate::limits::{MAX_JOBS, check_episodes};
 use crate::progress::Progress;
-use crate::reports::files::write_json;
 use crate::runs::merge::summary_document;
 use crate::runs::outputs::{Guarded, Outputs};
 use crate::training::seed_agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
@@ -31,9 +31,10 @@ use super::plan::{BatchConfig, Plan};
 use super::result_line::ResultLine;
 use super::run::run_plan;
 use super::scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};
-use super::summary::{SummaryRow, summarize, summary_path};
+use super::summary::{SummaryRow, summarize};
 use super::sweep::{ParamSet, checked_sweep};
 use super::units::{DEFAULT_METHODS, Shard};
+use crate::runs::outputs::summary_path;
 
 /// Every choice of a batch run, with its defaults ([`BatchRequest::default`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -346,7 +347,7 @@ impl BatchRequest {
         }
         for s in &setup.scenarios {
             guard = match (&s.kind, &self.stream) {
-                (ScenarioKind::Stream(stream), Some(file)) => guard.stream("stream", file, stream),
+                (ScenarioKind::Stream(stream), Some(file)) => guard.stream("stream", file, &stream.files),
                 _ => guard.input("maps", &s.source),
             };
         }
@@ -415,7 +416,7 @@ pub struct BatchReport {
     pub summary: PathBuf,
     /// Expectations checked on the mean over training seeds.
     pub checked: usize,
-    /// One message per expectation failed ([`crate::reports::tables::expectation_failures`]).
+    /// One message per expectation failed ([`crate::runs::batch::table::expectation_failures`]).
     pub failures: Vec<String>,
     /// The survivability warnings of the maps, from their scripted references' lines
     /// ([`survivability_warnings`]).
@@ -473,7 +474,7 @@ impl BatchJob {
         )?;
         Ok(BatchReport {
             checked: rows.iter().map(|r| r.checks.len()).sum(),
-            failures: crate::reports::tables::expectation_failures(&rows),
+            failures: crate::runs::batch::table::expectation_failures(&rows),
             survivability: survivability_warnings(&self.setup.scenarios, &lines),
             lines,
             rows,

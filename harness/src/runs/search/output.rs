@@ -318,7 +318,7 @@ pub(super) fn write_all(cfg: &SearchConfig<'_>, out: &Path, outcome: &Outcome) -
         failures,
         rejected,
     };
-    crate::reports::files::write_json(&out.join(SUMMARY), &summary)?;
+    crate::files::write_json(&out.join(SUMMARY), &summary)?;
     Ok(summary)
 }
 
@@ -459,7 +459,7 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
     })?;
     text.push_str(&body);
     text.push('\n');
-    crate::reports::files::write_atomic(&path, text.as_bytes())?;
+    crate::files::write_atomic(&path, text.as_bytes())?;
     Ok(FailureReport {
         name: map.name.clone(),
         file: path,
