@@ -124,7 +124,7 @@ pub enum Error {
     },
     /// No map of that name or path, or a map that does not validate.
     #[error(transparent)]
-    Map(#[from] MapLookupError),
+    Map(#[from] unforeseen_sim::embedded::LookupError),
     /// A map file that does not validate (every diagnostic).
     #[error(transparent)]
     MapFile(#[from] unforeseen_sim::MapError),
@@ -259,7 +259,7 @@ impl Error {
 
 /// Whether `err` or anything in its chain of causes is input the user can fix: an
 /// [`Error`] for which [`Error::is_user_input`] holds, a map that cannot be found or
-/// loaded ([`MapLookupError`], [`unforeseen_sim::MapError`]) or a bad
+/// loaded ([`unforeseen_sim::embedded::LookupError`], [`unforeseen_sim::MapError`]) or a bad
 /// deployment stream ([`StreamError`]). The command line exits with 2 for these and the
 /// Python package raises `ValueError`; anything else is a failure of the machine or of a
 /// component.
@@ -267,7 +267,7 @@ pub fn in_chain(err: &(dyn std::error::Error + 'static)) -> bool {
     let mut cause = Some(err);
     while let Some(e) = cause {
         let bad_input = e.downcast_ref::<Error>().is_some_and(Error::is_user_input)
-            || e.is::<MapLookupError>()
+            || e.is::<unforeseen_sim::embedded::LookupError>()
             || e.is::<StreamError>()
             || e.is::<unforeseen_sim::MapError>();
         if bad_input {
@@ -288,24 +288,6 @@ pub struct EpisodeError {
     /// What the env refused.
     #[source]
     pub source: unforeseen_env::EnvError,
-}
-
-/// Why a map could not be had.
-#[derive(Debug, thiserror::Error)]
-pub enum MapLookupError {
-    /// Neither a readable file nor an embedded map of that name.
-    #[error(
-        "{arg}: no such map file, and no embedded map of that name (embedded maps: {names}); pass a path to a .ron map file"
-    )]
-    NotFound {
-        /// What the user passed.
-        arg: String,
-        /// The embedded names, comma separated.
-        names: String,
-    },
-    /// The file or embedded map did not validate (its diagnostics, printed once).
-    #[error(transparent)]
-    Invalid(#[from] unforeseen_sim::MapError),
 }
 
 /// A stream file that cannot be used.
@@ -352,6 +334,6 @@ pub enum StreamError {
         index: usize,
         /// Why the map could not be loaded.
         #[source]
-        source: MapLookupError,
+        source: unforeseen_sim::embedded::LookupError,
     },
 }

@@ -37,13 +37,13 @@
 //!   [`LearnRequest`](runs::learn::LearnRequest), [`TraceRequest`](runs::trace::TraceRequest)),
 //!   the same value from every front, whose planning owns defaults, checks, agents, the
 //!   output guard and identity, and whose job writes its files;
-//! * [`reports`]: result [`files`](reports::files) written atomically, SVG
-//!   [`figures`](reports::figures) and the HTML [`replay_page`](reports::replay_page) of
-//!   an episode.
+//! * [`reports`]: what the jobs render with: SVG [`figures`](reports::figures), the HTML
+//!   [`replay_page`](reports::replay_page) of an episode and printed
+//!   [`tables`](reports::tables).
 //!
-//! Shared by all of them: [`maps`] finds a map by path or by embedded name,
+//! Shared by all of them: [`files`] are written atomically, [`maps`] finds a map by path or by embedded name,
 //! [`overrides`] applies `KEY=VALUE` parameter overrides, [`limits`] bounds what one
-//! run may ask for, [`seeds`] derives seeds,
+//! run may ask for (seeds derive in [`unforeseen_env::seeds`]),
 //! [`stats`] summarizes over seeds (mean, 95% Student-t interval, range, worst seed),
 //! [`error`] is the typed error every public function returns (and tells
 //! which are input the user can fix), and [`progress`] is how
@@ -62,6 +62,5 @@ pub mod overrides;
 pub mod progress;
 pub mod reports;
 pub mod runs;
-pub mod seeds;
 pub mod stats;
 pub mod training;

@@ -146,7 +146,7 @@ static PARSED: Mutex<Option<HashMap<String, Agent>>> = Mutex::new(None);
 const MAX_PARSED: usize = 16;
 
 pub(crate) fn parse_agent(text: &[u8]) -> PyResult<Agent> {
-    let key = unforeseen_harness::seeds::content_hash(text);
+    let key = unforeseen_env::seeds::content_hash(text);
     let mut parsed = PARSED.lock().unwrap_or_else(|e| e.into_inner());
     let map = parsed.get_or_insert_with(HashMap::new);
     if let Some(a) = map.get(&key) {

@@ -242,7 +242,7 @@ pub struct AgentArgs {
     #[arg(long = "set", value_name = "KEY=VALUE", help = unforeseen_harness::overrides::help())]
     pub set: Vec<String>,
     /// Run seed: the evaluation episodes and, without `--agent`, the training run derive from it.
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = unforeseen_env::seeds::DEFAULT_SEED)]
     pub seed: u64,
     /// No progress bars.
     #[arg(long, short)]
@@ -349,5 +349,41 @@ pub fn warn_replacing(dir: &std::path::Path, names: &[&str]) {
             existing.join(", "),
             dir.display()
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use unforeseen_harness::runs::compare::CompareRequest;
+    use unforeseen_harness::runs::evaluate::EvalRequest;
+    use unforeseen_harness::runs::learn::LearnRequest;
+    use unforeseen_harness::runs::trace::TraceRequest;
+
+    fn command(args: &[&str]) -> Command {
+        Cli::parse_from(args).command.expect("a command")
+    }
+
+    /// The flags' defaults are the requests' (batch and search check theirs beside their
+    /// arguments), and `cargo run` with no command runs compare's defaults.
+    #[test]
+    fn the_flags_defaults_are_the_requests() {
+        let Command::Compare(compare) = command(&["unforeseen", "compare"]) else {
+            panic!("not compare")
+        };
+        assert_eq!(compare.request(), CompareRequest::default());
+        assert_eq!(compare::CompareArgs::default().request(), CompareRequest::default());
+        let Command::Eval(eval) = command(&["unforeseen", "eval"]) else {
+            panic!("not eval")
+        };
+        assert_eq!(eval.request(), EvalRequest::default());
+        let Command::Learn(learn) = command(&["unforeseen", "learn"]) else {
+            panic!("not learn")
+        };
+        assert_eq!(learn.request(), LearnRequest::default());
+        let Command::Trace(trace) = command(&["unforeseen", "trace"]) else {
+            panic!("not trace")
+        };
+        assert_eq!(trace.request(), TraceRequest::default());
     }
 }

@@ -17,7 +17,7 @@ use crate::episodes::protocol::Protocol;
 use crate::episodes::runner::{EpisodeResult, EpisodeSeeds, run_episode};
 use crate::error::Error;
 use crate::progress::Progress;
-use crate::seeds::episode_seed;
+use unforeseen_env::seeds::episode_seed;
 
 /// Seeds of evaluation episode `episode` of `method` on `map`: the world seed depends
 /// on the map and episode only (every method meets the same pedestrians), the

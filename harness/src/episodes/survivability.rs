@@ -21,8 +21,9 @@
 //! every cruise in that bin is one it may hold. A map is survivable when care alone
 //! suffices.
 //!
-//! `check-map` measures both on every map with pedestrian rules; `batch` checks its
-//! brake-on-pedestrian and never-brake units. Both report the same warnings (returned
+//! `check-map` measures both on every map with pedestrian rules; `batch` on the maps where
+//! it ran brake-on-pedestrian and never-brake, with the careful cruises at its own
+//! episodes and seed. Both report the same warnings (returned
 //! here; the command line prints them on stderr) and neither changes the exit code. Episodes use [`crate::episodes::evaluation::eval_seeds`], so `check-map
 //! --seed S` and `batch --seed S` meet the same pedestrians and report the same figures.
 

@@ -58,13 +58,13 @@ pub struct EvalRequest {
 impl Default for EvalRequest {
     fn default() -> Self {
         EvalRequest {
-            map: "jaywalk".to_string(),
+            map: crate::maps::DEFAULT_TEST_MAP.to_string(),
             stream: None,
             method: Method::Scaled,
-            episodes: 100,
+            episodes: crate::limits::DEFAULT_EPISODES,
             protocol: Protocol::ZeroShot,
             sets: Vec::new(),
-            seed: 7,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/eval")),
             agent: None,
         }

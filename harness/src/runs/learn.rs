@@ -54,11 +54,11 @@ pub struct LearnRequest {
 impl Default for LearnRequest {
     fn default() -> Self {
         LearnRequest {
-            map: "jaywalk".to_string(),
+            map: crate::maps::DEFAULT_TEST_MAP.to_string(),
             stream: None,
             episodes: 50,
             sets: Vec::new(),
-            seed: 7,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/learn")),
             agent: None,
         }

@@ -46,7 +46,7 @@ use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::Protocol;
 use crate::episodes::runner::{EpisodeResult, run_episode};
 use crate::progress::Progress;
-use crate::seeds::episode_seed;
+use unforeseen_env::seeds::episode_seed;
 
 /// Largest stream file read (bytes).
 const MAX_BYTES: u64 = 1 << 20;

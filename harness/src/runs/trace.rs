@@ -64,12 +64,12 @@ pub struct TraceRequest {
 impl Default for TraceRequest {
     fn default() -> Self {
         TraceRequest {
-            map: "jaywalk".to_string(),
+            map: crate::maps::DEFAULT_TEST_MAP.to_string(),
             method: Method::Scaled,
             episode: 0,
             protocol: Protocol::ZeroShot,
             sets: Vec::new(),
-            seed: 7,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/trace")),
             html: None,
             agent: None,

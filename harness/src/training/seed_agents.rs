@@ -146,7 +146,7 @@ pub fn cache_key(map: &Map, cfg: &TrainConfig) -> Result<String, Error> {
         "code": env!("UNFORESEEN_TRAINING_FINGERPRINT"),
     });
     let text = serde_json::to_string(&parts)?;
-    Ok(format!("{:016x}", crate::seeds::episode_seed(0, &text, 0)))
+    Ok(format!("{:016x}", unforeseen_env::seeds::episode_seed(0, &text, 0)))
 }
 
 /// Where the cache keeps that agent: `DIR/<map>-seed<S>-<episodes>ep-<key>.ron`.

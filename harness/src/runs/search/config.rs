@@ -95,7 +95,7 @@ impl SearchConfig<'_> {
 
     /// The run's identity (the first line of `candidates.jsonl`).
     pub fn identity(&self) -> SearchIdentity {
-        let hash = |s: &str| crate::seeds::content_hash(s.as_bytes());
+        let hash = |s: &str| unforeseen_env::seeds::content_hash(s.as_bytes());
         SearchIdentity {
             program: format!(
                 "unforeseen {} (code {})",
