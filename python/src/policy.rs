@@ -27,10 +27,10 @@ use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_discretizer::Discretizer;
 use unforeseen_env::{EnvConfig, Observation, ObservationForm};
 use unforeseen_harness::error::Error;
-use unforeseen_harness::runs::outside_methods::{ExternalMethod, ExternalRun, LinePlace, evaluate_external};
 use unforeseen_harness::limits::check_episodes;
 use unforeseen_harness::progress::{Message, Progress};
 use unforeseen_harness::runs::batch::load_scenarios;
+use unforeseen_harness::runs::outside_methods::{ExternalMethod, ExternalRun, LinePlace, evaluate_external};
 
 use crate::errors;
 use crate::wrapper::{Habit, PyScaledHabitAgent, Wrapped};

@@ -12,9 +12,9 @@ use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use serde_json::{Map, Value};
 use unforeseen_harness::reports::tables::Document;
 use unforeseen_harness::runs::batch::table::{batch_summary, expectation_failures};
-use unforeseen_harness::runs::compare::table::compare;
 use unforeseen_harness::runs::batch::{ResultLine, summarize};
 use unforeseen_harness::runs::compare::CompareReport;
+use unforeseen_harness::runs::compare::table::compare;
 use unforeseen_harness::runs::evaluate::EvalOutcome;
 
 use crate::errors;

@@ -30,8 +30,8 @@ use unforeseen_harness::training::{TimeoutAs, TrainConfig};
 
 use crate::agent::PyAgent;
 use crate::errors;
-use crate::requests::request;
 use crate::reports::BatchResult;
+use crate::requests::request;
 
 pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
     unforeseen_harness::limits::check_episodes(what, n).map_err(errors::to_py)?;
