@@ -12,7 +12,7 @@ import os, re, sys
 root = sys.argv[1]
 crates = {'unforeseen': 'src', 'harness': 'harness/src', 'sim': 'sim/src', 'agent': 'agent/src', 'discretizer': 'discretizer/src', 'env': 'env/src', 'python': 'python/src'}
 # The harness's floors, lowest first: each entry is a module or a folder (every module
-# under it). The output guard sits below the jobs it guards.
+# under it). The output guard sits below the jobs it guards; the tests' fixtures on top.
 FLOORS = {'harness': [
     ['error', 'files', 'progress', 'limits', 'stats'],
     ['maps', 'overrides', 'episodes'],
@@ -20,6 +20,7 @@ FLOORS = {'harness': [
     ['reports'],
     ['runs::outputs'],
     ['runs'],
+    ['fixtures'],
 ]}
 def floor_of(floors, module):
     best, depth = None, -1

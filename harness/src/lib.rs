@@ -56,6 +56,8 @@
 pub mod episodes;
 pub mod error;
 pub mod files;
+#[cfg(feature = "fixtures")]
+pub mod fixtures;
 pub mod limits;
 pub mod maps;
 pub mod overrides;

@@ -3,6 +3,7 @@
 //! concatenate into the unsharded file.
 
 use crate::common;
+use unforeseen_harness::fixtures;
 
 use std::path::Path;
 use std::sync::OnceLock;
@@ -22,7 +23,7 @@ fn scenarios() -> Vec<Scenario> {
 /// The shared test agent (training seed 7).
 fn agents() -> &'static [Agent] {
     static AGENTS: OnceLock<Vec<Agent>> = OnceLock::new();
-    AGENTS.get_or_init(|| vec![Agent::from_bundle(common::bundle().clone())])
+    AGENTS.get_or_init(|| vec![Agent::from_bundle(fixtures::bundle().clone())])
 }
 
 fn config<'a>(scenarios: &'a [Scenario], params: &'a [ParamSet], jobs: usize, shard: Option<Shard>) -> BatchConfig<'a> {
@@ -236,7 +237,7 @@ fn expectations_pass_and_fail_as_declared() {
 fn the_cli_fails_when_an_expectation_fails_and_names_it() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("agent.ron");
-    unforeseen_harness::training::agent_file::save(&agent, common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, fixtures::bundle()).unwrap();
     let jay = Path::new(env!("CARGO_MANIFEST_DIR")).join("maps").join("jaywalk.ron");
     let map = dir.path().join("impossible.ron");
     std::fs::write(

@@ -9,7 +9,7 @@
 //! is refused as bad input (exit code 2) with a message naming the file, the field and
 //! the fix; a few go through the command line of each command that reads agents.
 
-use crate::common;
+use unforeseen_harness::fixtures;
 
 use std::path::Path;
 use std::process::Command;
@@ -68,7 +68,7 @@ struct Case {
 }
 
 fn corpus() -> Vec<Case> {
-    let t = common::tiny_agent_text();
+    let t = fixtures::tiny_agent_text();
     let q = ["q_learning: ("];
     let wm = ["world_model: ("];
     let b = ["bayes_rl: ("];
@@ -267,7 +267,7 @@ fn corpus() -> Vec<Case> {
 
 #[test]
 fn every_damaged_agent_file_is_refused_naming_the_field() {
-    let valid = common::tiny_agent_text();
+    let valid = fixtures::tiny_agent_text();
     let path = Path::new("agent.ron");
     unforeseen_harness::training::agent_file::parse(path, valid).expect("the undamaged agent loads");
     let cases = corpus();
@@ -292,7 +292,7 @@ fn every_damaged_agent_file_is_refused_naming_the_field() {
 fn commands_refuse_damaged_agent_files_with_exit_code_2() {
     let dir = tempfile::tempdir().unwrap();
     let map = dir.path().join("tiny.ron");
-    std::fs::write(&map, common::TINY_MAP).unwrap();
+    std::fs::write(&map, fixtures::TINY_MAP).unwrap();
     let m = map.to_str().unwrap();
     let cases = corpus();
     let pick = |name: &str| cases.iter().find(|c| c.name == name).unwrap();
@@ -335,7 +335,7 @@ fn commands_refuse_damaged_agent_files_with_exit_code_2() {
 fn export_model_never_writes_null() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("tiny_agent.ron");
-    std::fs::write(&agent, common::tiny_agent_text()).unwrap();
+    std::fs::write(&agent, fixtures::tiny_agent_text()).unwrap();
     let model = dir.path().join("model.json");
     let out = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
         .args(["export-model", "--obs", "1,1,1,1", "--agent"])

@@ -64,7 +64,7 @@ fn search_never_replaces_an_input_inside_its_out() {
     assert_eq!(read(&map), read(Path::new("maps/jaywalk.ron")));
     // An agent file at the summary's name.
     let agent = out.join("summary.json");
-    unforeseen_harness::training::agent_file::save(&agent, super::common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, unforeseen_harness::fixtures::bundle()).unwrap();
     let before = read(&agent);
     let r = search(&out, &["--agent", agent.to_str().unwrap()]);
     assert_exit(&r, 2, &["--agent"]);
@@ -239,7 +239,7 @@ fn a_streams_maps_are_inputs() {
     assert_eq!(read(&out.join("eval.json")), read(Path::new("maps/crowd.ron")));
     // learn --stream with a map at OUT/learn.csv (learn needs a real agent).
     let agent = d.path().join("agent.ron");
-    unforeseen_harness::training::agent_file::save(&agent, super::common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, unforeseen_harness::fixtures::bundle()).unwrap();
     let out = d.path().join("le");
     std::fs::create_dir_all(&out).unwrap();
     std::fs::copy("maps/crowd.ron", out.join("learn.csv")).unwrap();

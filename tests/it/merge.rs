@@ -2,8 +2,9 @@
 //! writes (timing aside); missing, duplicated and foreign shards are refused, naming the
 //! units or the differences.
 
-use crate::common::{TINY_MAP, assert_exit, run_cli, tiny_agent_text};
+use crate::common::{assert_exit, run_cli};
 use std::path::{Path, PathBuf};
+use unforeseen_harness::fixtures::{TINY_MAP, tiny_agent_text};
 use unforeseen_harness::runs::batch::{ResultLine, read_lines};
 use unforeseen_harness::runs::outputs::summary_path;
 

@@ -3,11 +3,11 @@
 //! point agrees with the text one, `scaling_mode=closed-form` reaches the closed form of
 //! Theorem 1, and a sweep counts equal values once.
 
-use crate::common;
 use serde_json::{Value, json};
 use unforeseen_agent::controller::Controller;
 use unforeseen_agent::param_table;
 use unforeseen_agent::params::{ScaledParams, ScalingMode};
+use unforeseen_harness::fixtures;
 use unforeseen_harness::overrides::{apply, keys, set_one, set_value};
 use unforeseen_harness::runs::batch::sweep;
 
@@ -103,7 +103,7 @@ fn unknown_keys_and_bad_values_name_the_key_and_the_allowed_values() {
 /// from the model, naming the key and the model's factors.
 #[test]
 fn factor_names_are_checked_against_the_model() {
-    let bundle = common::bundle();
+    let bundle = fixtures::bundle();
     let p = apply(ScaledParams::default(), &["gate_factor=x".into()]).unwrap();
     let e = unforeseen_harness::episodes::methods::scaled_agent(bundle, p)
         .unwrap_err()
@@ -129,7 +129,7 @@ fn scaling_mode_closed_form_reaches_the_closed_form_and_acts() {
     )
     .unwrap();
     assert_eq!(p.scaling.scaling_mode, ScalingMode::ClosedForm);
-    let bundle = common::bundle();
+    let bundle = fixtures::bundle();
     let mut agent = unforeseen_harness::episodes::methods::scaled_agent(bundle, p).unwrap();
     let n = bundle.world_model.n_states();
     agent.begin_episode(3);

@@ -23,7 +23,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::svg_text::assert_text_fits;
+use unforeseen_harness::fixtures::svg_text::assert_text_fits;
 
 /// Training episodes at most for `compare`.
 const TRAIN: u64 = 100;

@@ -8,9 +8,10 @@ use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::metrics::Aggregate;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::episodes::rewards::{entered_bins, red_light_cost, state_rewards};
+use unforeseen_harness::fixtures;
 use unforeseen_harness::runs::batch::check_expectations;
 
-use crate::common::{self, assert_exit, run_cli};
+use crate::common::{assert_exit, run_cli};
 
 fn shipped(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("maps").join(rel)
@@ -73,7 +74,7 @@ fn maps_without_the_rule_or_without_the_edge_keep_the_papers_preferences() {
     }
     // The rule with the paper's edges: d = 1 holds 4 m before the crosswalk, so no state
     // says the car has entered, and R(s) stays the rule-free one bit for bit.
-    let mut map = common::papers_bins("intersection");
+    let mut map = fixtures::papers_bins("intersection");
     let disc = Discretizer::new(&map).unwrap();
     let free = state_rewards(&map, &disc);
     map.reward.red_light = -100.0;

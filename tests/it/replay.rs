@@ -3,8 +3,7 @@
 //! figures as `trace.csv`, and keeps the SVG filmstrip beside it.
 
 use std::process::Command;
-
-use crate::common;
+use unforeseen_harness::fixtures;
 
 /// The JSON the page embeds for its script.
 fn embedded_episode(page: &str) -> serde_json::Value {
@@ -18,7 +17,7 @@ fn embedded_episode(page: &str) -> serde_json::Value {
 fn trace_html_is_self_contained_and_carries_every_tick() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("agent.ron");
-    unforeseen_harness::training::agent_file::save(&agent, common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, fixtures::bundle()).unwrap();
     let html = dir.path().join("replay").join("episode.html");
     let out = Command::new(env!("CARGO_BIN_EXE_unforeseen"))
         .args(["trace", "--map", "jaywalk", "--seed", "11", "-q", "--agent"])
@@ -103,7 +102,7 @@ fn trace_html_is_self_contained_and_carries_every_tick() {
 fn names_in_the_page_cannot_end_its_script() {
     let map = unforeseen_harness::maps::load("jaywalk").unwrap();
     let (_, ticks) = unforeseen_harness::episodes::trace::trace(
-        common::bundle(),
+        fixtures::bundle(),
         &Default::default(),
         unforeseen_harness::episodes::methods::Method::QLearning,
         &map,
@@ -133,7 +132,7 @@ fn names_in_the_page_cannot_end_its_script() {
 fn the_replay_marks_the_tick_that_ran_the_red_light() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("agent.ron");
-    unforeseen_harness::training::agent_file::save(&agent, common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, fixtures::bundle()).unwrap();
     let html = dir.path().join("episode.html");
     let map = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("maps/red_light/red_on_approach.ron");
     let out = Command::new(env!("CARGO_BIN_EXE_unforeseen"))

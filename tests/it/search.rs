@@ -12,7 +12,8 @@ use unforeseen_harness::runs::search::{self, Fairness, SearchConfig, Space, Valu
 use unforeseen_harness::training::seed_agents::Agent;
 use unforeseen_sim::Map;
 
-use crate::common::{assert_exit, bundle, run_cli};
+use crate::common::{assert_exit, run_cli};
+use unforeseen_harness::fixtures::bundle;
 
 fn jaywalk() -> Map {
     unforeseen_harness::maps::load("jaywalk").expect("embedded jaywalk")

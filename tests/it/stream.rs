@@ -3,7 +3,8 @@
 //! `--jobs`, shards merge into the whole and `--resume` completes a cut file; `learn`
 //! names each episode's map; bad streams and `--stream` with maps exit 2 writing nothing.
 
-use crate::common::{self, assert_exit, run_cli};
+use crate::common::{assert_exit, run_cli};
+use unforeseen_harness::fixtures;
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -25,7 +26,7 @@ fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
     )
     .unwrap();
     let agent = dir.join("agent.ron");
-    unforeseen_harness::training::agent_file::save(&agent, common::bundle()).unwrap();
+    unforeseen_harness::training::agent_file::save(&agent, fixtures::bundle()).unwrap();
     (stream, agent)
 }
 
@@ -137,7 +138,7 @@ fn batch_per_map_figures_are_those_of_eval_stream_and_the_summary_is_per_map() {
 /// The shared test agent, for the library's batch.
 fn agents() -> &'static [Agent] {
     static AGENTS: OnceLock<Vec<Agent>> = OnceLock::new();
-    AGENTS.get_or_init(|| vec![Agent::from_bundle(common::bundle().clone())])
+    AGENTS.get_or_init(|| vec![Agent::from_bundle(fixtures::bundle().clone())])
 }
 
 fn without_timing(lines: Vec<ResultLine>) -> Vec<ResultLine> {

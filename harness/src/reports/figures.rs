@@ -5,7 +5,7 @@
 //! Every key (legend) is drawn outside the plotting area, beside or above it, so it
 //! never covers data; text is laid out from a generous estimate of its width
 //! ([`text_width`]), and the integration tests check every figure for overlapping or
-//! clipped text (`tests/it/figures.rs`).
+//! clipped text (`harness/tests/it/figures.rs`).
 
 use plotters::coord::Shift;
 use plotters::prelude::*;

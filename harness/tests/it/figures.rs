@@ -7,12 +7,12 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::episodes::trace::trace;
+use unforeseen_harness::fixtures;
 use unforeseen_harness::reports::figures::{
     BarPanel, BarRow, Series, bar_key, filmstrip, grouped_bars, line_panels, theta_trace,
 };
 
-use crate::common;
-use crate::svg_text::assert_text_fits;
+use unforeseen_harness::fixtures::svg_text::assert_text_fits;
 
 #[test]
 fn theta_traces_of_short_and_long_episodes_fit() {
@@ -129,7 +129,7 @@ fn filmstrips_of_real_episodes_fit() {
     let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     for method in [Method::Scaled, Method::QLearning] {
         let (_, ticks) = trace(
-            common::bundle(),
+            fixtures::bundle(),
             &ScaledParams::default(),
             method,
             &jaywalk,
@@ -153,9 +153,7 @@ fn filmstrips_of_real_episodes_fit() {
 
 #[test]
 fn the_committed_figures_fit() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("docs")
-        .join("figures");
+    let dir = unforeseen_harness::fixtures::repo_path("docs/figures");
     let mut checked = 0;
     for entry in std::fs::read_dir(&dir).unwrap().flatten() {
         if entry.path().extension().is_some_and(|e| e == "svg") {

@@ -13,7 +13,6 @@
 //! of these 40 episodes (EXPERIMENTS.md, "The safe hand-back"). The default
 //! (`decline-learned`) never reasons with nobody on the crosswalk.
 
-use std::path::Path;
 use std::sync::OnceLock;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
@@ -22,10 +21,9 @@ use unforeseen_harness::episodes::evaluation::{eval_seeds, evaluate_under};
 use unforeseen_harness::episodes::methods::{Method, scaled_agent};
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::episodes::runner::{EpisodeResult, run_episode};
+use unforeseen_harness::fixtures;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
-
-use crate::common;
 
 /// The agent `unforeseen train --seed 7` writes.
 fn full_agent() -> &'static AgentBundle {
@@ -41,7 +39,7 @@ fn full_agent() -> &'static AgentBundle {
 const EPISODES: u64 = 40;
 
 fn crowd() -> unforeseen_sim::Map {
-    unforeseen_harness::maps::load_file(Path::new("maps/crowd.ron")).expect("maps/crowd.ron")
+    unforeseen_harness::maps::load_file(&fixtures::repo_path("maps/crowd.ron")).expect("maps/crowd.ron")
 }
 
 fn run(bundle: &AgentBundle, method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<EpisodeResult> {
@@ -75,7 +73,7 @@ fn check_learning_loses_nothing(bundle: &AgentBundle) {
 
 #[test]
 fn learning_loses_no_crowd_episode_that_the_test_agent_without_learning_survives() {
-    check_learning_loses_nothing(common::bundle());
+    check_learning_loses_nothing(fixtures::bundle());
 }
 
 #[test]
@@ -100,7 +98,7 @@ fn continual_ticks_with(
     for (key, value) in settings {
         params.set_str(key, value).unwrap();
     }
-    let mut agent = scaled_agent(common::bundle(), params).unwrap();
+    let mut agent = scaled_agent(fixtures::bundle(), params).unwrap();
     let mut env = Env::new(map, EnvConfig::default()).unwrap();
     (0..episodes)
         .map(|ep| {
@@ -159,8 +157,9 @@ fn empty_road_reasoning(map: &str, settings: &[(&str, &str)]) -> usize {
 /// run a red (docs/ARCHITECTURE.md §4.11).
 #[test]
 fn decline_learned_never_reasons_on_an_empty_road() {
+    let slow_walker = fixtures::repo_path("maps/slow_walker.ron").display().to_string();
     for crash in ["hazard", "states"] {
-        for map in ["intersection", "maps/slow_walker.ron"] {
+        for map in ["intersection", slow_walker.as_str()] {
             let settings = [
                 ("handback", "decline-learned"),
                 ("crash_model", crash),
@@ -174,5 +173,5 @@ fn decline_learned_never_reasons_on_an_empty_road() {
         ("crash_model", "states"),
         ("competence", "surprise-only"),
     ];
-    assert!(empty_road_reasoning("maps/slow_walker.ron", &settings) > 0);
+    assert!(empty_road_reasoning(&slow_walker, &settings) > 0);
 }

@@ -2,7 +2,7 @@
 //! seed, Q-learning drives on and hits the pedestrian; the scaled agent notices the
 //! surprise, reasons, and avoids it.
 
-use crate::common;
+use unforeseen_harness::fixtures;
 
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
@@ -16,7 +16,7 @@ use unforeseen_harness::progress::NoProgress;
 
 #[test]
 fn scaled_avoids_the_jaywalker_that_q_learning_hits() {
-    let bundle = common::bundle();
+    let bundle = fixtures::bundle();
     let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let params = ScaledParams::default();
 
@@ -60,7 +60,7 @@ fn scaled_avoids_the_jaywalker_that_q_learning_hits() {
 /// and learning never costs a crash.
 #[test]
 fn test_time_learning_makes_the_jaywalk_familiar_without_a_crash() {
-    let bundle = common::bundle();
+    let bundle = fixtures::bundle();
     let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let points = learn(bundle, &ScaledParams::default(), &jaywalk, 30, 3, &NoProgress).unwrap();
     let (first, last) = (&points[0], points.last().unwrap());
@@ -77,7 +77,7 @@ fn test_time_learning_makes_the_jaywalk_familiar_without_a_crash() {
 
 #[test]
 fn over_a_few_episodes_scaled_beats_q_learning_on_the_jaywalk() {
-    let bundle = common::bundle();
+    let bundle = fixtures::bundle();
     let jaywalk = unforeseen_harness::maps::load("jaywalk").unwrap();
     let params = ScaledParams::default();
     let run = |m: Method| {
@@ -96,7 +96,7 @@ fn over_a_few_episodes_scaled_beats_q_learning_on_the_jaywalk() {
 /// at index N: the same outcome, return and reasoning as `evaluate`'s N-th episode.
 #[test]
 fn a_traced_continual_episode_is_the_one_a_continual_run_meets() {
-    let bundle = common::bundle();
+    let bundle = fixtures::bundle();
     let map = unforeseen_harness::maps::load("stop_midway").unwrap();
     let params = ScaledParams::default();
     let mut agent = Method::Scaled.controller(bundle, &params, &map).unwrap();
@@ -116,7 +116,7 @@ fn a_traced_continual_episode_is_the_one_a_continual_run_meets() {
 /// habit does what reasoning chose, and learning causes no crash.
 #[test]
 fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
-    let bundle = common::bundle();
+    let bundle = fixtures::bundle();
     let map = unforeseen_harness::maps::load("jaywalk_late").unwrap();
     let reasoning = |params: &ScaledParams| {
         let points = learn(bundle, params, &map, 30, 3, &NoProgress).unwrap();
@@ -156,9 +156,9 @@ fn scaled_waits_for_the_slow_walker() {
     let map = unforeseen_harness::maps::load("slow_walker").unwrap();
     let mut states = ScaledParams::default();
     states.planning.crash_model = unforeseen_agent::params::CrashPlanning::States;
-    assert_eq!(success(common::bundle(), &map, &ScaledParams::default()), 1.0);
-    assert_eq!(success(common::bundle(), &map, &states), 1.0);
-    let (papers, papers_map) = (common::papers_bundle(), common::papers_bins("slow_walker"));
+    assert_eq!(success(fixtures::bundle(), &map, &ScaledParams::default()), 1.0);
+    assert_eq!(success(fixtures::bundle(), &map, &states), 1.0);
+    let (papers, papers_map) = (fixtures::papers_bundle(), fixtures::papers_bins("slow_walker"));
     assert_eq!(success(papers, &papers_map, &states), 1.0);
     let mut absorbing = states;
     absorbing.planning.root_step = unforeseen_agent::params::RootStep::Absorbing;

@@ -8,7 +8,6 @@
 //! When a change is meant to alter behaviour, the new digests are printed by the failing
 //! assertion; update them in the same commit and say why in its message.
 
-use crate::common;
 use std::fmt::Write;
 use unforeseen_agent::params::{ActionSelection, CompetenceCheck, CrashPlanning, ScaledParams, TieBreak};
 use unforeseen_agent::persist::AgentBundle;
@@ -17,6 +16,7 @@ use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::episodes::runner::{EpisodeResult, Tick};
 use unforeseen_harness::episodes::trace::trace;
+use unforeseen_harness::fixtures;
 use unforeseen_harness::training::{TimeoutAs, train};
 
 fn bits(x: f64) -> String {
@@ -116,7 +116,7 @@ fn noisy_jaywalk(papers: bool) -> unforeseen_sim::Map {
     };
     let mut map = unforeseen_sim::Map::from_str_named("noisy_jaywalk.ron", text, &embedded).expect("valid map");
     if papers {
-        let papers = common::papers_bins("jaywalk").bins;
+        let papers = fixtures::papers_bins("jaywalk").bins;
         map.bins.distance_edges = papers.distance_edges;
         map.bins.speed_edges = papers.speed_edges;
     }
@@ -147,8 +147,8 @@ fn digests(bundle: &AgentBundle) -> [String; 4] {
 fn papers_digests(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
     [
         agent_digest(bundle),
-        episodes_digest(bundle, &common::papers_bins("intersection"), params),
-        episodes_digest(bundle, &common::papers_bins("jaywalk"), params),
+        episodes_digest(bundle, &fixtures::papers_bins("intersection"), params),
+        episodes_digest(bundle, &fixtures::papers_bins("jaywalk"), params),
         episodes_digest(bundle, &noisy_jaywalk(true), params),
     ]
 }
@@ -159,7 +159,10 @@ fn papers_digests(bundle: &AgentBundle, params: &ScaledParams) -> [String; 4] {
 fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
     let mut params = papers_agent();
     params.set_str("handback", "theta").unwrap();
-    assert_eq!(papers_digests(common::papers_bundle(), &params), GOLDEN_THETA_HANDBACK);
+    assert_eq!(
+        papers_digests(fixtures::papers_bundle(), &params),
+        GOLDEN_THETA_HANDBACK
+    );
 }
 
 /// Training with time-outs taken as terminal states reproduces the agent, and every
@@ -167,9 +170,9 @@ fn the_theta_handback_ablation_reproduces_the_decisions_of_before() {
 /// recorded on that code.
 #[test]
 fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
-    let mut cfg = common::small_config(7);
+    let mut cfg = fixtures::small_config(7);
     cfg.timeout_as = TimeoutAs::Termination;
-    let (bundle, _) = train(&common::papers_bins("intersection"), &cfg).unwrap();
+    let (bundle, _) = train(&fixtures::papers_bins("intersection"), &cfg).unwrap();
     assert_eq!(digests(&bundle), GOLDEN_TIMEOUT_AS_TERMINATION);
 }
 
@@ -179,9 +182,9 @@ fn timeouts_as_terminal_reproduce_the_agents_and_decisions_of_before() {
 /// with the paper's edges and as the paper's agent it decides as before.
 #[test]
 fn trained_agent_and_decisions_are_unchanged() {
-    let (_, log) = train(&common::papers_bins("intersection"), &common::small_config(7)).unwrap();
+    let (_, log) = train(&fixtures::papers_bins("intersection"), &fixtures::small_config(7)).unwrap();
     assert_eq!(log.timeouts, 0);
-    assert_eq!(digests(common::papers_bundle()), GOLDEN);
+    assert_eq!(digests(fixtures::papers_bundle()), GOLDEN);
 }
 
 /// Planning with the crash model (`crash_model = hazard`, docs/ARCHITECTURE.md §4.3) on
@@ -191,7 +194,7 @@ fn trained_agent_and_decisions_are_unchanged() {
 fn the_crash_model_decisions_are_recorded() {
     let mut params = papers_agent();
     params.planning.crash_model = CrashPlanning::Hazard;
-    assert_eq!(papers_digests(common::papers_bundle(), &params), GOLDEN_CRASH_MODEL);
+    assert_eq!(papers_digests(fixtures::papers_bundle(), &params), GOLDEN_CRASH_MODEL);
 }
 
 /// The competence check (docs/ARCHITECTURE.md §4.11) with the paper's edges and crash
@@ -201,13 +204,13 @@ fn the_crash_model_decisions_are_recorded() {
 fn the_competence_check_decisions_are_recorded() {
     let mut params = papers_agent();
     params.gate.competence = CompetenceCheck::Regret;
-    assert_eq!(papers_digests(common::papers_bundle(), &params), GOLDEN_COMPETENCE);
+    assert_eq!(papers_digests(fixtures::papers_bundle(), &params), GOLDEN_COMPETENCE);
 }
 
 /// The default agent's digests on the default maps with the scaled agent's parameters
 /// `params`.
 fn default_digests(params: &ScaledParams) -> [String; 4] {
-    let bundle = common::bundle();
+    let bundle = fixtures::bundle();
     [
         agent_digest(bundle),
         episodes_digest(bundle, &unforeseen_harness::maps::load("intersection").unwrap(), params),
@@ -256,8 +259,8 @@ fn the_policy_mode_ablation_reproduces_the_default_of_before() {
 /// time-outs truncate.
 #[test]
 fn timeouts_truncate_and_learners_bootstrap() {
-    let map = common::tiny_map();
-    let mut cfg = common::small_config(3);
+    let map = fixtures::tiny_map();
+    let mut cfg = fixtures::small_config(3);
     cfg.episodes = 60;
     let (truncating, log) = train(&map, &cfg).unwrap();
     cfg.timeout_as = TimeoutAs::Termination;

@@ -3,11 +3,11 @@
 //! distance bin with a pedestrian on the crosswalk, under the crash model and the paper's
 //! crash-risk states.
 
-use crate::common::bundle;
 use unforeseen_agent::params::{CrashPlanning, ScaledParams};
 use unforeseen_discretizer::{Discretizer, State};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::rewards::crash_model;
+use unforeseen_harness::fixtures::bundle;
 
 /// Hazards of the default map by hand: speed bins [0, 0.5), [0.5, 4.5), [4.5, 7.5),
 /// [7.5, 9] have middles 0.25, 2.5, 6, 8.25 m/s; one tick at top speed covers 9 m.

@@ -2,7 +2,7 @@
 //! same results zero-shot (fresh controller per episode, in parallel) as continual (one
 //! controller, in order), and zero-shot results do not depend on the number of threads.
 
-use crate::common;
+use unforeseen_harness::fixtures;
 
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_harness::episodes::evaluation::{evaluate, evaluate_under};
@@ -32,7 +32,7 @@ fn zero_shot(method: Method, threads: usize) -> Vec<EpisodeResult> {
         evaluate_under(
             Protocol::ZeroShot,
             &jaywalk,
-            common::bundle(),
+            fixtures::bundle(),
             &params,
             method,
             4,
@@ -50,7 +50,7 @@ fn methods_that_do_not_learn_across_episodes_give_the_same_results_under_both_pr
     for method in [Method::QLearning, Method::ScaledNoLearning] {
         assert!(!method.learns_across_episodes(&params));
         // The real continual loop: one controller, episodes in order.
-        let mut controller = method.controller(common::bundle(), &params, &jaywalk).unwrap();
+        let mut controller = method.controller(fixtures::bundle(), &params, &jaywalk).unwrap();
         let continual = untimed(evaluate(&jaywalk, controller.as_mut(), method, 4, 5, &NoProgress).unwrap());
         assert_eq!(continual, zero_shot(method, 2), "{method}");
     }
