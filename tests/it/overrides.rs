@@ -4,43 +4,41 @@
 //! Theorem 1, and a sweep counts equal values once.
 
 use crate::common;
-use serde_json::{Value, json};
 use unforeseen_agent::controller::Controller;
-use unforeseen_agent::param_table;
+use unforeseen_agent::param_table::{self, ParamValue};
 use unforeseen_agent::params::{ScaledParams, ScalingMode};
 use unforeseen_harness::overrides::{apply, keys, set_one, set_value};
 use unforeseen_harness::runs::batch::sweep;
 
-/// A value other than the default for each key, as `--set` text and as JSON.
-fn other_value(key: &str) -> (String, Value) {
+/// A value other than the default for each key, as `--set` text and typed.
+fn other_value(key: &str) -> (String, ParamValue) {
     match ScaledParams::default().get(key).unwrap() {
-        Value::Bool(b) => ((!b).to_string(), json!(!b)),
-        Value::Number(n) if n.is_u64() => ("2".into(), json!(if n.as_u64() == Some(2) { 1 } else { 2 })),
-        Value::Number(n) => {
-            let x = n.as_f64().unwrap() / 4.0;
-            (x.to_string(), json!(x))
+        ParamValue::Bool(b) => ((!b).to_string(), ParamValue::Bool(!b)),
+        ParamValue::Int(n) => ("2".into(), ParamValue::Int(if n == 2 { 1 } else { 2 })),
+        ParamValue::Number(x) => {
+            let x = x / 4.0;
+            (x.to_string(), ParamValue::Number(x))
         }
-        Value::String(_) if key == "gate_factor" => ("v".into(), json!("v")),
-        Value::String(_) if key == "persistence_ignores" => ("L".into(), json!("L")),
-        Value::String(s) => {
+        ParamValue::Name(_) if key == "gate_factor" => ("v".into(), ParamValue::Name("v".into())),
+        ParamValue::Name(_) if key == "persistence_ignores" => ("L".into(), ParamValue::Name("L".into())),
+        ParamValue::Name(s) => {
             let e = apply(ScaledParams::default(), &[format!("{key}=?")])
                 .unwrap_err()
                 .to_string();
             let allowed = e.split("one of: ").nth(1).unwrap_or_else(|| panic!("{key}: {e}"));
             let x = allowed.split(", ").find(|v| **v != *s).unwrap().to_string();
-            (x.clone(), json!(x))
+            (x.clone(), ParamValue::Name(x))
         }
-        other => panic!("{key}: {other}"),
     }
 }
 
 #[test]
-fn every_key_round_trips_and_the_json_entry_point_agrees() {
+fn every_key_round_trips_and_the_typed_entry_point_agrees() {
     assert!(keys().len() >= 25, "{:?}", keys());
     for key in keys() {
         let (text, value) = other_value(key);
-        let (text, value) = if key == "horizon" || value == json!(1) {
-            ("1".to_string(), json!(1))
+        let (text, value) = if key == "horizon" || value == ParamValue::Int(1) {
+            ("1".to_string(), ParamValue::Int(1))
         } else {
             (text, value)
         };
@@ -49,7 +47,7 @@ fn every_key_round_trips_and_the_json_entry_point_agrees() {
         assert_eq!(set.get(key).unwrap(), value, "{key} reads back");
         let mut typed = ScaledParams::default();
         set_value(&mut typed, key, value.clone()).unwrap();
-        assert_eq!(typed, set, "{key}: JSON and text differ");
+        assert_eq!(typed, set, "{key}: typed and text differ");
         let dotted = param_table::lookup(key).unwrap().dotted();
         let mut by_dotted = ScaledParams::default();
         set_one(&mut by_dotted, &dotted, &text).unwrap();
@@ -93,9 +91,16 @@ fn unknown_keys_and_bad_values_name_the_key_and_the_allowed_values() {
     let e = err(&["horizon=9"]);
     assert!(e.contains("horizon") && e.contains("1..=8"), "{e}");
     let mut p = ScaledParams::default();
-    let e = set_value(&mut p, "vmp_tol", json!("small")).unwrap_err().to_string();
-    assert!(e.contains("vmp_tol") && e.contains("finite and > 0"), "{e}");
-    let e = set_value(&mut p, "no_such", json!(1)).unwrap_err().to_string();
+    let e = set_value(&mut p, "vmp_tol", ParamValue::Name("small".into()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("vmp_tol") && e.contains("small") && e.contains("finite and > 0"),
+        "{e}"
+    );
+    let e = set_value(&mut p, "no_such", ParamValue::Int(1))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("no_such") && e.contains("scaling_mode"), "{e}");
 }
 
