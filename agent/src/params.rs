@@ -10,7 +10,7 @@
 //! through [`crate::param_table`].
 
 use crate::error::ParamError;
-use crate::param_table::{NameRule, Rule, param_enum, param_group, param_groups};
+use crate::param_decl::{Bound, NameRule, Rule, param_enum, param_group, param_groups};
 use crate::structure::{Parent, Structure};
 use serde::{Deserialize, Serialize};
 
@@ -300,7 +300,7 @@ param_groups! {
     /// Hyperparameters of the paper's agent ([`crate::scaled_agent::ScaledAgent`]), grouped by the
     /// paper's concepts. Every parameter has a key (the name in the table below; the
     /// dotted `group.key` is accepted too) by which it is read and set
-    /// ([`ScaledParams::get`], [`ScaledParams::set_str`], [`ScaledParams::set_value`],
+    /// ([`ScaledParams::get`], [`ScaledParams::set_str`], [`ScaledParams::set`],
     /// [`crate::param_table`]). Each group's fields are declared once, with their key,
     /// default and range (`param_group!` below): the struct, its serde names, the table's
     /// setter and getter and the range checks all come from that declaration, so a field
@@ -527,56 +527,6 @@ mod f64_or_inf {
 /// `persistence_ignores`: `"none"` is read as `""` (no pooling).
 fn factor_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     Ok(NameRule::FactorList.normal(String::deserialize(d)?))
-}
-
-/// The range of one numeric parameter of [`ScaledParams`], as [`ScaledParams::check`]
-/// enforces it and error messages state it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Bound {
-    /// Finite and > 0.
-    Positive,
-    /// Finite and >= 0.
-    NonNegative,
-    /// In (0, 1].
-    HalfOpenUnit,
-    /// In [0, 1).
-    BelowOne,
-    /// > 0, infinity allowed.
-    PositiveOrInf,
-    /// A whole number in `1..=max`: counts that size an allocation or a loop, so that no
-    /// setting asks for more memory or time than a run has.
-    Count {
-        /// Largest value.
-        max: usize,
-        /// The range and why, e.g. `"in 1..=1000 (...)"`.
-        expected: &'static str,
-    },
-}
-
-impl Bound {
-    /// The range in words, as error messages give it.
-    pub fn expected(self) -> &'static str {
-        match self {
-            Bound::Positive => "finite and > 0",
-            Bound::NonNegative => "finite and >= 0",
-            Bound::HalfOpenUnit => "in (0, 1]",
-            Bound::BelowOne => "in [0, 1)",
-            Bound::PositiveOrInf => "> 0 (inf for unbounded)",
-            Bound::Count { expected, .. } => expected,
-        }
-    }
-
-    /// Whether `x` is in range (a count must be whole).
-    pub fn admits(self, x: f64) -> bool {
-        match self {
-            Bound::Positive => x > 0.0 && x.is_finite(),
-            Bound::NonNegative => x >= 0.0 && x.is_finite(),
-            Bound::HalfOpenUnit => x > 0.0 && x <= 1.0,
-            Bound::BelowOne => (0.0..1.0).contains(&x),
-            Bound::PositiveOrInf => x > 0.0,
-            Bound::Count { max, .. } => x.fract() == 0.0 && x >= 1.0 && x <= max as f64,
-        }
-    }
 }
 
 /// Largest planning horizon: the EFE tree evaluates `n_actions^H` policies per reasoning tick.

@@ -7,7 +7,8 @@
 //! as its flag, `--set`.
 
 use unforeseen_agent::error::SetError;
-use unforeseen_agent::param_table::{self, ParamValue};
+use unforeseen_agent::param_decl::ParamValue;
+use unforeseen_agent::param_table;
 use unforeseen_agent::params::ScaledParams;
 
 use crate::error::Error;

@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
 use unforeseen_agent::controller::{Controller, Decision, Ending};
-use unforeseen_agent::param_table::ParamValue;
+use unforeseen_agent::param_decl::ParamValue;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::methods::Method;

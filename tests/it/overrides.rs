@@ -5,7 +5,8 @@
 
 use crate::common;
 use unforeseen_agent::controller::Controller;
-use unforeseen_agent::param_table::{self, ParamValue};
+use unforeseen_agent::param_decl::ParamValue;
+use unforeseen_agent::param_table;
 use unforeseen_agent::params::{ScaledParams, ScalingMode};
 use unforeseen_harness::overrides::{apply, keys, set_one, set_value};
 use unforeseen_harness::runs::batch::sweep;
