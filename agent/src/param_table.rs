@@ -93,19 +93,27 @@ impl ScaledParams {
         self.set_given(key, Given::Text(text), || text.to_string())
     }
 
+    /// Sets `key` on a copy (the field's declared type and range), checks the rule between
+    /// fields where `key` is the one it names, and keeps the copy only if both pass.
     fn set_given(&mut self, key: &str, given: Given<'_>, shown: impl Fn() -> String) -> Result<(), SetError> {
         let k = lookup(key)?;
-        let result = self
-            .group_set(&k.group, &k.name, given)
-            .ok_or_else(|| SetError::UnknownKey {
-                key: key.to_string(),
-                known: key_names(),
-            })?;
-        result.map_err(|problem| SetError::BadValue {
+        let bad = |problem: String| SetError::BadValue {
             key: key.to_string(),
             value: shown(),
             problem,
-        })
+        };
+        let mut next = self.clone();
+        next.group_set(&k.group, &k.name, given)
+            .ok_or_else(|| SetError::UnknownKey {
+                key: key.to_string(),
+                known: key_names(),
+            })?
+            .map_err(bad)?;
+        if let Some(e) = next.cross_problem().filter(|e| e.name == k.name) {
+            return Err(bad(format!("must be {}", e.expected)));
+        }
+        *self = next;
+        Ok(())
     }
 }
 
@@ -211,7 +219,13 @@ mod tests {
         assert!(e.contains("max_scaling_iters") && e.contains("1..=10000"), "{e}");
         let e = p.set("horizon", ParamValue::Int(-1)).unwrap_err().to_string();
         assert!(e.contains("horizon") && e.contains("-1") && e.contains("1..=8"), "{e}");
+        let e = p.set_str("persistence_ignores", "d+p").unwrap_err().to_string();
+        assert!(e.contains("persistence_ignores") && e.contains("not gate_factor"), "{e}");
         assert_eq!(p, ScaledParams::default(), "a failed set changes nothing");
+        // The rule between the two names is the pooled list's: the watched factor may be
+        // renamed onto a pooled one, which `check` then refuses.
+        p.set_str("gate_factor", "d").unwrap();
+        assert_eq!(p.check_ref().unwrap_err().name, "persistence_ignores");
     }
 
     #[test]

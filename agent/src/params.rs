@@ -537,22 +537,24 @@ pub const MAX_COMPETENCE_HORIZON: usize = 40;
 
 impl ScaledParams {
     /// Every violation of the declared ranges (numbers, counts, the factor names'
-    /// spelling), group by group in declaration order, then a `persistence_ignores` that
-    /// names the watched factor.
+    /// spelling), group by group in declaration order, then of the rules between fields.
     pub(crate) fn problems(&self) -> Vec<ParamError> {
         let mut out = self.field_problems();
+        out.extend(self.cross_problem().filter(|e| !out.iter().any(|o| o.name == e.name)));
+        out
+    }
+
+    /// The rule between fields: `persistence_ignores` does not name the watched factor
+    /// (`gate_factor`). The error names `persistence_ignores`.
+    pub(crate) fn cross_problem(&self) -> Option<ParamError> {
         let (factor, ignores) = (&self.gate.gate_factor, &self.planning.persistence_ignores);
-        if !ignores.is_empty()
-            && ignores.split('+').any(|n| n == factor)
-            && !out.iter().any(|e| e.name == "persistence_ignores")
-        {
-            out.push(ParamError::new(
+        (!ignores.is_empty() && ignores.split('+').any(|n| n == factor)).then(|| {
+            ParamError::new(
                 "persistence_ignores",
                 format!("{ignores:?}"),
                 NameRule::FactorList.range().unwrap_or(""),
-            ));
-        }
-        out
+            )
+        })
     }
 
     /// Validate ranges (table above) without consuming the parameters.
