@@ -220,7 +220,10 @@ mod tests {
         let e = p.set("horizon", ParamValue::Int(-1)).unwrap_err().to_string();
         assert!(e.contains("horizon") && e.contains("-1") && e.contains("1..=8"), "{e}");
         let e = p.set_str("persistence_ignores", "d+p").unwrap_err().to_string();
-        assert!(e.contains("persistence_ignores") && e.contains("not gate_factor"), "{e}");
+        assert!(
+            e.contains("persistence_ignores") && e.contains("not gate_factor"),
+            "{e}"
+        );
         assert_eq!(p, ScaledParams::default(), "a failed set changes nothing");
         // The rule between the two names is the pooled list's: the watched factor may be
         // renamed onto a pooled one, which `check` then refuses.
