@@ -9,9 +9,10 @@
 
 use std::fmt;
 
-/// A parameter's value, typed: what [`ScaledParams::get`](crate::params::ScaledParams::get) returns and
-/// [`ScaledParams::set`](crate::params::ScaledParams::set) takes. Displayed as `--set` would spell it (`0.5`, `3`, `true`,
-/// `closed-form`, `inf`).
+/// A parameter's value, typed: what
+/// [`ScaledParams::get`](crate::params::ScaledParams::get) returns and
+/// [`ScaledParams::set`](crate::params::ScaledParams::set) takes. Displayed as `--set`
+/// would spell it (`0.5`, `3`, `true`, `closed-form`, `inf`).
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParamValue {
     /// A switch.
@@ -47,12 +48,13 @@ pub enum ValueKind {
     Switch,
     /// One of an enum's names (canonical names, in declaration order).
     OneOf(&'static [&'static str]),
-    /// Free text checked by the field's [`Names`] rule.
+    /// Free text checked by the field's [`NameRule`].
     Text,
 }
 
-/// One parameter of the table: the group it belongs to (a field of [`ScaledParams`](crate::params::ScaledParams)), its
-/// key (the group's field, as serialized), its type and its declared range.
+/// One parameter of the table: the group it belongs to (a field of
+/// [`ScaledParams`](crate::params::ScaledParams)), its key (the group's field, as
+/// serialized), its type and its declared range.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Key {
     /// The group, e.g. `gate`.
@@ -255,7 +257,7 @@ pub enum NameRule {
 }
 
 /// Not a factor's name: empty, with a space or with a `+`.
-pub(crate) fn bad_name(n: &str) -> bool {
+fn bad_name(n: &str) -> bool {
     n.is_empty() || n.contains('+') || n.chars().any(char::is_whitespace)
 }
 
@@ -365,9 +367,9 @@ macro_rules! rule_or_any {
 }
 pub(crate) use rule_or_any;
 
-/// Declares one group of [`ScaledParams`](crate::params::ScaledParams): the struct (its serde names are the keys,
-/// every field defaulted), its `Default`, and its part of the table: the entries, the
-/// typed getter and setter by key, and the range checks. Each field is
+/// Declares one group of [`ScaledParams`](crate::params::ScaledParams): the struct (its
+/// serde names are the keys, every field defaulted), its `Default`, and its part of the
+/// table: the entries, the typed getter and setter by key, and the range checks. Each field is
 /// `name: Type = default => "key"`, optionally followed by `in RULE` (a [`Rule`] of the
 /// type: a [`Bound`], a [`NameRule`]); other attributes (docs, serde `with`) pass through.
 macro_rules! param_group {
@@ -448,9 +450,9 @@ macro_rules! param_group {
 }
 pub(crate) use param_group;
 
-/// Declares [`ScaledParams`](crate::params::ScaledParams), a struct of groups declared with `param_group!` (each
-/// field's name is the group's key), and its table: the entries of every group, and the
-/// getter, the setter and the range checks by group and key.
+/// Declares [`ScaledParams`](crate::params::ScaledParams), a struct of groups declared
+/// with `param_group!` (each field's name is the group's key), and its table: the entries
+/// of every group, and the getter, the setter and the range checks by group and key.
 macro_rules! param_groups {
     (
         $(#[$meta:meta])*
