@@ -74,7 +74,8 @@ pub fn scaled_params(params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParam
             if let Ok(text) = v.extract::<String>() {
                 unforeseen_harness::overrides::set_one(&mut p, &key, &text).map_err(errors::to_py)?;
             } else {
-                unforeseen_harness::overrides::set_value(&mut p, &key, param_value(&key, &v)?).map_err(errors::to_py)?;
+                unforeseen_harness::overrides::set_value(&mut p, &key, param_value(&key, &v)?)
+                    .map_err(errors::to_py)?;
             }
         }
     }
