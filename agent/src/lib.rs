@@ -6,7 +6,7 @@
 //! learning, and the two baselines (tabular Q-learning, Bayesian RL). All three methods
 //! implement [`controller::Controller`].
 //!
-//! Module map (named after the paper): [`maths`], [`params`] (and [`param_table`], the scaled agent's parameters by name), [`structure`], [`model`], [`transition`] (factored `B`),
+//! Module map (named after the paper): [`maths`], [`params`] (declared with [`param_decl`]; [`param_table`], the scaled agent's parameters by name), [`structure`], [`model`] (the world model, one concept per file), [`transition`] (factored `B`),
 //! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`handback`] (the safe hand-back, beyond the paper), [`competence`] (the competence check of the habit, beyond the paper), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
 //! [`habit`] (`π_o` as an interface), [`scaled_agent`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
@@ -38,6 +38,7 @@ pub mod learning;
 pub mod limits;
 pub mod maths;
 pub mod model;
+pub mod param_decl;
 pub mod param_table;
 pub mod params;
 pub mod perception;

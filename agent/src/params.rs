@@ -6,9 +6,11 @@
 //! [`crate::scaled_agent::ScaledAgent::new`], [`crate::bayes_rl::BayesRl::new`],
 //! [`crate::q_learning::QLearning::new`]) calls `check()` and returns the error.
 //! Defaults follow the paper's §VI where it states them. The scaled agent's parameters
-//! are read and set by name through [`crate::param_table`].
+//! are declared once per group with their keys and ranges, and read and set by name
+//! through [`crate::param_table`].
 
 use crate::error::ParamError;
+use crate::param_decl::{Bound, NameRule, Rule, param_enum, param_group, param_groups};
 use crate::structure::{Parent, Structure};
 use serde::{Deserialize, Serialize};
 
@@ -110,435 +112,386 @@ impl ModelPriors {
     }
 }
 
-/// How the scaled policy is computed (§IV Theorem 1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum ScalingMode {
-    /// The iterative update of eq. "gradient_descent_equations" with eq. "stopping_criterion".
-    #[default]
-    Iterative,
-    /// The closed form of Theorem 1: `π' ∝ π_o ψ^θ`.
-    ClosedForm,
-}
-
-/// How the action is drawn from the policy acted upon (docs/ARCHITECTURE.md §4.9).
-/// By name also `sample=true|false` (see [`crate::param_table::ALIASES`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum ActionSelection {
-    /// The mode over the outcomes the model tells apart (beyond the paper; default in
-    /// evaluation): on a reasoning tick each action's probability is pooled with that of
-    /// every action whose predicted next state overlaps its own,
-    /// `π̃(u) = Σ_w (1 - TV(B[u] q_t, B[w] q_t)) π'(w)`, and the agent acts on the mode of
-    /// `π̃` (ties: lowest index), so that two actions the model cannot tell apart
-    /// (maintain and speed up in the top speed bin, maintain and slow down at a
-    /// standstill) do not split the mass of one choice between them. Feed-forward ticks
-    /// act on the mode of `π_o`, as [`ActionSelection::Mode`] does.
-    #[default]
-    #[serde(alias = "false", alias = "no", alias = "0")]
-    OutcomeMode,
-    /// The mode of the policy acted upon (ties: lowest index): the paper's rule (ablation).
-    Mode,
-    /// Sample with the agent's seeded ChaCha8 RNG.
-    #[serde(alias = "true", alias = "yes", alias = "1")]
-    Sample,
-}
-
-/// What the agent does with the actions its world model cannot tell apart from the one it
-/// chose (docs/ARCHITECTURE.md §4.9).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum TieBreak {
-    /// Beyond the paper (default): on every tick, among the chosen action and the actions
-    /// whose predicted next state `B[u] q_t` lies within `tie_tolerance` of its own (total
-    /// variation), the agent takes the one least likely to crash when held for
-    /// `handback_horizon` ticks (the hand-back's crash risk, [`crate::handback`]); the
-    /// chosen action keeps the tick where none is less likely. Where the model cannot tell
-    /// "speed up" from "maintain" (the top speed bin), the crash model still can: the
-    /// faster car covers more ground in a tick where a pedestrian may be.
-    #[default]
-    Safest,
-    /// Act on the chosen action (the paper's; ablation).
-    Chosen,
-}
-
-/// When reasoning (VMP + planning + scaling) runs (§II footnote, §IV; ablation).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum ReasoningMode {
-    /// Only when θ_t > ε (the paper's method).
-    #[default]
-    Triggered,
-    /// On every tick (ablation "scaled with reasoning on every tick").
-    Always,
-}
-
-/// What the reasoning trigger measures (§II, §VI; docs/ARCHITECTURE.md §4.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum GateMode {
-    /// Surprise on the state: `-ln P(x_t | parents_t)` of the watched factor (the paper's
-    /// "surprise measured from the state space", Fig. 9a-b), see [`crate::gate`].
-    #[default]
-    State,
-    /// Ablation: the one-step surprise of the joint transition, `-ln Σ_s A[o_t,s] ŝ_t[s]`
-    /// (Lemma 1), which also fires on the car's own bin crossings.
-    OneStep,
-}
-
-/// How the gate's table learns a situation as familiar (§V applied to the gate;
-/// docs/ARCHITECTURE.md §4.4). Beyond the paper, whose rule is only `θ <= ε`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum GateLearning {
-    /// A reasoning tick counts in the gate's table with weight `π'(a_o) / max_u π'(u)`,
-    /// where `a_o` is the habit's action after this episode's update of `ν`: a situation
-    /// becomes familiar (and control returns to the habit) only as far as the planner
-    /// endorses what the habit would do there. Feed-forward ticks count fully.
-    #[default]
-    Endorsed,
-    /// Ablation: every tick counts fully (the situation becomes familiar whatever the habit does).
-    Every,
-}
-
-/// What the trigger subtracts from the gate's surprise before `θ = 1 - exp(-Ω S)`
-/// ([`crate::gate::StateGate::excess_surprise`]). Beyond the paper, whose trigger reads `S`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum GateBaseline {
-    /// The surprise expected in the state, `c(s) H(row)`, where `c(s)` grows with the
-    /// reasoning ticks in that state that endorsed the habit (full after `gate_memory`):
-    /// the uncertainty of a situation stops triggering reasoning once the habit has
-    /// been shown to act there as reasoning would. Zero for a never-endorsed state.
-    #[default]
-    Endorsed,
-    /// Ablation (the paper's trigger): nothing; `θ` reads the surprise itself.
-    None,
-}
-
-/// When control goes back to the habit on a tick whose `θ <= ε` ([`crate::handback`];
-/// docs/ARCHITECTURE.md §4.10). Beyond the paper, whose rule is `θ <= ε` alone.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum HandBackRule {
-    /// Where test-time learning changed the trigger's verdict, learning may only take
-    /// reasoning away, and only where the habit is safe. A hand-back that learning made
-    /// (the trained agent's trigger would still fire) is made only if the habit, rolled
-    /// forward `handback_horizon` ticks through the learned model, enters a crash-risk
-    /// state at most `handback_risk` more likely than the safest action; otherwise the
-    /// agent reasons. A reasoning tick that learning alone made (the trained trigger would
-    /// hand back, the learned one fires: learning that pedestrians are common makes an
-    /// empty road read as surprising) is declined: the habit acts, as the trained agent's
-    /// would. So the agent reasons only where its trained trigger fires.
-    #[default]
-    DeclineLearned,
-    /// Option: the crash-risk check decides both ways. Hand-backs as `DeclineLearned`; a
-    /// reasoning tick that learning alone made is taken where the check finds the habit at
-    /// risk (e.g. about to run a red light into a crosswalk where pedestrians cross on red),
-    /// otherwise declined. There the planner acts on what it knows and the habit has not
-    /// learnt (a traffic rule: on the rule-aware maps/red_light/ it saves cars of two of
-    /// 20 agents), at the cost of reasoning on an empty road (EXPERIMENTS.md, "The safe
-    /// hand-back").
-    RiskChecked,
-    /// Ablation: only hand-backs that learning made are checked; every tick the learned
-    /// trigger fires on reasons.
-    HandBackChecked,
-    /// Ablation (the paper's rule): `θ <= ε` hands back, whatever the habit does.
-    Theta,
-}
-
-/// Whether the world model checks the habit where the surprise gate leaves it in charge
-/// ([`crate::competence`]; docs/ARCHITECTURE.md §4.11). Beyond the paper, whose agent
-/// trusts the habit wherever nothing surprises it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum CompetenceCheck {
-    /// The habit acts only where holding its action for `competence_horizon` ticks is
-    /// predicted (expected free energy, Prop. 1) at most `competence_regret` nats worse than
-    /// holding the best action, or where the best action is the riskier (by more than
-    /// `handback_risk`); otherwise the agent reasons.
-    #[default]
-    Regret,
-    /// Ablation (the paper's agent): reasoning only where the gate finds surprise.
-    SurpriseOnly,
-}
-
-/// Which model the EFE tree's first step from `q_t` goes through
-/// ([`crate::planning::EfeTree::evaluate`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum RootStep {
-    /// The learned `B`: the car observes `q_t` while the episode goes on, so from a
-    /// crash-risk state braking out of it counts; later steps absorb.
-    #[default]
-    Learned,
-    /// Ablation: the planning model's, where episode-ending states are absorbing from
-    /// the root on, so every action from a crash-risk state ends alike.
-    Absorbing,
-}
-
-/// How the planner models a crash at the crosswalk.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum CrashPlanning {
-    /// The paper's model (the ablation): every state with a pedestrian on the crosswalk
-    /// while the car moves in the crosswalk's distance bin is a crash, absorbing, whatever
-    /// the car does, so braking there earns nothing and a dash to the goal looks best.
-    States,
-    /// Beyond the paper, the default: a tick in the crosswalk's bin with a pedestrian on
-    /// the crosswalk ends in a crash with a probability that grows with the distance the
-    /// car covers under the action, and a crashed episode forfeits the goal
-    /// ([`crate::model::CrashModel`]); braking there earns what it saves. Where the car is
-    /// already on the crosswalk when a pedestrian steps on, stopping can be what gets it
-    /// hit (EXPERIMENTS.md, "The crosswalk's distance bins and the crash model"). Agents
-    /// without a crash model plan as `states`.
-    #[default]
-    Hazard,
-}
-
-/// Hyperparameters of the paper's agent ([`crate::scaled_agent::ScaledAgent`]), grouped by the
-/// paper's concepts. Every parameter has a key (the name in the table below; the
-/// dotted `group.key` is accepted too) by which it is read and set
-/// ([`ScaledParams::get`], [`ScaledParams::set_str`], [`ScaledParams::set_value`],
-/// [`crate::param_table`]): the keys are those of the serialized groups, so a field added
-/// to a group is settable by name with no other edit.
-///
-/// | group | key | default | range | paper |
-/// |---|---|---|---|---|
-/// | `gate` | `omega` Ω | 0.425 | finite and > 0 | §IV θ = 1 - exp(-Ω S), §VI |
-/// | `gate` | `epsilon` ε | 0.2 | [0, 1) | §II reasoning trigger θ > ε, §VI |
-/// | `gate` | `gate` | `state` | `state`, `one-step` | §VI surprise on the state, or the one-step joint surprise (ablation) ([`GateMode`]) |
-/// | `gate` | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
-/// | `gate` | `gate_memory` | 20.0 | > 0 (`inf` allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
-/// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
-/// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `none` is the paper's trigger) ([`GateBaseline`]) |
-/// | `gate` | `handback` | `decline-learned` | `decline-learned`, `risk-checked`, `hand-back-checked`, `theta` | where test-time learning changed the trigger's verdict: a hand-back learning made goes to the habit only if the world model's crash-risk check passes, a reasoning tick learning alone made is declined (beyond the paper; `risk-checked` takes such a tick where the check finds the habit at risk, `hand-back-checked` takes every one, `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
-/// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
-/// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |
-/// | `gate` | `competence` | `regret` | `regret`, `surprise-only` | where the gate leaves the habit in charge, the world model scores holding its action against holding the best one, and the agent reasons where it is worse by more than `competence_regret` (beyond the paper; `surprise-only` is the paper's agent) ([`CompetenceCheck`]) |
-/// | `gate` | `competence_regret` | 10.0 | finite and >= 0 | nats of expected free energy by which holding the habit's action may be worse than holding the best action before the agent reasons |
-/// | `gate` | `competence_horizon` | 8 | 1..=40 | ticks each action is held by the competence check |
-/// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
-/// | `perception` | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
-/// | `perception` | `vmp_tol` | 1e-6 | finite and > 0 | VMP convergence threshold on max \|Δ q\| |
-/// | `perception` | `vmp_max_iters` | 32 | 1..=10000 | VMP iteration cap |
-/// | `planning` | `gamma` γ | 0.5 | finite and > 0 | Cor. 1 q(π) = σ(-γG), §VI |
-/// | `planning` | `horizon` H | 3 | 1..=8 | policy length (n_actions^H policies, Prop. 1) |
-/// | `planning` | `root_step` | `learned` | `learned`, `absorbing` | the EFE tree's first step uses the learned `B`, later steps the absorbing planning model ([`RootStep`]; `absorbing` absorbs from the root on) |
-/// | `planning` | `crash_model` | `hazard` | `hazard`, `states` | a crash as a transition whose probability grows with the distance the car covers, forfeiting the goal (beyond the paper), or the paper's absorbing crash-risk states ([`CrashPlanning`]) |
-/// | `planning` | `persistence_ignores` | `"d+L"` | next-time parents' names joined by `+`, or `""` (also written `none`) | the watched factor's persistence (rows where it was present) is pooled over these parents in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
-/// | `scaling` | `varsigma` ς | 0.05 | finite and >= 0 | eq. "stopping_criterion", §VI |
-/// | `scaling` | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
-/// | `scaling` | `max_scaling_iters` | 50 | 1..=10000 | cap of the scaling loop |
-/// | `scaling` | `scaling_mode` | `iterative` | `iterative`, `closed-form` | Theorem 1 iterative / closed form ([`ScalingMode`]) |
-/// | `scaling` | `action_selection` | `outcome-mode` | `outcome-mode`, `mode`, `sample` | act on the mode over the outcomes the model tells apart, on the policy's mode (the paper's, ablation) or sample it ([`ActionSelection`]) |
-/// | `scaling` | `tie_break` | `safest` | `safest`, `chosen` | among the actions whose predicted next state is within `tie_tolerance` of the chosen one's, take the one least likely to crash within `handback_horizon` ticks (beyond the paper), or the chosen one (the paper's, ablation) ([`TieBreak`]) |
-/// | `scaling` | `tie_tolerance` | 0.05 | [0, 1) | the total variation between two actions' predicted next states below which the model cannot tell them apart |
-/// | `scaling` | `reasoning` | `triggered` | `triggered`, `always` | reason when θ > ε, or on every tick (ablation) ([`ReasoningMode`]) |
-/// | `learning` | `learning` | true | true, false | test-time learning §V at episode end |
-/// | `learning` | `learning_rate` | 1.0 | finite and >= 0 | multiplies the expected counts added in §V |
-/// | `learning` | `nu0` ν0 | 10.0 | finite and > 0 | prior strength of ν = ν0 σ(Q/T) (docs/ARCHITECTURE.md §4.8) |
-/// | `learning` | `nu_temperature` T | 1.0 | finite and > 0 | temperature of ν's softmax over Q |
-/// | `learning` | `habit_memory` | 20.0 | > 0 (`inf` allowed) | counts of reasoning a state of the habit keeps beyond its prior: each state's counts are rescaled to at most this many at the end of an episode (beyond the paper; [`crate::habit::Habit::bound_memory`]) |
-///
-/// Where each range is enforced: numbers and enum values when set by name and by
-/// [`ScaledParams::check`]; the spelling of `gate_factor` and `persistence_ignores` (names
-/// without spaces, `+` between names, no name twice, the watched factor not among the
-/// pooled ones) by `check`; that they name factors of the model (the watched factor, and
-/// next-time parents of it) only where a model is known, by
-/// [`CheckedScaledParams::check_factors`], which [`crate::scaled_agent::ScaledAgent::new`] calls.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct ScaledParams {
-    /// The reasoning trigger (§II, §IV, §VI).
-    pub gate: GateParams,
-    /// VMP perception (§III).
-    pub perception: PerceptionParams,
-    /// EFE planning (§IV, Prop. 1, Cor. 1).
-    pub planning: PlanningParams,
-    /// Test-time policy scaling and action selection (§IV, Theorem 1).
-    pub scaling: ScalingParams,
-    /// Test-time learning (§V).
-    pub learning: LearningParams,
-}
-
-/// The reasoning trigger's parameters (table of [`ScaledParams`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct GateParams {
-    /// Ω, saturation of the normalised surprise.
-    pub omega: f64,
-    /// ε, reasoning threshold on θ.
-    pub epsilon: f64,
-    /// What the reasoning trigger measures (key `gate`).
-    #[serde(rename = "gate")]
-    pub mode: GateMode,
-    /// Name of the factor the state gate watches (given its next-time parents).
-    pub gate_factor: String,
-    /// Data counts each row of the state gate's table keeps (bounded memory; `inf`
-    /// is written as the string `"inf"`).
-    #[serde(with = "f64_or_inf")]
-    pub gate_memory: f64,
-    /// How the gate's table learns a situation as familiar.
-    pub gate_learning: GateLearning,
-    /// What the trigger subtracts from the gate's surprise.
-    pub gate_baseline: GateBaseline,
-    /// When control goes back to the habit.
-    pub handback: HandBackRule,
-    /// ρ: the largest excess of the habit's predicted crash risk over the safest first
-    /// action's at which control goes back to it.
-    pub handback_risk: f64,
-    /// Ticks of the hand-back check's rollout of the habit.
-    pub handback_horizon: usize,
-    /// Whether the world model checks the habit's action on the ticks the gate leaves to it.
-    pub competence: CompetenceCheck,
-    /// The largest regret (nats) of holding the habit's action at which it acts.
-    pub competence_regret: f64,
-    /// Ticks each action is held by the competence check.
-    pub competence_horizon: usize,
-}
-
-impl Default for GateParams {
-    fn default() -> Self {
-        Self {
-            omega: 0.425,
-            epsilon: 0.2,
-            mode: GateMode::State,
-            gate_factor: "p".into(),
-            gate_memory: 20.0,
-            gate_learning: GateLearning::Endorsed,
-            gate_baseline: GateBaseline::Endorsed,
-            handback: HandBackRule::DeclineLearned,
-            handback_risk: 0.08,
-            handback_horizon: 3,
-            competence: CompetenceCheck::Regret,
-            competence_regret: 10.0,
-            competence_horizon: 8,
-        }
+param_enum! {
+    /// How the scaled policy is computed (§IV Theorem 1).
+    pub enum ScalingMode {
+        /// The iterative update of eq. "gradient_descent_equations" with eq. "stopping_criterion".
+        #[default]
+        Iterative = "iterative",
+        /// The closed form of Theorem 1: `π' ∝ π_o ψ^θ`.
+        ClosedForm = "closed-form",
     }
 }
 
-/// VMP perception's parameters (table of [`ScaledParams`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PerceptionParams {
-    /// VMP window W.
-    pub vmp_window: usize,
-    /// VMP step size κ.
-    pub vmp_kappa: f64,
-    /// VMP tolerance.
-    pub vmp_tol: f64,
-    /// VMP iteration cap.
-    pub vmp_max_iters: u32,
-}
-
-impl Default for PerceptionParams {
-    fn default() -> Self {
-        Self {
-            vmp_window: 4,
-            vmp_kappa: 1.0,
-            vmp_tol: 1e-6,
-            vmp_max_iters: 32,
-        }
+param_enum! {
+    /// How the action is drawn from the policy acted upon (docs/ARCHITECTURE.md §4.9).
+    /// By name also `sample=true|false` (see [`crate::param_table::ALIASES`]).
+    pub enum ActionSelection {
+        /// The mode over the outcomes the model tells apart (beyond the paper; default in
+        /// evaluation): on a reasoning tick each action's probability is pooled with that of
+        /// every action whose predicted next state overlaps its own,
+        /// `π̃(u) = Σ_w (1 - TV(B[u] q_t, B[w] q_t)) π'(w)`, and the agent acts on the mode of
+        /// `π̃` (ties: lowest index), so that two actions the model cannot tell apart
+        /// (maintain and speed up in the top speed bin, maintain and slow down at a
+        /// standstill) do not split the mass of one choice between them. Feed-forward ticks
+        /// act on the mode of `π_o`, as [`ActionSelection::Mode`] does.
+        #[default]
+        OutcomeMode = "outcome-mode" | "false" | "no" | "0",
+        /// The mode of the policy acted upon (ties: lowest index): the paper's rule (ablation).
+        Mode = "mode",
+        /// Sample with the agent's seeded ChaCha8 RNG.
+        Sample = "sample" | "true" | "yes" | "1",
     }
 }
 
-/// EFE planning's parameters (table of [`ScaledParams`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PlanningParams {
-    /// γ, policy precision.
-    pub gamma: f64,
-    /// Planning horizon H.
-    pub horizon: usize,
-    /// The model of the EFE tree's first step.
-    pub root_step: RootStep,
-    /// How a crash at the crosswalk is modelled.
-    pub crash_model: CrashPlanning,
-    /// The next-time parents the watched factor's persistence does not depend on, joined
-    /// by `+` (`""`: none; `"none"` is read as `""`).
-    #[serde(deserialize_with = "factor_list")]
-    pub persistence_ignores: String,
-}
-
-impl Default for PlanningParams {
-    fn default() -> Self {
-        Self {
-            gamma: 0.5,
-            horizon: 3,
-            root_step: RootStep::Learned,
-            crash_model: CrashPlanning::Hazard,
-            persistence_ignores: "d+L".into(),
-        }
+param_enum! {
+    /// What the agent does with the actions its world model cannot tell apart from the one it
+    /// chose (docs/ARCHITECTURE.md §4.9).
+    pub enum TieBreak {
+        /// Beyond the paper (default): on every tick, among the chosen action and the actions
+        /// whose predicted next state `B[u] q_t` lies within `tie_tolerance` of its own (total
+        /// variation), the agent takes the one least likely to crash when held for
+        /// `handback_horizon` ticks (the hand-back's crash risk, [`crate::handback`]); the
+        /// chosen action keeps the tick where none is less likely. Where the model cannot tell
+        /// "speed up" from "maintain" (the top speed bin), the crash model still can: the
+        /// faster car covers more ground in a tick where a pedestrian may be.
+        #[default]
+        Safest = "safest",
+        /// Act on the chosen action (the paper's; ablation).
+        Chosen = "chosen",
     }
 }
 
-/// Policy scaling's parameters (table of [`ScaledParams`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct ScalingParams {
-    /// ς, stopping tolerance.
-    pub varsigma: f64,
-    /// Scaling step size in (0, 1].
-    pub kappa_pi: f64,
-    /// Maximum scaling iterations.
-    pub max_scaling_iters: u32,
-    /// Iterative or closed-form scaling.
-    pub scaling_mode: ScalingMode,
-    /// Mode over outcomes, mode or sample.
-    pub action_selection: ActionSelection,
-    /// What happens to the actions the model cannot tell from the chosen one.
-    pub tie_break: TieBreak,
-    /// Total variation below which two actions' predicted next states are the same.
-    pub tie_tolerance: f64,
-    /// Triggered or always.
-    pub reasoning: ReasoningMode,
-}
-
-impl Default for ScalingParams {
-    fn default() -> Self {
-        Self {
-            varsigma: 0.05,
-            kappa_pi: 1.0,
-            max_scaling_iters: 50,
-            scaling_mode: ScalingMode::Iterative,
-            action_selection: ActionSelection::OutcomeMode,
-            tie_break: TieBreak::Safest,
-            tie_tolerance: 0.05,
-            reasoning: ReasoningMode::Triggered,
-        }
+param_enum! {
+    /// When reasoning (VMP + planning + scaling) runs (§II footnote, §IV; ablation).
+    pub enum ReasoningMode {
+        /// Only when θ_t > ε (the paper's method).
+        #[default]
+        Triggered = "triggered",
+        /// On every tick (ablation "scaled with reasoning on every tick").
+        Always = "always",
     }
 }
 
-/// Test-time learning's parameters (table of [`ScaledParams`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct LearningParams {
-    /// Test-time learning on/off (key `learning`).
-    #[serde(rename = "learning")]
-    pub enabled: bool,
-    /// Test-time learning rate.
-    pub learning_rate: f64,
-    /// ν0, prior strength of the policy counts.
-    pub nu0: f64,
-    /// T, temperature of the Q softmax that initialises ν.
-    pub nu_temperature: f64,
-    /// Counts of reasoning each state of the habit keeps beyond its prior (bounded memory;
-    /// `inf`, written as the string `"inf"`, is unbounded).
-    #[serde(with = "f64_or_inf")]
-    pub habit_memory: f64,
+param_enum! {
+    /// What the reasoning trigger measures (§II, §VI; docs/ARCHITECTURE.md §4.4).
+    pub enum GateMode {
+        /// Surprise on the state: `-ln P(x_t | parents_t)` of the watched factor (the paper's
+        /// "surprise measured from the state space", Fig. 9a-b), see [`crate::gate`].
+        #[default]
+        State = "state",
+        /// Ablation: the one-step surprise of the joint transition, `-ln Σ_s A[o_t,s] ŝ_t[s]`
+        /// (Lemma 1), which also fires on the car's own bin crossings.
+        OneStep = "one-step",
+    }
 }
 
-impl Default for LearningParams {
-    fn default() -> Self {
-        Self {
-            enabled: true,
-            learning_rate: 1.0,
-            nu0: 10.0,
-            nu_temperature: 1.0,
-            habit_memory: 20.0,
-        }
+param_enum! {
+    /// How the gate's table learns a situation as familiar (§V applied to the gate;
+    /// docs/ARCHITECTURE.md §4.4). Beyond the paper, whose rule is only `θ <= ε`.
+    pub enum GateLearning {
+        /// A reasoning tick counts in the gate's table with weight `π'(a_o) / max_u π'(u)`,
+        /// where `a_o` is the habit's action after this episode's update of `ν`: a situation
+        /// becomes familiar (and control returns to the habit) only as far as the planner
+        /// endorses what the habit would do there. Feed-forward ticks count fully.
+        #[default]
+        Endorsed = "endorsed",
+        /// Ablation: every tick counts fully (the situation becomes familiar whatever the habit does).
+        Every = "every",
     }
+}
+
+param_enum! {
+    /// What the trigger subtracts from the gate's surprise before `θ = 1 - exp(-Ω S)`
+    /// ([`crate::gate::StateGate::excess_surprise`]). Beyond the paper, whose trigger reads `S`.
+    pub enum GateBaseline {
+        /// The surprise expected in the state, `c(s) H(row)`, where `c(s)` grows with the
+        /// reasoning ticks in that state that endorsed the habit (full after `gate_memory`):
+        /// the uncertainty of a situation stops triggering reasoning once the habit has
+        /// been shown to act there as reasoning would. Zero for a never-endorsed state.
+        #[default]
+        Endorsed = "endorsed",
+        /// Ablation (the paper's trigger): nothing; `θ` reads the surprise itself.
+        None = "none",
+    }
+}
+
+param_enum! {
+    /// When control goes back to the habit on a tick whose `θ <= ε` ([`crate::handback`];
+    /// docs/ARCHITECTURE.md §4.10). Beyond the paper, whose rule is `θ <= ε` alone.
+    pub enum HandBackRule {
+        /// Where test-time learning changed the trigger's verdict, learning may only take
+        /// reasoning away, and only where the habit is safe. A hand-back that learning made
+        /// (the trained agent's trigger would still fire) is made only if the habit, rolled
+        /// forward `handback_horizon` ticks through the learned model, enters a crash-risk
+        /// state at most `handback_risk` more likely than the safest action; otherwise the
+        /// agent reasons. A reasoning tick that learning alone made (the trained trigger would
+        /// hand back, the learned one fires: learning that pedestrians are common makes an
+        /// empty road read as surprising) is declined: the habit acts, as the trained agent's
+        /// would. So the agent reasons only where its trained trigger fires.
+        #[default]
+        DeclineLearned = "decline-learned",
+        /// Option: the crash-risk check decides both ways. Hand-backs as `DeclineLearned`; a
+        /// reasoning tick that learning alone made is taken where the check finds the habit at
+        /// risk (e.g. about to run a red light into a crosswalk where pedestrians cross on red),
+        /// otherwise declined. There the planner acts on what it knows and the habit has not
+        /// learnt (a traffic rule: on the rule-aware maps/red_light/ it saves cars of two of
+        /// 20 agents), at the cost of reasoning on an empty road (EXPERIMENTS.md, "The safe
+        /// hand-back").
+        RiskChecked = "risk-checked",
+        /// Ablation: only hand-backs that learning made are checked; every tick the learned
+        /// trigger fires on reasons.
+        HandBackChecked = "hand-back-checked",
+        /// Ablation (the paper's rule): `θ <= ε` hands back, whatever the habit does.
+        Theta = "theta",
+    }
+}
+
+param_enum! {
+    /// Whether the world model checks the habit where the surprise gate leaves it in charge
+    /// ([`crate::competence`]; docs/ARCHITECTURE.md §4.11). Beyond the paper, whose agent
+    /// trusts the habit wherever nothing surprises it.
+    pub enum CompetenceCheck {
+        /// The habit acts only where holding its action for `competence_horizon` ticks is
+        /// predicted (expected free energy, Prop. 1) at most `competence_regret` nats worse than
+        /// holding the best action, or where the best action is the riskier (by more than
+        /// `handback_risk`); otherwise the agent reasons.
+        #[default]
+        Regret = "regret",
+        /// Ablation (the paper's agent): reasoning only where the gate finds surprise.
+        SurpriseOnly = "surprise-only",
+    }
+}
+
+param_enum! {
+    /// Which model the EFE tree's first step from `q_t` goes through
+    /// ([`crate::planning::EfeTree::evaluate`]).
+    pub enum RootStep {
+        /// The learned `B`: the car observes `q_t` while the episode goes on, so from a
+        /// crash-risk state braking out of it counts; later steps absorb.
+        #[default]
+        Learned = "learned",
+        /// Ablation: the planning model's, where episode-ending states are absorbing from
+        /// the root on, so every action from a crash-risk state ends alike.
+        Absorbing = "absorbing",
+    }
+}
+
+param_enum! {
+    /// How the planner models a crash at the crosswalk.
+    pub enum CrashPlanning {
+        /// The paper's model (the ablation): every state with a pedestrian on the crosswalk
+        /// while the car moves in the crosswalk's distance bin is a crash, absorbing, whatever
+        /// the car does, so braking there earns nothing and a dash to the goal looks best.
+        States = "states",
+        /// Beyond the paper, the default: a tick in the crosswalk's bin with a pedestrian on
+        /// the crosswalk ends in a crash with a probability that grows with the distance the
+        /// car covers under the action, and a crashed episode forfeits the goal
+        /// ([`crate::model::CrashModel`]); braking there earns what it saves. Where the car is
+        /// already on the crosswalk when a pedestrian steps on, stopping can be what gets it
+        /// hit (EXPERIMENTS.md, "The crosswalk's distance bins and the crash model"). Agents
+        /// without a crash model plan as `states`.
+        #[default]
+        Hazard = "hazard",
+    }
+}
+
+param_groups! {
+    /// Hyperparameters of the paper's agent ([`crate::scaled_agent::ScaledAgent`]), grouped by the
+    /// paper's concepts. Every parameter has a key (the name in the table below; the
+    /// dotted `group.key` is accepted too) by which it is read and set
+    /// ([`ScaledParams::get`], [`ScaledParams::set_str`], [`ScaledParams::set`],
+    /// [`crate::param_table`]). Each group's fields are declared once, with their key,
+    /// default and range (`param_group!` below): the struct, its serde names, the table's
+    /// setter and getter and the range checks all come from that declaration, so a field
+    /// added to a group is settable by name with no other edit.
+    ///
+    /// | group | key | default | range | paper |
+    /// |---|---|---|---|---|
+    /// | `gate` | `omega` Ω | 0.425 | finite and > 0 | §IV θ = 1 - exp(-Ω S), §VI |
+    /// | `gate` | `epsilon` ε | 0.2 | [0, 1) | §II reasoning trigger θ > ε, §VI |
+    /// | `gate` | `gate` | `state` | `state`, `one-step` | §VI surprise on the state, or the one-step joint surprise (ablation) ([`GateMode`]) |
+    /// | `gate` | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
+    /// | `gate` | `gate_memory` | 20.0 | > 0 (`inf` allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
+    /// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
+    /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `none` is the paper's trigger) ([`GateBaseline`]) |
+    /// | `gate` | `handback` | `decline-learned` | `decline-learned`, `risk-checked`, `hand-back-checked`, `theta` | where test-time learning changed the trigger's verdict: a hand-back learning made goes to the habit only if the world model's crash-risk check passes, a reasoning tick learning alone made is declined (beyond the paper; `risk-checked` takes such a tick where the check finds the habit at risk, `hand-back-checked` takes every one, `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
+    /// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
+    /// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |
+    /// | `gate` | `competence` | `regret` | `regret`, `surprise-only` | where the gate leaves the habit in charge, the world model scores holding its action against holding the best one, and the agent reasons where it is worse by more than `competence_regret` (beyond the paper; `surprise-only` is the paper's agent) ([`CompetenceCheck`]) |
+    /// | `gate` | `competence_regret` | 10.0 | finite and >= 0 | nats of expected free energy by which holding the habit's action may be worse than holding the best action before the agent reasons |
+    /// | `gate` | `competence_horizon` | 8 | 1..=40 | ticks each action is held by the competence check |
+    /// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
+    /// | `perception` | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
+    /// | `perception` | `vmp_tol` | 1e-6 | finite and > 0 | VMP convergence threshold on max \|Δ q\| |
+    /// | `perception` | `vmp_max_iters` | 32 | 1..=10000 | VMP iteration cap |
+    /// | `planning` | `gamma` γ | 0.5 | finite and > 0 | Cor. 1 q(π) = σ(-γG), §VI |
+    /// | `planning` | `horizon` H | 3 | 1..=8 | policy length (n_actions^H policies, Prop. 1) |
+    /// | `planning` | `root_step` | `learned` | `learned`, `absorbing` | the EFE tree's first step uses the learned `B`, later steps the absorbing planning model ([`RootStep`]; `absorbing` absorbs from the root on) |
+    /// | `planning` | `crash_model` | `hazard` | `hazard`, `states` | a crash as a transition whose probability grows with the distance the car covers, forfeiting the goal (beyond the paper), or the paper's absorbing crash-risk states ([`CrashPlanning`]) |
+    /// | `planning` | `persistence_ignores` | `"d+L"` | next-time parents' names joined by `+`, or `""` (also written `none`) | the watched factor's persistence (rows where it was present) is pooled over these parents in the model `B` is built from ([`crate::model::WorldModel::set_persistence_pooling`]; beyond the paper, `""` is the paper's CPT) |
+    /// | `scaling` | `varsigma` ς | 0.05 | finite and >= 0 | eq. "stopping_criterion", §VI |
+    /// | `scaling` | `kappa_pi` | 1.0 | (0, 1] | scaling step size: 1 is the paper's step (eq. "gradient_descent_equations": one step lands on ψ); smaller steps stop part-way |
+    /// | `scaling` | `max_scaling_iters` | 50 | 1..=10000 | cap of the scaling loop |
+    /// | `scaling` | `scaling_mode` | `iterative` | `iterative`, `closed-form` | Theorem 1 iterative / closed form ([`ScalingMode`]) |
+    /// | `scaling` | `action_selection` | `outcome-mode` | `outcome-mode`, `mode`, `sample` | act on the mode over the outcomes the model tells apart, on the policy's mode (the paper's, ablation) or sample it ([`ActionSelection`]) |
+    /// | `scaling` | `tie_break` | `safest` | `safest`, `chosen` | among the actions whose predicted next state is within `tie_tolerance` of the chosen one's, take the one least likely to crash within `handback_horizon` ticks (beyond the paper), or the chosen one (the paper's, ablation) ([`TieBreak`]) |
+    /// | `scaling` | `tie_tolerance` | 0.05 | [0, 1) | the total variation between two actions' predicted next states below which the model cannot tell them apart |
+    /// | `scaling` | `reasoning` | `triggered` | `triggered`, `always` | reason when θ > ε, or on every tick (ablation) ([`ReasoningMode`]) |
+    /// | `learning` | `learning` | true | true, false | test-time learning §V at episode end |
+    /// | `learning` | `learning_rate` | 1.0 | finite and >= 0 | multiplies the expected counts added in §V |
+    /// | `learning` | `nu0` ν0 | 10.0 | finite and > 0 | prior strength of ν = ν0 σ(Q/T) (docs/ARCHITECTURE.md §4.8) |
+    /// | `learning` | `nu_temperature` T | 1.0 | finite and > 0 | temperature of ν's softmax over Q |
+    /// | `learning` | `habit_memory` | 20.0 | > 0 (`inf` allowed) | counts of reasoning a state of the habit keeps beyond its prior: each state's counts are rescaled to at most this many at the end of an episode (beyond the paper; [`crate::habit::Habit::bound_memory`]) |
+    ///
+    /// Where each range is enforced: numbers, enum values and the spelling of `gate_factor`
+    /// and `persistence_ignores` (names without spaces, `+` between names, no name twice)
+    /// when set by name and by [`ScaledParams::check`]; that the watched factor is not
+    /// among the pooled ones by `check`; that they name factors of the model (the watched factor, and
+    /// next-time parents of it) only where a model is known, by
+    /// [`CheckedScaledParams::check_factors`], which [`crate::scaled_agent::ScaledAgent::new`] calls.
+    pub struct ScaledParams {
+        /// The reasoning trigger (§II, §IV, §VI).
+        gate: GateParams,
+        /// VMP perception (§III).
+        perception: PerceptionParams,
+        /// EFE planning (§IV, Prop. 1, Cor. 1).
+        planning: PlanningParams,
+        /// Test-time policy scaling and action selection (§IV, Theorem 1).
+        scaling: ScalingParams,
+        /// Test-time learning (§V).
+        learning: LearningParams,
+    }
+}
+
+param_group! {
+    /// The reasoning trigger's parameters (table of [`ScaledParams`]).
+    pub struct GateParams {
+        /// Ω, saturation of the normalised surprise.
+        omega: f64 = 0.425 => "omega" in Bound::Positive,
+        /// ε, reasoning threshold on θ.
+        epsilon: f64 = 0.2 => "epsilon" in Bound::BelowOne,
+        /// What the reasoning trigger measures (key `gate`).
+        mode: GateMode = GateMode::State => "gate",
+        /// Name of the factor the state gate watches (given its next-time parents).
+        gate_factor: String = "p".into() => "gate_factor" in NameRule::Factor,
+        /// Data counts each row of the state gate's table keeps (bounded memory; `inf`
+        /// is written as the string `"inf"`).
+        #[serde(with = "f64_or_inf")]
+        gate_memory: f64 = 20.0 => "gate_memory" in Bound::PositiveOrInf,
+        /// How the gate's table learns a situation as familiar.
+        gate_learning: GateLearning = GateLearning::Endorsed => "gate_learning",
+        /// What the trigger subtracts from the gate's surprise.
+        gate_baseline: GateBaseline = GateBaseline::Endorsed => "gate_baseline",
+        /// When control goes back to the habit.
+        handback: HandBackRule = HandBackRule::DeclineLearned => "handback",
+        /// ρ: the largest excess of the habit's predicted crash risk over the safest first
+        /// action's at which control goes back to it.
+        handback_risk: f64 = 0.08 => "handback_risk" in Bound::BelowOne,
+        /// Ticks of the hand-back check's rollout of the habit.
+        handback_horizon: usize = 3 => "handback_horizon" in count(
+            MAX_HORIZON,
+            "in 1..=8 (the hand-back check rolls the habit forward on the ticks it checks)",
+        ),
+        /// Whether the world model checks the habit's action on the ticks the gate leaves to it.
+        competence: CompetenceCheck = CompetenceCheck::Regret => "competence",
+        /// The largest regret (nats) of holding the habit's action at which it acts.
+        competence_regret: f64 = 10.0 => "competence_regret" in Bound::NonNegative,
+        /// Ticks each action is held by the competence check.
+        competence_horizon: usize = 8 => "competence_horizon" in count(
+            MAX_COMPETENCE_HORIZON,
+            "in 1..=40 (the competence check holds each action this many ticks where the habit acts)",
+        ),
+    }
+}
+
+param_group! {
+    /// VMP perception's parameters (table of [`ScaledParams`]).
+    pub struct PerceptionParams {
+        /// VMP window W.
+        vmp_window: usize = 4 => "vmp_window" in count(
+            MAX_VMP_WINDOW,
+            "in 1..=1000 (the perception keeps a belief per tick of the window)",
+        ),
+        /// VMP step size κ.
+        vmp_kappa: f64 = 1.0 => "vmp_kappa" in Bound::HalfOpenUnit,
+        /// VMP tolerance.
+        vmp_tol: f64 = 1e-6 => "vmp_tol" in Bound::Positive,
+        /// VMP iteration cap.
+        vmp_max_iters: u32 = 32 => "vmp_max_iters" in count(
+            MAX_ITERATIONS,
+            "in 1..=10000 (VMP runs on every reasoning tick)",
+        ),
+    }
+}
+
+param_group! {
+    /// EFE planning's parameters (table of [`ScaledParams`]).
+    pub struct PlanningParams {
+        /// γ, policy precision.
+        gamma: f64 = 0.5 => "gamma" in Bound::Positive,
+        /// Planning horizon H.
+        horizon: usize = 3 => "horizon" in count(
+            MAX_HORIZON,
+            "in 1..=8 (the planner evaluates n_actions^H policies on every reasoning tick)",
+        ),
+        /// The model of the EFE tree's first step.
+        root_step: RootStep = RootStep::Learned => "root_step",
+        /// How a crash at the crosswalk is modelled.
+        crash_model: CrashPlanning = CrashPlanning::Hazard => "crash_model",
+        /// The next-time parents the watched factor's persistence does not depend on, joined
+        /// by `+` (`""`: none; `"none"` is read as `""`).
+        #[serde(deserialize_with = "factor_list")]
+        persistence_ignores: String = "d+L".into() => "persistence_ignores" in NameRule::FactorList,
+    }
+}
+
+param_group! {
+    /// Policy scaling's parameters (table of [`ScaledParams`]).
+    pub struct ScalingParams {
+        /// ς, stopping tolerance.
+        varsigma: f64 = 0.05 => "varsigma" in Bound::NonNegative,
+        /// Scaling step size in (0, 1].
+        kappa_pi: f64 = 1.0 => "kappa_pi" in Bound::HalfOpenUnit,
+        /// Maximum scaling iterations.
+        max_scaling_iters: u32 = 50 => "max_scaling_iters" in count(
+            MAX_ITERATIONS,
+            "in 1..=10000 (the scaling loop runs on every reasoning tick)",
+        ),
+        /// Iterative or closed-form scaling.
+        scaling_mode: ScalingMode = ScalingMode::Iterative => "scaling_mode",
+        /// Mode over outcomes, mode or sample.
+        action_selection: ActionSelection = ActionSelection::OutcomeMode => "action_selection",
+        /// What happens to the actions the model cannot tell from the chosen one.
+        tie_break: TieBreak = TieBreak::Safest => "tie_break",
+        /// Total variation below which two actions' predicted next states are the same.
+        tie_tolerance: f64 = 0.05 => "tie_tolerance" in Bound::BelowOne,
+        /// Triggered or always.
+        reasoning: ReasoningMode = ReasoningMode::Triggered => "reasoning",
+    }
+}
+
+param_group! {
+    /// Test-time learning's parameters (table of [`ScaledParams`]).
+    pub struct LearningParams {
+        /// Test-time learning on/off (key `learning`).
+        enabled: bool = true => "learning",
+        /// Test-time learning rate.
+        learning_rate: f64 = 1.0 => "learning_rate" in Bound::NonNegative,
+        /// ν0, prior strength of the policy counts.
+        nu0: f64 = 10.0 => "nu0" in Bound::Positive,
+        /// T, temperature of the Q softmax that initialises ν.
+        nu_temperature: f64 = 1.0 => "nu_temperature" in Bound::Positive,
+        /// Counts of reasoning each state of the habit keeps beyond its prior (bounded memory;
+        /// `inf`, written as the string `"inf"`, is unbounded).
+        #[serde(with = "f64_or_inf")]
+        habit_memory: f64 = 20.0 => "habit_memory" in Bound::PositiveOrInf,
+    }
+}
+
+/// A count's range: `1..=max`, stated as `expected` (the range and why).
+const fn count(max: usize, expected: &'static str) -> Bound {
+    Bound::Count { max, expected }
 }
 
 /// `gate_memory` and `habit_memory`: a number, or `"inf"` (JSON has no infinity).
@@ -573,58 +526,7 @@ mod f64_or_inf {
 
 /// `persistence_ignores`: `"none"` is read as `""` (no pooling).
 fn factor_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
-    let s = String::deserialize(d)?;
-    Ok(if s.trim() == "none" { String::new() } else { s })
-}
-
-/// The range of one numeric parameter of [`ScaledParams`], as [`ScaledParams::check`]
-/// enforces it and error messages state it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Bound {
-    /// Finite and > 0.
-    Positive,
-    /// Finite and >= 0.
-    NonNegative,
-    /// In (0, 1].
-    HalfOpenUnit,
-    /// In [0, 1).
-    BelowOne,
-    /// > 0, infinity allowed.
-    PositiveOrInf,
-    /// A whole number in `1..=max`: counts that size an allocation or a loop, so that no
-    /// setting asks for more memory or time than a run has.
-    Count {
-        /// Largest value.
-        max: usize,
-        /// The range and why, e.g. `"in 1..=1000 (...)"`.
-        expected: &'static str,
-    },
-}
-
-impl Bound {
-    /// The range in words, as error messages give it.
-    pub fn expected(self) -> &'static str {
-        match self {
-            Bound::Positive => "finite and > 0",
-            Bound::NonNegative => "finite and >= 0",
-            Bound::HalfOpenUnit => "in (0, 1]",
-            Bound::BelowOne => "in [0, 1)",
-            Bound::PositiveOrInf => "> 0 (inf for unbounded)",
-            Bound::Count { expected, .. } => expected,
-        }
-    }
-
-    /// Whether `x` is in range (a count must be whole).
-    pub fn admits(self, x: f64) -> bool {
-        match self {
-            Bound::Positive => x > 0.0 && x.is_finite(),
-            Bound::NonNegative => x >= 0.0 && x.is_finite(),
-            Bound::HalfOpenUnit => x > 0.0 && x <= 1.0,
-            Bound::BelowOne => (0.0..1.0).contains(&x),
-            Bound::PositiveOrInf => x > 0.0,
-            Bound::Count { max, .. } => x.fract() == 0.0 && x >= 1.0 && x <= max as f64,
-        }
-    }
+    Ok(NameRule::FactorList.normal(String::deserialize(d)?))
 }
 
 /// Largest planning horizon: the EFE tree evaluates `n_actions^H` policies per reasoning tick.
@@ -634,120 +536,25 @@ pub const MAX_HORIZON: usize = 8;
 pub const MAX_COMPETENCE_HORIZON: usize = 40;
 
 impl ScaledParams {
-    /// Every numeric parameter's key, value and range (the table above).
-    pub fn bounds(&self) -> [(&'static str, f64, Bound); 21] {
-        let (g, pe, pl, s, l) = (
-            &self.gate,
-            &self.perception,
-            &self.planning,
-            &self.scaling,
-            &self.learning,
-        );
-        let count = |max, expected| Bound::Count { max, expected };
-        [
-            ("omega", g.omega, Bound::Positive),
-            ("epsilon", g.epsilon, Bound::BelowOne),
-            ("gate_memory", g.gate_memory, Bound::PositiveOrInf),
-            ("handback_risk", g.handback_risk, Bound::BelowOne),
-            (
-                "handback_horizon",
-                g.handback_horizon as f64,
-                count(
-                    MAX_HORIZON,
-                    "in 1..=8 (the hand-back check rolls the habit forward on the ticks it checks)",
-                ),
-            ),
-            ("competence_regret", g.competence_regret, Bound::NonNegative),
-            (
-                "competence_horizon",
-                g.competence_horizon as f64,
-                count(
-                    MAX_COMPETENCE_HORIZON,
-                    "in 1..=40 (the competence check holds each action this many ticks where the habit acts)",
-                ),
-            ),
-            (
-                "vmp_window",
-                pe.vmp_window as f64,
-                count(
-                    MAX_VMP_WINDOW,
-                    "in 1..=1000 (the perception keeps a belief per tick of the window)",
-                ),
-            ),
-            ("vmp_kappa", pe.vmp_kappa, Bound::HalfOpenUnit),
-            ("vmp_tol", pe.vmp_tol, Bound::Positive),
-            (
-                "vmp_max_iters",
-                f64::from(pe.vmp_max_iters),
-                count(MAX_ITERATIONS, "in 1..=10000 (VMP runs on every reasoning tick)"),
-            ),
-            ("gamma", pl.gamma, Bound::Positive),
-            (
-                "horizon",
-                pl.horizon as f64,
-                count(
-                    MAX_HORIZON,
-                    "in 1..=8 (the planner evaluates n_actions^H policies on every reasoning tick)",
-                ),
-            ),
-            ("varsigma", s.varsigma, Bound::NonNegative),
-            ("tie_tolerance", s.tie_tolerance, Bound::BelowOne),
-            ("kappa_pi", s.kappa_pi, Bound::HalfOpenUnit),
-            (
-                "max_scaling_iters",
-                f64::from(s.max_scaling_iters),
-                count(
-                    MAX_ITERATIONS,
-                    "in 1..=10000 (the scaling loop runs on every reasoning tick)",
-                ),
-            ),
-            ("learning_rate", l.learning_rate, Bound::NonNegative),
-            ("nu0", l.nu0, Bound::Positive),
-            ("nu_temperature", l.nu_temperature, Bound::Positive),
-            ("habit_memory", l.habit_memory, Bound::PositiveOrInf),
-        ]
-    }
-
-    /// The range of the numeric parameter `key` (a flat key), if it is one.
-    pub fn bound_of(key: &str) -> Option<Bound> {
-        ScaledParams::default()
-            .bounds()
-            .into_iter()
-            .find(|(k, _, _)| *k == key)
-            .map(|(_, _, b)| b)
-    }
-
-    /// Every violation of the table's ranges and of the factor names' spelling, in
-    /// table order.
+    /// Every violation of the declared ranges (numbers, counts, the factor names'
+    /// spelling), group by group in declaration order, then of the rules between fields.
     pub(crate) fn problems(&self) -> Vec<ParamError> {
-        let mut out: Vec<ParamError> = self
-            .bounds()
-            .into_iter()
-            .filter(|(_, x, b)| !b.admits(*x))
-            .map(|(k, x, b)| ParamError::new(k, x, b.expected()))
-            .collect();
-        let factor = &self.gate.gate_factor;
-        let bad_name = |n: &str| n.is_empty() || n.contains('+') || n.chars().any(char::is_whitespace);
-        if bad_name(factor) {
-            out.push(ParamError::new(
-                "gate_factor",
-                format!("{factor:?}"),
-                "a factor's name (not empty, no spaces, no `+`)",
-            ));
-        }
-        let ignores = &self.planning.persistence_ignores;
-        if !ignores.is_empty() {
-            let names: Vec<&str> = ignores.split('+').collect();
-            let twice = names.iter().enumerate().any(|(i, n)| names[..i].contains(n));
-            if names.iter().any(|n| bad_name(n)) || twice || names.contains(&factor.as_str()) {
-                out.push(ParamError::new(
-                    "persistence_ignores",
-                    format!("{ignores:?}"),
-                    "factor names joined by `+` (no spaces, none twice, not gate_factor), or \"\" / none",
-                ));
-            }
-        }
+        let mut out = self.field_problems();
+        out.extend(self.cross_problem().filter(|e| !out.iter().any(|o| o.name == e.name)));
         out
+    }
+
+    /// The rule between fields: `persistence_ignores` does not name the watched factor
+    /// (`gate_factor`). The error names `persistence_ignores`.
+    pub(crate) fn cross_problem(&self) -> Option<ParamError> {
+        let (factor, ignores) = (&self.gate.gate_factor, &self.planning.persistence_ignores);
+        (!ignores.is_empty() && ignores.split('+').any(|n| n == factor)).then(|| {
+            ParamError::new(
+                "persistence_ignores",
+                format!("{ignores:?}"),
+                NameRule::FactorList.range().unwrap_or(""),
+            )
+        })
     }
 
     /// Validate ranges (table above) without consuming the parameters.

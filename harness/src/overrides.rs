@@ -7,6 +7,7 @@
 //! as its flag, `--set`.
 
 use unforeseen_agent::error::SetError;
+use unforeseen_agent::param_decl::ParamValue;
 use unforeseen_agent::param_table;
 use unforeseen_agent::params::ScaledParams;
 
@@ -23,7 +24,7 @@ pub fn help() -> String {
     let mut groups: Vec<(String, Vec<String>)> = Vec::new();
     for k in param_table::keys() {
         let shown = match p.get(&k.name) {
-            Ok(serde_json::Value::String(s)) => format!("{}={s:?}", k.name),
+            Ok(ParamValue::Name(s)) => format!("{}={s:?}", k.name),
             Ok(v) => format!("{}={v}", k.name),
             Err(_) => k.name.clone(),
         };
@@ -83,9 +84,9 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), Error
     p.set_str(key, value).map_err(|e| override_error(key, value, e))
 }
 
-/// Sets one parameter by name to a typed value (as [`ScaledParams::set_value`]; for
-/// keyword arguments of other front ends). The same path as [`set_one`].
-pub fn set_value(p: &mut ScaledParams, key: &str, value: serde_json::Value) -> Result<(), Error> {
+/// Sets one parameter by name to a typed value (as [`ScaledParams::set`]; for keyword
+/// arguments of other front ends). The same checks and messages as [`set_one`].
+pub fn set_value(p: &mut ScaledParams, key: &str, value: ParamValue) -> Result<(), Error> {
     let shown = value.to_string();
-    p.set_value(key, value).map_err(|e| override_error(key, &shown, e))
+    p.set(key, value).map_err(|e| override_error(key, &shown, e))
 }

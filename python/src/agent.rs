@@ -9,6 +9,7 @@ use std::sync::Mutex;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
 use unforeseen_agent::controller::{Controller, Decision, Ending};
+use unforeseen_agent::param_decl::ParamValue;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::methods::Method;
@@ -44,20 +45,16 @@ pub fn protocol(name: &str) -> PyResult<Protocol> {
 }
 
 /// A keyword argument as the typed value the parameter table takes: a bool, a whole
-/// number or a float (`inf` as the table writes it).
-fn json_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
-    use serde_json::Value;
+/// number or a float (`inf` included).
+fn param_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<ParamValue> {
     if v.is_instance_of::<PyBool>() {
-        return Ok(Value::Bool(v.extract()?));
+        return Ok(ParamValue::Bool(v.extract()?));
     }
     if let Ok(i) = v.extract::<i64>() {
-        return Ok(Value::from(i));
+        return Ok(ParamValue::Int(i));
     }
     if let Ok(x) = v.extract::<f64>() {
-        return Ok(serde_json::Number::from_f64(x).map_or_else(
-            || Value::String(if x > 0.0 { "inf".into() } else { x.to_string() }),
-            Value::Number,
-        ));
+        return Ok(ParamValue::Number(x));
     }
     Err(errors::value(format!(
         "{key}: expected a number, a bool or a string, got {}",
@@ -77,7 +74,8 @@ pub fn scaled_params(params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParam
             if let Ok(text) = v.extract::<String>() {
                 unforeseen_harness::overrides::set_one(&mut p, &key, &text).map_err(errors::to_py)?;
             } else {
-                unforeseen_harness::overrides::set_value(&mut p, &key, json_value(&key, &v)?).map_err(errors::to_py)?;
+                unforeseen_harness::overrides::set_value(&mut p, &key, param_value(&key, &v)?)
+                    .map_err(errors::to_py)?;
             }
         }
     }

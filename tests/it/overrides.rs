@@ -1,46 +1,45 @@
 //! `--set` overrides and the scaled agent's parameter table: every key is
 //! settable and reads back, bad keys and values name what is allowed, the typed entry
-//! point agrees with the text one, `scaling_mode=closed-form` reaches the closed form of
-//! Theorem 1, and a sweep counts equal values once.
+//! point agrees with the text one, and a sweep counts equal values once (that a
+//! parameter set by name reaches the agent, e.g. the closed form of Theorem 1, is the
+//! agent's test: agent/tests/it/closed_form.rs).
 
-use serde_json::{Value, json};
-use unforeseen_agent::controller::Controller;
+use unforeseen_agent::param_decl::ParamValue;
 use unforeseen_agent::param_table;
-use unforeseen_agent::params::{ScaledParams, ScalingMode};
+use unforeseen_agent::params::ScaledParams;
 use unforeseen_harness::fixtures;
 use unforeseen_harness::overrides::{apply, keys, set_one, set_value};
 use unforeseen_harness::runs::batch::sweep;
 
-/// A value other than the default for each key, as `--set` text and as JSON.
-fn other_value(key: &str) -> (String, Value) {
+/// A value other than the default for each key, as `--set` text and typed.
+fn other_value(key: &str) -> (String, ParamValue) {
     match ScaledParams::default().get(key).unwrap() {
-        Value::Bool(b) => ((!b).to_string(), json!(!b)),
-        Value::Number(n) if n.is_u64() => ("2".into(), json!(if n.as_u64() == Some(2) { 1 } else { 2 })),
-        Value::Number(n) => {
-            let x = n.as_f64().unwrap() / 4.0;
-            (x.to_string(), json!(x))
+        ParamValue::Bool(b) => ((!b).to_string(), ParamValue::Bool(!b)),
+        ParamValue::Int(n) => ("2".into(), ParamValue::Int(if n == 2 { 1 } else { 2 })),
+        ParamValue::Number(x) => {
+            let x = x / 4.0;
+            (x.to_string(), ParamValue::Number(x))
         }
-        Value::String(_) if key == "gate_factor" => ("v".into(), json!("v")),
-        Value::String(_) if key == "persistence_ignores" => ("L".into(), json!("L")),
-        Value::String(s) => {
+        ParamValue::Name(_) if key == "gate_factor" => ("v".into(), ParamValue::Name("v".into())),
+        ParamValue::Name(_) if key == "persistence_ignores" => ("L".into(), ParamValue::Name("L".into())),
+        ParamValue::Name(s) => {
             let e = apply(ScaledParams::default(), &[format!("{key}=?")])
                 .unwrap_err()
                 .to_string();
             let allowed = e.split("one of: ").nth(1).unwrap_or_else(|| panic!("{key}: {e}"));
             let x = allowed.split(", ").find(|v| **v != *s).unwrap().to_string();
-            (x.clone(), json!(x))
+            (x.clone(), ParamValue::Name(x))
         }
-        other => panic!("{key}: {other}"),
     }
 }
 
 #[test]
-fn every_key_round_trips_and_the_json_entry_point_agrees() {
+fn every_key_round_trips_and_the_typed_entry_point_agrees() {
     assert!(keys().len() >= 25, "{:?}", keys());
     for key in keys() {
         let (text, value) = other_value(key);
-        let (text, value) = if key == "horizon" || value == json!(1) {
-            ("1".to_string(), json!(1))
+        let (text, value) = if key == "horizon" || value == ParamValue::Int(1) {
+            ("1".to_string(), ParamValue::Int(1))
         } else {
             (text, value)
         };
@@ -49,7 +48,7 @@ fn every_key_round_trips_and_the_json_entry_point_agrees() {
         assert_eq!(set.get(key).unwrap(), value, "{key} reads back");
         let mut typed = ScaledParams::default();
         set_value(&mut typed, key, value.clone()).unwrap();
-        assert_eq!(typed, set, "{key}: JSON and text differ");
+        assert_eq!(typed, set, "{key}: typed and text differ");
         let dotted = param_table::lookup(key).unwrap().dotted();
         let mut by_dotted = ScaledParams::default();
         set_one(&mut by_dotted, &dotted, &text).unwrap();
@@ -93,9 +92,16 @@ fn unknown_keys_and_bad_values_name_the_key_and_the_allowed_values() {
     let e = err(&["horizon=9"]);
     assert!(e.contains("horizon") && e.contains("1..=8"), "{e}");
     let mut p = ScaledParams::default();
-    let e = set_value(&mut p, "vmp_tol", json!("small")).unwrap_err().to_string();
-    assert!(e.contains("vmp_tol") && e.contains("finite and > 0"), "{e}");
-    let e = set_value(&mut p, "no_such", json!(1)).unwrap_err().to_string();
+    let e = set_value(&mut p, "vmp_tol", ParamValue::Name("small".into()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("vmp_tol") && e.contains("small") && e.contains("finite and > 0"),
+        "{e}"
+    );
+    let e = set_value(&mut p, "no_such", ParamValue::Int(1))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("no_such") && e.contains("scaling_mode"), "{e}");
 }
 
@@ -117,45 +123,6 @@ fn factor_names_are_checked_against_the_model() {
         e.contains("persistence_ignores") && e.contains("next-time parents of `p`"),
         "{e}"
     );
-}
-
-/// `--set scaling_mode=closed-form` reaches Theorem 1's closed form: on every reasoning
-/// tick the policy acted upon is `π_o ψ^θ`, normalised.
-#[test]
-fn scaling_mode_closed_form_reaches_the_closed_form_and_acts() {
-    let p = apply(
-        ScaledParams::default(),
-        &["scaling_mode=closed-form".into(), "reasoning=always".into()],
-    )
-    .unwrap();
-    assert_eq!(p.scaling.scaling_mode, ScalingMode::ClosedForm);
-    let bundle = fixtures::bundle();
-    let mut agent = unforeseen_harness::episodes::methods::scaled_agent(bundle, p).unwrap();
-    let n = bundle.world_model.n_states();
-    agent.begin_episode(3);
-    let mut reasoned = 0;
-    for s in (0..n).step_by(5).take(8) {
-        let d = agent.act(s);
-        assert!(d.action < 3);
-        assert_eq!(d.scaling_iters, 0, "the closed form does not iterate");
-        if !d.reasoned {
-            continue;
-        }
-        reasoned += 1;
-        let (th, tr) = (d.theta.unwrap(), agent.last_reasoning());
-        let floor = unforeseen_agent::maths::LN_FLOOR;
-        let raw: Vec<f64> = tr
-            .pi_o
-            .iter()
-            .zip(&tr.psi)
-            .map(|(o, p)| o * p.max(floor).powf(th))
-            .collect();
-        let z: f64 = raw.iter().sum();
-        for (got, want) in d.policy.iter().zip(&raw) {
-            assert!((got - want / z).abs() < 1e-9, "{:?} vs {raw:?}/{z}", d.policy);
-        }
-    }
-    assert!(reasoned > 0);
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! instead of one per file keeps `cargo test` builds short).
 
 mod bundle_and_controllers;
+mod closed_form;
 mod hand_worked;
 mod planning_root;
 mod properties;

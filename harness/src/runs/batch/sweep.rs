@@ -69,7 +69,7 @@ pub fn sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
             p.set_str(key, v).and_then(|()| p.get(key)).ok()
         };
         let mut values: Vec<&str> = Vec::new();
-        let mut seen: Vec<Result<serde_json::Value, &str>> = Vec::new();
+        let mut seen: Vec<Result<unforeseen_agent::param_decl::ParamValue, &str>> = Vec::new();
         for v in listed {
             let id = parsed(v).ok_or(v);
             if !seen.contains(&id) {

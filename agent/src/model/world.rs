@@ -1,400 +1,45 @@
-//! The world model `W` (§II-A eq. "world model"; Dirichlet parameters §V):
-//! factor CPTs with Dirichlet counts, the joint `B[u]` materialised from them,
-//! the observation model `A` with Dirichlet counts, preferences `C` and the state prior `D`.
+//! The agent's world model `W` (§II-A eq. "world model"; Dirichlet parameters §V):
+//! factor CPTs with Dirichlet counts, the joint `B[u]` materialised from them, the
+//! observation model `A` with Dirichlet counts, preferences `C` and the state prior `D`.
 
 use crate::error::{AgentError, FieldError, ParamError};
-use crate::limits::{MAX_ACTIONS, MAX_STATES, MAX_VALUE};
-use crate::maths::{LN_FLOOR, ln, log_softmax};
+use crate::limits::{MAX_ACTIONS, MAX_STATES};
+use crate::maths::{LN_FLOOR, log_softmax};
 use crate::params::ModelPriors;
-use crate::stored_values;
-use crate::structure::{Parent, Structure};
+use crate::structure::Structure;
 use crate::transition::{FactoredLogB, FactoredTransition};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-/// The plain matrices of a generative model (what perception and planning read):
-/// `A[o,s] = p(o|s)`, `B[u][(s',s)] = p(s'|s,u)`, `C = ln c` (normalised log
-/// preferences), `D = p(s_1)`, plus the derived `ln A`, `ln B` and the ambiguity
-/// `H_A[s] = -Σ_o A[o,s] ln A[o,s]` (Prop. 1).
-#[derive(Debug, Clone, PartialEq)]
-pub struct GenerativeModel {
-    /// Observation model `A` (n_obs x n_states, column-stochastic).
-    pub a: DMatrix<f64>,
-    /// Elementwise floored `ln A`.
-    pub ln_a: DMatrix<f64>,
-    /// Ambiguity per state, `H_A[s]`.
-    pub h_a: Vec<f64>,
-    /// Whether `A` is exactly the identity (enables one-hot fast paths).
-    pub a_identity: bool,
-    /// Transition matrices `B[u]` (n_states x n_states, column-stochastic).
-    pub b: Vec<DMatrix<f64>>,
-    /// Elementwise floored `ln B[u]`.
-    pub ln_b: Vec<DMatrix<f64>>,
-    /// `(ln B[u])^T`, i.e. `ln B[u]` row by row: VMP's backward messages and `F` read
-    /// `ln B` a row at a time, which this layout makes contiguous.
-    pub ln_b_t: Vec<DMatrix<f64>>,
-    /// Log preferences over observations, `C = ln c` (a normalised log distribution).
-    pub c: Vec<f64>,
-    /// A preference over transitions, beside `C` (docs/ARCHITECTURE.md §4.3): planning adds
-    /// its expected cost to every step's `G`.
-    pub transition_cost: Option<TransitionCost>,
-    /// The crash hazard planning uses in place of absorbing crash-risk states
-    /// ([`CrashModel`]; only on the planning model, and only when the agent plans with it).
-    pub crash: Option<CrashModel>,
-    /// Initial state prior `D`.
-    pub d: Vec<f64>,
-    /// The same `B[u]` as per-factor steps (§II-A), when the model came from a factored
-    /// world model whose structure allows it; planning uses it for dense beliefs.
-    pub factored: Option<FactoredTransition>,
-    /// `ln B[u]` as per-factor terms (perception's messages and `F`), when the model came
-    /// from a factored world model and every entry of `B` is at least the log floor, so
-    /// that the factored sum is `ln B` up to rounding (see [`FactoredLogB`]).
-    pub log_factored: Option<FactoredLogB>,
-}
-
-/// A cost in nats for moving from one set of states to another in one step (a
-/// preference over transitions that no state preference can express, such as entering
-/// the crosswalk on red: docs/ARCHITECTURE.md §4.3).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TransitionCost {
-    /// The states a costly step starts from, per state.
-    pub from: Vec<bool>,
-    /// The states a costly step ends in, per state.
-    pub to: Vec<bool>,
-    /// The cost, in nats of `G` (added to the expected free energy, so positive is avoided).
-    pub cost: f64,
-}
-
-/// The crosswalk's crash model (beyond the paper; docs/ARCHITECTURE.md §4.3): the
-/// probability that one tick ends in a collision, per action and state, and what a crashed
-/// episode is worth to the planner.
-///
-/// The paper's planner treats a pedestrian on the crosswalk while the car moves in the
-/// crosswalk's distance bin as a crash, whatever the car does, so braking there earns
-/// nothing and dashing to the goal looks like the shortest way out. With this model the
-/// crash happens on a transition: a tick from a state with `hazard[u][s] > 0` ends in a
-/// collision with that probability, which grows with the distance the car covers in the
-/// tick under `u`; the crashed mass leaves the drive (it can reach nothing else) and is
-/// worth `crashed` nats of preference for the rest of the horizon.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CrashModel {
-    /// Per action, per state: the probability in [0, 1] that a tick ends in a collision.
-    pub hazard: Vec<Vec<f64>>,
-    /// The log preference of a crashed episode, on the scale of `C` (nats).
-    pub crashed: f64,
-    /// The log preference planning gives the hazard states themselves (where the paper's
-    /// model has its crash preference): that of a state with no reward, on `C`'s scale.
-    pub neutral: f64,
-}
-
-impl CrashModel {
-    /// States with a hazard under some action.
-    pub fn hazard_states(&self) -> Vec<usize> {
-        let n = self.hazard.first().map_or(0, Vec::len);
-        (0..n).filter(|&s| self.hazard.iter().any(|h| h[s] > 0.0)).collect()
-    }
-
-    /// The mass of belief `x` that crashes in one tick of `u`: `Σ_s x[s] hazard[u][s]`,
-    /// and `survive = x ⊙ (1 - hazard[u])`.
-    pub fn split(&self, u: usize, x: &[f64], survive: &mut [f64]) -> f64 {
-        let mut crashed = 0.0;
-        for ((out, xs), h) in survive.iter_mut().zip(x).zip(&self.hazard[u]) {
-            let hit = xs * h;
-            crashed += hit;
-            *out = xs - hit;
-        }
-        crashed
-    }
-
-    /// The risk term of a crashed mass `m`, `m (ln m - crashed)`: the crashed episode as
-    /// one more outcome of the step's KL risk (Prop. 1).
-    pub fn risk(&self, m: f64) -> f64 {
-        if m > 0.0 { m * (ln(m) - self.crashed) } else { 0.0 }
-    }
-}
-
-impl GenerativeModel {
-    /// Build from `A`, `B`, `C` (already normalised log preferences) and `D`, computing
-    /// the derived quantities. Shapes are the caller's responsibility (see `inspect`).
-    pub fn new(a: DMatrix<f64>, b: Vec<DMatrix<f64>>, c: Vec<f64>, d: Vec<f64>) -> Self {
-        let ln_a = a.map(ln);
-        let h_a = (0..a.ncols())
-            .map(|s| -(0..a.nrows()).map(|o| a[(o, s)] * ln_a[(o, s)]).sum::<f64>())
-            .collect();
-        let a_identity = a.is_square() && a == DMatrix::identity(a.nrows(), a.ncols());
-        let ln_b: Vec<DMatrix<f64>> = b.iter().map(|m| m.map(ln)).collect();
-        let ln_b_t = ln_b.iter().map(|m| m.transpose()).collect();
-        GenerativeModel {
-            a,
-            ln_a,
-            h_a,
-            a_identity,
-            b,
-            ln_b,
-            ln_b_t,
-            c,
-            transition_cost: None,
-            crash: None,
-            d,
-            factored: None,
-            log_factored: None,
-        }
-    }
-
-    /// The expected cost of one step `u` from belief `s` under [`Self::transition_cost`]
-    /// (0 without one): `cost · Σ_{s'} to[s'] (B[u] (from ⊙ s))[s']`. `masked` and
-    /// `next` are scratch of `n_states`.
-    pub fn transition_cost_of(
-        &self,
-        u: usize,
-        s: &[f64],
-        masked: &mut [f64],
-        next: &mut [f64],
-        scratch: &mut Vec<f64>,
-    ) -> f64 {
-        let Some(t) = &self.transition_cost else {
-            return 0.0;
-        };
-        for ((m, x), f) in masked.iter_mut().zip(s).zip(&t.from) {
-            *m = if *f { *x } else { 0.0 };
-        }
-        if masked.iter().all(|m| *m == 0.0) {
-            return 0.0;
-        }
-        self.transition_into(u, masked, next, scratch);
-        t.cost
-            * next
-                .iter()
-                .zip(&t.to)
-                .filter(|(_, to)| **to)
-                .map(|(p, _)| p)
-                .sum::<f64>()
-    }
-
-    /// `out = B[u] x` (§II): the factor-by-factor product when it is cheaper than the
-    /// dense columns of `x`'s non-zero entries, else those columns. `scratch` is reused.
-    pub fn transition_into(&self, u: usize, x: &[f64], out: &mut [f64], scratch: &mut Vec<f64>) {
-        let n = self.n_states();
-        match &self.factored {
-            Some(ft) if x.iter().filter(|v| **v != 0.0).count() * n > ft.cost() => ft.apply(u, x, out, scratch),
-            _ => crate::maths::axpy_columns(self.b[u].as_slice(), n, x, out),
-        }
-    }
-
-    /// Number of hidden states.
-    pub fn n_states(&self) -> usize {
-        self.a.ncols()
-    }
-    /// Number of observations.
-    pub fn n_obs(&self) -> usize {
-        self.a.nrows()
-    }
-    /// Number of actions.
-    pub fn n_actions(&self) -> usize {
-        self.b.len()
-    }
-}
-
-#[derive(Serialize, Deserialize, Clone)]
-#[serde(deny_unknown_fields, rename = "WorldModel")]
-struct WorldModelRepr {
-    structure: Structure,
-    n_actions: usize,
-    priors: ModelPriors,
-    cpt: Vec<Vec<f64>>,
-    #[serde(deserialize_with = "checked_matrix")]
-    a_counts: DMatrix<f64>,
-    c: Vec<f64>,
-    d_counts: Vec<f64>,
-    #[serde(default)]
-    terminal: Vec<usize>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    transition_cost: Option<TransitionCost>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    crash: Option<CrashModel>,
-}
-
-/// A `DMatrix` stored as nalgebra writes it, `(data, nrows, ncols)` in column-major
-/// order, checking `nrows * ncols` without overflow (nalgebra's own reader multiplies
-/// unchecked: a damaged file could claim a `2^32 x 2^32` matrix with no data).
-fn checked_matrix<'de, D: serde::Deserializer<'de>>(de: D) -> Result<DMatrix<f64>, D::Error> {
-    use serde::de::Error;
-    let (data, nrows, ncols): (Vec<f64>, usize, usize) = Deserialize::deserialize(de)?;
-    if nrows.checked_mul(ncols) != Some(data.len()) {
-        return Err(D::Error::custom(format!(
-            "a {nrows} x {ncols} matrix needs {nrows} x {ncols} entries, found {}",
-            data.len()
-        )));
-    }
-    Ok(DMatrix::from_vec(nrows, ncols, data))
-}
-
-/// Checks the stored fields of a world model (names as in the file), before anything
-/// is computed from them: sizes within [`crate::limits`], CPTs of the structure's
-/// shape, `A`'s columns and `D` positive finite counts, `C` a normalised log distribution,
-/// terminal states in range.
-fn check_repr(r: &WorldModelRepr) -> Result<(), FieldError> {
-    let n = r.structure.joint_size();
-    stored_values::size(
-        "structure",
-        n,
-        1,
-        MAX_STATES,
-        "joint states: the product of the factor sizes",
-    )?;
-    stored_values::size("n_actions", r.n_actions, 1, MAX_ACTIONS, "the car's actions")?;
-    r.priors.check().map_err(|e| FieldError::from(e).within("priors"))?;
-    stored_values::finite("priors.transition_concentration", &[r.priors.transition_concentration])
-        .and(stored_values::finite(
-            "priors.a_concentration",
-            &[r.priors.a_concentration],
-        ))
-        .map_err(|e| FieldError::new(e.path.trim_end_matches("[0]"), e.message))?;
-    if let Some(d) = &r.priors.d {
-        stored_values::len("priors.d", d.len(), n, "one prior probability per joint state")?;
-    }
-    let factors = r.structure.factors();
-    stored_values::len(
-        "cpt",
-        r.cpt.len(),
-        factors.len(),
-        "one table per factor of the structure",
-    )?;
-    for (f, counts) in r.cpt.iter().enumerate() {
-        let path = format!("cpt[{f}]");
-        let configs = r.structure.n_configs(f, r.n_actions);
-        let want = stored_values::product(&path, configs, factors[f].size)?;
-        stored_values::len(
-            &path,
-            counts.len(),
-            want,
-            &format!(
-                "{configs} parent configurations x {} values of factor `{}`",
-                factors[f].size, factors[f].name
-            ),
-        )?;
-        stored_values::counts(&path, counts)?;
-    }
-    let (no, ns) = (r.a_counts.nrows(), r.a_counts.ncols());
-    if ns != n || !(1..=MAX_STATES).contains(&no) {
-        return Err(FieldError::new(
-            "a_counts",
-            format!("is {no} x {ns}; must be n_obs x {n} (one column per joint state, 1..={MAX_STATES} observations)"),
-        ));
-    }
-    for (s, col) in r.a_counts.column_iter().enumerate() {
-        if let Some(o) = col.iter().position(|x| !(0.0..=MAX_VALUE).contains(x)) {
-            return Err(FieldError::new(
-                format!("a_counts[{o},{s}]"),
-                format!("must be a finite count in [0, {MAX_VALUE:e}], found {}", col[o]),
-            ));
-        }
-        let z: f64 = col.sum();
-        if !(z > 0.0 && z.is_finite()) {
-            return Err(FieldError::new(
-                format!("a_counts[..,{s}]"),
-                format!("column {s} sums to {z}; each state's observation counts need a positive finite total"),
-            ));
-        }
-    }
-    stored_values::len(
-        "c",
-        r.c.len(),
-        no,
-        "one log preference per observation (rows of a_counts)",
-    )?;
-    stored_values::finite("c", &r.c)?;
-    let m = r.c.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let lse = m + r.c.iter().map(|v| (v - m).exp()).sum::<f64>().ln();
-    if lse.abs() > 1e-6 {
-        return Err(FieldError::new(
-            "c",
-            format!("is not a normalised log distribution: ln Σ exp(C) = {lse}, must be 0 (± 1e-6)"),
-        ));
-    }
-    stored_values::len("d_counts", r.d_counts.len(), n, "one count per joint state")?;
-    stored_values::counts("d_counts", &r.d_counts)?;
-    if r.d_counts.iter().sum::<f64>() <= 0.0 {
-        return Err(FieldError::new(
-            "d_counts",
-            "all zero; the initial-state counts need a positive total",
-        ));
-    }
-    if let Some(i) = r.terminal.iter().position(|&s| s >= n) {
-        return Err(FieldError::new(
-            format!("terminal[{i}]"),
-            format!("state {} is out of range (0..{n})", r.terminal[i]),
-        ));
-    }
-    if let Some(t) = &r.transition_cost {
-        for (name, len) in [("from", t.from.len()), ("to", t.to.len())] {
-            if len != n {
-                return Err(FieldError::new(
-                    format!("transition_cost.{name}"),
-                    format!("{len} entries, expected one per state ({n})"),
-                ));
-            }
-        }
-        if !t.cost.is_finite() {
-            return Err(FieldError::new(
-                "transition_cost.cost",
-                format!("{} is not finite", t.cost),
-            ));
-        }
-    }
-    if let Some(c) = &r.crash {
-        check_crash(c, n, r.n_actions)?;
-    }
-    Ok(())
-}
-
-/// A crash model fits `n` states and `n_actions` actions, with probabilities in [0, 1] and
-/// finite preferences.
-fn check_crash(c: &CrashModel, n: usize, n_actions: usize) -> Result<(), FieldError> {
-    stored_values::len("crash.hazard", c.hazard.len(), n_actions, "one row per action")?;
-    for (u, h) in c.hazard.iter().enumerate() {
-        stored_values::len(&format!("crash.hazard[{u}]"), h.len(), n, "one probability per state")?;
-        if let Some(s) = h.iter().position(|p| !(0.0..=1.0).contains(p)) {
-            return Err(FieldError::new(
-                format!("crash.hazard[{u}][{s}]"),
-                format!("{} is not a probability in [0, 1]", h[s]),
-            ));
-        }
-    }
-    for (name, v) in [("crash.crashed", c.crashed), ("crash.neutral", c.neutral)] {
-        if !v.is_finite() {
-            return Err(FieldError::new(name, format!("{v} is not finite")));
-        }
-    }
-    Ok(())
-}
+use super::crash::check_crash;
+use super::pooling::Pooling;
+use super::stored::{WorldModelRepr, check_repr};
+use super::{CrashModel, GenerativeModel, TransitionCost};
 
 /// The agent's world model (§II-A, §V): Dirichlet-count CPTs per factor, `A` counts,
 /// `C`, `D`, and the materialised joint [`GenerativeModel`] (derived, not serialised).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "WorldModelRepr", into = "WorldModelRepr")]
 pub struct WorldModel {
-    structure: Structure,
-    n_actions: usize,
-    priors: ModelPriors,
+    pub(super) structure: Structure,
+    pub(super) n_actions: usize,
+    pub(super) priors: ModelPriors,
     /// Per factor: counts laid out `[config * size + child]`, priors included.
-    cpt: Vec<Vec<f64>>,
-    a_counts: DMatrix<f64>,
+    pub(super) cpt: Vec<Vec<f64>>,
+    pub(super) a_counts: DMatrix<f64>,
     /// Counts behind `D` (prior mass 1 spread per `ModelPriors::d`).
-    d_counts: Vec<f64>,
+    pub(super) d_counts: Vec<f64>,
     /// Episode-ending states, absorbing in the planning model.
-    terminal: Vec<usize>,
+    pub(super) terminal: Vec<usize>,
     /// The crash model of the map the agent was trained on, if it has one.
-    crash: Option<CrashModel>,
+    pub(super) crash: Option<CrashModel>,
     /// Whether planning uses [`WorldModel::crash_model`] (not serialised; set by the agent).
-    plan_crash: bool,
+    pub(super) plan_crash: bool,
     /// Persistence pooling of one factor (not serialised; set by the agent that uses it).
-    pooling: Option<Pooling>,
-    gm: GenerativeModel,
+    pub(super) pooling: Option<Pooling>,
+    pub(super) gm: GenerativeModel,
     /// The generative model used for planning: `gm` with every terminal state absorbing.
-    gm_plan: GenerativeModel,
+    pub(super) gm_plan: GenerativeModel,
 }
 
 impl From<WorldModel> for WorldModelRepr {
@@ -436,71 +81,6 @@ impl TryFrom<WorldModelRepr> for WorldModel {
         };
         w.materialize();
         Ok(w)
-    }
-}
-
-/// Which CPT rows of one factor share their counts ([`WorldModel::set_persistence_pooling`]).
-#[derive(Debug, Clone, PartialEq)]
-struct Pooling {
-    factor: usize,
-    /// Position of the factor's own previous value among its parents.
-    own: usize,
-    /// Positions of the pooled parents.
-    over: Vec<usize>,
-    /// Per parent position: its size and its stride in the configuration index.
-    sizes: Vec<usize>,
-    strides: Vec<usize>,
-}
-
-impl Pooling {
-    fn new(structure: &Structure, n_actions: usize, factor: &str, over: &str) -> Result<Pooling, AgentError> {
-        let factors = structure.factors();
-        let index = |name: &str| {
-            factors.iter().position(|f| f.name == name).ok_or_else(|| {
-                let names: Vec<&str> = factors.iter().map(|f| f.name.as_str()).collect();
-                AgentError::Structure(format!(
-                    "persistence pooling names factor `{name}`, not one of {names:?}"
-                ))
-            })
-        };
-        let f = index(factor)?;
-        let names: Vec<&str> = over.split('+').collect();
-        let gs = names
-            .iter()
-            .map(|n| index(n))
-            .collect::<Result<Vec<usize>, AgentError>>()?;
-        let parents = &factors[f].parents;
-        let own = parents.iter().position(|p| *p == Parent::Prev(f)).ok_or_else(|| {
-            AgentError::Structure(format!(
-                "persistence pooling: factor `{factor}` does not depend on its own previous value"
-            ))
-        })?;
-        let over = names
-            .iter()
-            .zip(gs)
-            .map(|(name, g)| {
-                parents.iter().position(|p| *p == Parent::Next(g)).ok_or_else(|| {
-                    AgentError::Structure(format!(
-                        "persistence pooling: `{name}` is not a next-time parent of factor `{factor}`"
-                    ))
-                })
-            })
-            .collect::<Result<Vec<usize>, AgentError>>()?;
-        let sizes = structure.parent_sizes(f);
-        // Mixed radix in parent order; an action parent, if any, is the least significant digit.
-        let mut strides = vec![0; sizes.len()];
-        let mut stride = if factors[f].action_parent { n_actions } else { 1 };
-        for k in (0..sizes.len()).rev() {
-            strides[k] = stride;
-            stride *= sizes[k];
-        }
-        Ok(Pooling {
-            factor: f,
-            own,
-            over,
-            sizes,
-            strides,
-        })
     }
 }
 
@@ -681,7 +261,9 @@ impl WorldModel {
             .map(|f| {
                 let size = self.structure.factors()[f].size;
                 let mut m = match &self.pooling {
-                    Some(pool) if pool.factor == f => self.pooled_counts(pool),
+                    Some(pool) if pool.factor == f => {
+                        pool.pooled(&self.cpt[f], size, self.priors.transition_concentration)
+                    }
                     _ => self.cpt[f].clone(),
                 };
                 for row in m.chunks_mut(size) {
@@ -714,38 +296,6 @@ impl WorldModel {
         };
         self.materialize();
         Ok(())
-    }
-
-    /// The CPT counts of `pool.factor` with the persistence rows pooled (see
-    /// [`WorldModel::set_persistence_pooling`]); the prior is counted once per row.
-    fn pooled_counts(&self, pool: &Pooling) -> Vec<f64> {
-        let f = pool.factor;
-        let size = self.structure.factors()[f].size;
-        let counts = &self.cpt[f];
-        let b0 = self.priors.transition_concentration;
-        let n_cfg = counts.len() / size;
-        // Key of a row: its configuration with the pooled parents' values set to 0.
-        let value = |cfg: usize, k: usize| (cfg / pool.strides[k]) % pool.sizes[k];
-        let key = |cfg: usize| {
-            cfg - pool
-                .over
-                .iter()
-                .map(|&k| value(cfg, k) * pool.strides[k])
-                .sum::<usize>()
-        };
-        let mut sums = vec![0.0; counts.len()];
-        for cfg in (0..n_cfg).filter(|&c| value(c, pool.own) != 0) {
-            for x in 0..size {
-                sums[key(cfg) * size + x] += (counts[cfg * size + x] - b0).max(0.0);
-            }
-        }
-        let mut out = counts.clone();
-        for cfg in (0..n_cfg).filter(|&c| value(c, pool.own) != 0) {
-            for x in 0..size {
-                out[cfg * size + x] = b0 + sums[key(cfg) * size + x];
-            }
-        }
-        out
     }
 
     /// The joint `B[u][(s', s)] = Π_f p(s'_f | parents_f, u)` computed entry by entry,
@@ -962,7 +512,9 @@ impl WorldModel {
             .structure
             .config_from_parent_values(factor, parent_values, action, self.n_actions);
         let pooled = match &self.pooling {
-            Some(pool) if pool.factor == factor => Some(self.pooled_counts(pool)),
+            Some(pool) if pool.factor == factor => {
+                Some(pool.pooled(&self.cpt[factor], fac.size, self.priors.transition_concentration))
+            }
             _ => None,
         };
         let counts = pooled.as_deref().unwrap_or(&self.cpt[factor]);
