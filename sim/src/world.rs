@@ -84,6 +84,9 @@ pub struct Snapshot {
     pub light_time_left: f64,
     /// Pedestrians currently in the world (spawned and not yet gone).
     pub pedestrians: Vec<PedestrianSnapshot>,
+    /// The surface patches on the road now (`road.surface`'s, once appeared), in the
+    /// map's order.
+    pub surface: Vec<SurfacePatch>,
 }
 
 impl Snapshot {
@@ -634,6 +637,7 @@ impl World {
             light,
             light_time_left: left,
             pedestrians,
+            surface: self.surface().copied().collect(),
         }
     }
 }
