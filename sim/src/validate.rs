@@ -607,8 +607,19 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
 /// The road surface (always: a map may set it before switching to `Forces`) and the
 /// parameters of the force-driven vehicle model (under `dynamics: Forces`).
 fn check_forces(c: &mut Check, map: &Map) {
-    let friction = "μ is about 0.8 on dry asphalt, 0.4 wet, 0.1 on ice; racing tyres reach 2";
-    c.within("road.friction", map.road.friction, (1e-9, 2.0), "", friction);
+    let friction = |c: &mut Check, path: &str, mu: f64| {
+        let hint = "μ is about 0.8 on dry asphalt, 0.4 wet, 0.1 on ice; racing tyres reach 2";
+        if mu.is_finite() && mu <= 0.0 {
+            c.fail(
+                path,
+                format!("a friction coefficient must be greater than 0, got {mu}"),
+                hint,
+            );
+        } else {
+            c.within(path, mu, (0.0, 2.0), "", hint);
+        }
+    };
+    friction(c, "road.friction", map.road.friction);
     c.within(
         "road.air_density",
         map.road.air_density,
@@ -630,7 +641,7 @@ fn check_forces(c: &mut Check, map: &Map) {
     let (start, end) = (map.vehicle.start_x - map.vehicle.length, map.road.goal_x);
     for (i, p) in map.road.surface.iter().enumerate().take(MAX_LIST) {
         let path = format!("road.surface[{i}]");
-        c.within(&format!("{path}.friction"), p.friction, (1e-9, 2.0), "", friction);
+        friction(c, &format!("{path}.friction"), p.friction);
         if !(c.finite(&format!("{path}.from"), p.from) & c.finite(&format!("{path}.to"), p.to)) {
             continue;
         }

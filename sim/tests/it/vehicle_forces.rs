@@ -264,3 +264,39 @@ fn maintain_holds_speed_and_mass_matters() {
     let (light, heavy) = (gain(1500.0), gain(3500.0));
     assert!(light > 2.0 * heavy, "1500 kg gains {light} m/s, 3500 kg {heavy} m/s");
 }
+
+/// The same map, seed and actions give bit-identical trajectories under forces, on
+/// whichever thread they run (positions and speeds compared as bits).
+#[test]
+fn trajectories_are_bit_identical_across_threads() {
+    let mut map = Map::default();
+    map.vehicle.dynamics = Dynamics::Forces;
+    map.road.surface = vec![SurfacePatch {
+        from: 44.0,
+        to: 64.0,
+        friction: 0.1,
+        trigger: Some(Trigger::CarWithin { min: 0.0, max: 30.0 }),
+    }];
+    let run = |seed: u64| {
+        let mut world = World::from_map(&map, seed);
+        let mut bits = Vec::new();
+        let mut k = 0usize;
+        while !world.is_done() {
+            world.step(Action::ALL[(k * 7 + seed as usize) % 3]);
+            let s = world.snapshot();
+            bits.push((s.car_x.to_bits(), s.car_speed.to_bits(), s.surface.len()));
+            k += 1;
+        }
+        bits
+    };
+    let here: Vec<_> = (0..4).map(run).collect();
+    let threads: Vec<_> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..4).map(|seed| scope.spawn(move || run(seed))).collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert_eq!(here, threads);
+    assert!(
+        here.iter().any(|t| t.iter().any(|&(_, _, n)| n == 1)),
+        "the patch appears"
+    );
+}
