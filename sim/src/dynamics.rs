@@ -20,7 +20,18 @@
 use std::collections::VecDeque;
 
 use crate::map::{Dynamics, Vehicle};
-use crate::world::Action;
+
+/// What the driver asks of the drive train for one sub-step (one of the paper's three
+/// actions).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Pedal {
+    /// Full drive ("speed up").
+    Drive,
+    /// Full brake demand ("slow down").
+    Brake,
+    /// Hold this speed, m/s ("maintain"), within the drive and brake forces.
+    Cruise(f64),
+}
 
 /// Gravitational acceleration, m/s².
 pub const GRAVITY: f64 = 9.81;
@@ -85,17 +96,17 @@ impl Drivetrain {
         self.rolling + self.drag * v * v
     }
 
-    /// The net longitudinal force on the car for the coming sub-step, N, with `action`
-    /// held, `cruise` the speed "maintain" holds, `v` the car's speed and `mu` the
-    /// friction under its wheels; advances the brake actuator by one sub-step.
-    pub(crate) fn force(&mut self, action: Action, cruise: f64, v: f64, mu: f64) -> f64 {
+    /// The net longitudinal force on the car for the coming sub-step, N, with `pedal`
+    /// held, `v` the car's speed and `mu` the friction under its wheels; advances the
+    /// brake actuator by one sub-step.
+    pub(crate) fn force(&mut self, pedal: Pedal, v: f64, mu: f64) -> f64 {
         let (m, h) = (self.mass, self.h);
         let resistance = self.resistance(v);
         let limit = self.drive_limit(v);
-        let (drive, demand) = match action {
-            Action::SpeedUp => (limit, 0.0),
-            Action::SlowDown => (0.0, self.brake_force),
-            Action::Maintain => {
+        let (drive, demand) = match pedal {
+            Pedal::Drive => (limit, 0.0),
+            Pedal::Brake => (0.0, self.brake_force),
+            Pedal::Cruise(cruise) => {
                 let need = m * (cruise - v) / h + resistance;
                 if need >= 0.0 {
                     (need.min(limit), 0.0)
@@ -211,7 +222,7 @@ mod tests {
     fn a_car_at_rest_stays_at_rest() {
         let mut d = Drivetrain::new(&forces(), 1.2, 1.0 / 60.0);
         for _ in 0..120 {
-            assert_eq!(d.force(Action::SlowDown, 0.0, 0.0, 0.8), 0.0);
+            assert_eq!(d.force(Pedal::Brake, 0.0, 0.8), 0.0);
         }
     }
 }

@@ -7,7 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier2d::prelude::*;
 
-use crate::dynamics::Drivetrain;
+use crate::dynamics::{Drivetrain, Pedal};
 use crate::light::{LightPhase, light_at};
 use crate::map::{Dynamics, LightCondition, Map, Offset, Pause, Side, SurfacePatch, Trigger};
 
@@ -378,16 +378,11 @@ impl World {
     /// rounding never accumulates); with damping it builds on the body's
     /// current, damped speed.
     ///
-    /// Under `Forces` the drive train's net force replaces the body's force for the
-    /// sub-step, "maintain" holding `v0` (see [`crate::dynamics`]).
+    /// Under `Forces` the drive train drives the car instead (`drive_by_forces`,
+    /// "maintain" holding `v0`).
     fn control_car(&mut self, action: Action, v0: f64, k: u32) {
         if self.drivetrain.is_some() {
-            let mu = self.car_friction();
-            let speed = self.phys.bodies[self.car].linvel().x as f64;
-            let force = self.drivetrain.as_mut().map_or(0.0, |d| d.force(action, v0, speed, mu));
-            let body = &mut self.phys.bodies[self.car];
-            body.reset_forces(true);
-            body.add_force(Vector::new(force as Real, 0.0), true);
+            self.drive_by_forces(action, v0);
             return;
         }
         let v = &self.map.vehicle;
@@ -405,6 +400,25 @@ impl World {
         };
         let target = target.clamp(0.0, v.max_speed);
         body.set_linvel(Vector::new(target as Real, 0.0), true);
+    }
+
+    /// `dynamics: Forces`: the drive train's net force for the coming sub-step, on the
+    /// friction under the car's axles, replaces the force on the car's body.
+    fn drive_by_forces(&mut self, action: Action, v0: f64) {
+        let mu = self.car_friction();
+        let speed = self.phys.bodies[self.car].linvel().x as f64;
+        let pedal = match action {
+            Action::SpeedUp => Pedal::Drive,
+            Action::SlowDown => Pedal::Brake,
+            Action::Maintain => Pedal::Cruise(v0),
+        };
+        let Some(drivetrain) = self.drivetrain.as_mut() else {
+            return;
+        };
+        let force = drivetrain.force(pedal, speed, mu);
+        let body = &mut self.phys.bodies[self.car];
+        body.reset_forces(true);
+        body.add_force(Vector::new(force as Real, 0.0), true);
     }
 
     /// Keep the car's speed within [0, max_speed] after f32 integration.
