@@ -1,4 +1,5 @@
-//! Whole-system benchmarks: one physics decision step, one jaywalk episode,
+//! Whole-system benchmarks: one physics decision step and one jaywalk episode (each also
+//! with the car driven by forces),
 //! training throughput, and the closed loop (world + discretizer + scaled agent) at
 //! 10 Hz decisions / 60 Hz physics.
 //!
@@ -15,38 +16,50 @@ use unforeseen_harness::episodes::evaluation::eval_seeds;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::runner::run_episode;
 use unforeseen_harness::training::train;
-use unforeseen_sim::{Action, World, embedded};
+use unforeseen_sim::{Action, Dynamics, Map, World, embedded};
 
 mod common;
 use common::{agent, bundle, criterion_config, train_cfg};
+
+/// The map with the car driven by forces (`dynamics: Forces`, the default parameters).
+fn with_forces(mut map: Map) -> Map {
+    map.vehicle.dynamics = Dynamics::Forces;
+    map
+}
 
 /// `physics_decision_step`: one `World::step` on the intersection map (the physics alone,
 /// below `Env`) (decision_dt 1 s
 /// at 60 Hz = 60 Rapier sub-steps, plus lights, spawns and events). The car speeds up
 /// on the first tick and then holds its speed; a finished world is rebuilt untimed.
+/// Side by side: `ideal` (velocity control, the paper's) and `forces` (the force model).
 fn physics_decision_step(c: &mut Criterion) {
-    let map = embedded::load("intersection").expect("map");
-    c.bench_function("physics_decision_step", |b| {
-        b.iter_custom(|iters| {
-            let mut total = Duration::ZERO;
-            let mut world = World::from_map(&map, 0);
-            let mut seed = 0;
-            let mut k = 0;
-            for _ in 0..iters {
-                if world.is_done() {
-                    seed += 1;
-                    world = World::from_map(&map, seed);
-                    k = 0;
+    let ideal = embedded::load("intersection").expect("map");
+    let forces = with_forces(ideal.clone());
+    let mut g = c.benchmark_group("physics_decision_step");
+    for (name, map) in [("ideal", &ideal), ("forces", &forces)] {
+        g.bench_function(name, |b| {
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                let mut world = World::from_map(map, 0);
+                let mut seed = 0;
+                let mut k = 0;
+                for _ in 0..iters {
+                    if world.is_done() {
+                        seed += 1;
+                        world = World::from_map(map, seed);
+                        k = 0;
+                    }
+                    let action = if k == 0 { Action::SpeedUp } else { Action::Maintain };
+                    let t = Instant::now();
+                    black_box(world.step(black_box(action)));
+                    total += t.elapsed();
+                    k += 1;
                 }
-                let action = if k == 0 { Action::SpeedUp } else { Action::Maintain };
-                let t = Instant::now();
-                black_box(world.step(black_box(action)));
-                total += t.elapsed();
-                k += 1;
-            }
-            total
-        })
-    });
+                total
+            })
+        });
+    }
+    g.finish();
 }
 
 /// `env_step`: one `Env::step` on the same map and actions as `physics_decision_step`:
@@ -80,10 +93,13 @@ fn env_step(c: &mut Criterion) {
 
 /// `episode`: one jaywalk episode (`run_episode`, no recording) of a fresh scaled agent
 /// built from the trained bundle (construction untimed), including its end-of-episode
-/// test-time learning.
+/// test-time learning. Side by side: the default agent, the paper's (the competence
+/// check off), and the default agent on jaywalk with the car driven by forces.
 fn episode(c: &mut Criterion, bundle: &AgentBundle) {
     let map = embedded::load("jaywalk").expect("map");
+    let forces = with_forces(map.clone());
     let mut env = Env::new(&map, EnvConfig::default()).expect("env");
+    let mut forces_env = Env::new(&forces, EnvConfig::default()).expect("env");
     let params = ScaledParams::default();
     let seeds = eval_seeds(7, &map, Method::Scaled, 0);
     let mut probe = Method::Scaled.controller(bundle, &params, &map).expect("controller");
@@ -105,6 +121,14 @@ fn episode(c: &mut Criterion, bundle: &AgentBundle) {
             )
         });
     }
+    let forces_seeds = eval_seeds(7, &forces, Method::Scaled, 0);
+    g.bench_function("forces", |b| {
+        b.iter_batched(
+            || Method::Scaled.controller(bundle, &params, &forces).expect("controller"),
+            |mut ctl| run_episode(&mut forces_env, ctl.as_mut(), forces_seeds, false).expect("episode"),
+            BatchSize::SmallInput,
+        )
+    });
     g.finish();
 }
 

@@ -78,7 +78,10 @@ pub enum DiscretizerError {
 ///
 /// where `v_max` is the car's top speed, `b` its braking and `Δt` a decision tick: the
 /// approach is never shorter than the distance in which a car at top speed, braking one
-/// tick after it sees a pedestrian, comes to a stop. On the training intersection
+/// tick after it sees a pedestrian, comes to a stop. Under `dynamics: Forces` the
+/// `v_max² / (2 b)` term is the force model's stopping distance on the road's default
+/// friction (dead time, lag phase, then friction-limited deceleration:
+/// `unforeseen_sim::dynamics::stopping_distance`). On the training intersection
 /// (`n = 26`, 9 m/s, 3 m/s², 1 s: 22.5 m) the default `Crosswalk(lead: 0.0, approach:
 /// 34.0)` gives `[0, 26, 60]`, and `Crosswalk(lead: 4.0, approach: 30.0)` the paper's
 /// `[0, 30, 60]`.
@@ -88,7 +91,8 @@ pub fn distance_edges(map: &Map) -> Vec<f64> {
         DistanceEdges::Crosswalk(c) => {
             let near = map.crosswalk_distance_to_goal().0;
             let v = &map.vehicle;
-            let stopping = v.max_speed * map.episode.decision_dt + v.max_speed * v.max_speed / (2.0 * v.max_brake);
+            let stopping = v.max_speed * map.episode.decision_dt
+                + unforeseen_sim::dynamics::stopping_distance(v, v.max_speed, map.road.friction);
             let e1 = near + c.lead;
             vec![0.0, e1, e1 + c.approach.max(stopping)]
         }

@@ -24,6 +24,7 @@ fn snapshot(distance: f64, speed: f64, light: LightPhase, peds_on: &[bool]) -> S
         time: 0.0,
         car_x: 90.0 - distance,
         car_speed: speed,
+        surface: Vec::new(),
         distance_to_goal: distance,
         light,
         light_time_left: 1.0,

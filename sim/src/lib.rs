@@ -4,7 +4,9 @@
 //! way there is a crosswalk with a traffic light (a cycle of green, amber and
 //! red phases). The car is a dynamic rigid body; the three actions of the
 //! paper ([`Action`]: maintain, speed up, slow down) act on it through
-//! longitudinal velocity control (Rapier integrates it and finds contacts). Pedestrians are kinematic bodies with sensor colliders
+//! longitudinal velocity control (`dynamics: Ideal`, the paper's) or through forces
+//! (`dynamics: Forces`: engine, brakes with lag, rolling resistance, drag, and the
+//! friction of the road surface, [`dynamics`]); Rapier integrates and finds contacts. Pedestrians are kinematic bodies with sensor colliders
 //! that cross the crosswalk when the map's spawn rules say so. A collision is the
 //! car's collider intersecting a pedestrian's (parry's intersection test, the one
 //! Rapier's narrow phase runs on sensors) after any physics sub-step.
@@ -24,12 +26,15 @@
 //! Determinism: the same map, seed and actions give bit-identical snapshots.
 //!
 //! Modules: [`map`] (the map's fields and defaults), [`light`] (the traffic
-//! light), [`world`] (car, pedestrians, stepping), [`embedded`] (the shipped
+//! light), [`dynamics`] (the force-driven vehicle model), [`world`] (car, pedestrians,
+//! surface, stepping), [`embedded`] (the shipped
 //! maps), and the loader with its diagnostics ([`MapError`], [`Diagnostic`]).
 
+pub mod dynamics;
 pub mod embedded;
 pub mod light;
 mod load;
+mod locate;
 pub mod map;
 mod map_texts;
 mod validate;
@@ -38,8 +43,8 @@ pub mod world;
 pub use light::{LightPhase, light_at};
 pub use load::{Diagnostic, EMBEDDED_PREFIX, MAX_BASE_DEPTH, MAX_FILE_BYTES, MAX_NESTING, MapError};
 pub use map::{
-    Bins, Crosswalk, CrosswalkBins, DistanceEdges, Episode, Expectation, Light, LightCondition, Map, Offset, Pause,
-    Phase, Reward, Road, Side, SpawnRule, Trigger, Vehicle,
+    Bins, Crosswalk, CrosswalkBins, DistanceEdges, Dynamics, Episode, Expectation, Light, LightCondition, Map, Offset,
+    Pause, Phase, Reward, Road, Side, SpawnRule, SurfacePatch, Trigger, Vehicle,
 };
 pub use validate::{
     DECISION_DT, MAX_EPISODE_PLANNING, MAX_EPISODE_SUBSTEPS, MAX_JOINT_STATES, MAX_LIST, MAX_METRES, MAX_PEDESTRIANS,

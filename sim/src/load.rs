@@ -12,9 +12,9 @@ use serde::de::{self, Deserializer, Visitor};
 
 use crate::map::{
     BinsPatch, CrosswalkPatch, EpisodePatch, Expectation, LightPatch, Map, MapPatch, Pause, Phase, RewardPatch,
-    RoadPatch, SpawnRule, VehiclePatch,
+    RoadPatch, SpawnRule, SurfacePatch, VehiclePatch,
 };
-use crate::validate;
+use crate::{locate, validate};
 
 /// Largest map file accepted, bytes.
 pub const MAX_FILE_BYTES: usize = 1 << 20;
@@ -28,7 +28,8 @@ pub const MAX_BASE_DEPTH: usize = 16;
 pub struct Diagnostic {
     /// The file (or embedded map name) the problem is in.
     pub file: String,
-    /// 1-based line and column, for syntax and type errors.
+    /// 1-based line and column: of a syntax or type error, or of the field a semantic
+    /// problem is about when the file writes it (not when it is inherited or a default).
     pub position: Option<(usize, usize)>,
     /// Field path such as `road.lane_width` or `pedestrians[0].speed`; empty when not about a field.
     pub path: String,
@@ -385,7 +386,10 @@ fn load_top(origin: &str, key: &str, src: &str, resolve: &Resolver) -> Result<Ma
         Err(MapError::new(
             problems
                 .into_iter()
-                .map(|p| Diagnostic::new(origin, &p.path, p.message, p.hint))
+                .map(|p| Diagnostic {
+                    position: locate::field(src, &p.path),
+                    ..Diagnostic::new(origin, &p.path, p.message, p.hint)
+                })
                 .collect(),
         ))
     }
@@ -491,6 +495,7 @@ fn parse_patch(origin: &str, src: &str) -> Result<MapPatch, MapError> {
 enum Kind {
     Map,
     Road,
+    Surface,
     Crosswalk,
     Light,
     Phase,
@@ -508,6 +513,7 @@ fn fields_of(kind: Kind) -> &'static [&'static str] {
     match kind {
         Kind::Map => field_names::<MapPatch>(),
         Kind::Road => field_names::<RoadPatch>(),
+        Kind::Surface => field_names::<SurfacePatch>(),
         Kind::Crosswalk => field_names::<CrosswalkPatch>(),
         Kind::Light => field_names::<LightPatch>(),
         Kind::Phase => field_names::<Phase>(),
@@ -525,6 +531,7 @@ fn fields_of(kind: Kind) -> &'static [&'static str] {
 fn child(kind: Kind, field: &str) -> Kind {
     match (kind, field) {
         (Kind::Map, "road") => Kind::Road,
+        (Kind::Road, "surface") => Kind::Surface,
         (Kind::Map, "crosswalk") => Kind::Crosswalk,
         (Kind::Map, "light") => Kind::Light,
         (Kind::Map, "vehicle") => Kind::Vehicle,
@@ -625,7 +632,15 @@ mod tests {
     fn field_names_come_from_serde() {
         assert_eq!(
             field_names::<RoadPatch>(),
-            &["lane_width", "lanes", "sidewalk_width", "goal_x"]
+            &[
+                "lane_width",
+                "lanes",
+                "sidewalk_width",
+                "goal_x",
+                "friction",
+                "surface",
+                "air_density"
+            ]
         );
         assert!(field_names::<MapPatch>().contains(&"pedestrians"));
         assert!(field_names::<SpawnRule>().contains(&"pause"));
@@ -659,6 +674,7 @@ mod doc_tests {
         let kinds = [
             Kind::Map,
             Kind::Road,
+            Kind::Surface,
             Kind::Crosswalk,
             Kind::Light,
             Kind::Phase,

@@ -66,7 +66,33 @@ config_struct! {
         sidewalk_width: f64 = 2.0,
         /// x of the destination line, m; the episode succeeds when the car's front reaches it. Default 90.0.
         goal_x: f64 = 90.0,
+        /// Tyre-road friction coefficient μ of the road where no surface patch lies, in (0, 2]
+        /// (used by `dynamics: Forces`). Default 0.8 (dry asphalt).
+        friction: f64 = 0.8,
+        /// Stretches of road with their own μ (wet asphalt, ice, gravel), possibly appearing
+        /// at run time; a later patch lies over an earlier one where they overlap. Default [].
+        surface: Vec<SurfacePatch> = Vec::new(),
+        /// Density of the air, kg/m³ (aerodynamic drag under `dynamics: Forces`). Default 1.2.
+        air_density: f64 = 1.2,
     }
+}
+
+/// A stretch of road surface with its own friction coefficient, from x `from` to x `to`
+/// (the car's wheels on it feel `friction`). With a `trigger` the patch is absent until
+/// the trigger holds (the trigger of a pedestrian spawn rule, without its light
+/// condition): a puddle can appear as a jaywalker does.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfacePatch {
+    /// Start of the patch along the road, m.
+    pub from: f64,
+    /// End of the patch along the road, m (> `from`).
+    pub to: f64,
+    /// Friction coefficient μ on the patch, in (0, 2] (wet asphalt ~0.4, ice ~0.1).
+    pub friction: f64,
+    /// When the patch appears; `None` (the default): it is there from the start.
+    #[serde(default)]
+    pub trigger: Option<Trigger>,
 }
 
 config_struct! {
@@ -153,9 +179,25 @@ config_struct! {
     }
 }
 
+/// How the three actions move the car (docs/ARCHITECTURE.md §2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Dynamics {
+    /// The paper's kinematics: each sub-step sets the body's velocity to the speed
+    /// integrated at `max_accel` / `max_brake`, clamped to [0, `max_speed`]; mass, road
+    /// friction, drag and lag play no part.
+    #[default]
+    Ideal,
+    /// Forces on the body: drive `min(drive_force, power / v)`, brakes through a dead
+    /// time and a first-order lag, rolling resistance, aerodynamic drag, all within the
+    /// tyre-road friction limit `μ m g`; `max_speed` is a speed governor.
+    Forces,
+}
+
 config_struct! {
-    /// The ego car: a dynamic rigid body under longitudinal velocity control.
+    /// The ego car: a dynamic rigid body, driven as `dynamics` says.
     pub struct Vehicle / VehiclePatch as "Vehicle" {
+        /// The vehicle model: `Ideal` (velocity control, the paper's) or `Forces`. Default `Ideal`.
+        dynamics: Dynamics = Dynamics::Ideal,
         /// Body length, m. Default 4.5.
         length: f64 = 4.5,
         /// Body width, m. Default 1.8.
@@ -174,6 +216,23 @@ config_struct! {
         max_speed: f64 = 9.0,
         /// Linear damping coefficient, 1/s (0 = "maintain" holds speed exactly). Default 0.0.
         damping: f64 = 0.0,
+        /// `Forces`: the largest drive force at the tyres, N. Default 5000 (3.3 m/s² on 1500 kg).
+        drive_force: f64 = 5000.0,
+        /// `Forces`: the engine's power at the tyres, W; the drive force is at most
+        /// power / speed. Default 60000.
+        power: f64 = 60_000.0,
+        /// `Forces`: the brake force "slow down" demands, N. Default 7500 (5 m/s² on 1500 kg).
+        brake_force: f64 = 7500.0,
+        /// `Forces`: time constant of the brake's first-order lag, s (0: none). Default 0.2.
+        brake_lag: f64 = 0.2,
+        /// `Forces`: dead time before the brake responds to a new demand, s. Default 0.1.
+        brake_dead_time: f64 = 0.1,
+        /// `Forces`: rolling resistance coefficient (force = coefficient × m g). Default 0.012.
+        rolling_resistance: f64 = 0.012,
+        /// `Forces`: aerodynamic drag coefficient C_d. Default 0.3.
+        drag_coefficient: f64 = 0.3,
+        /// `Forces`: frontal area A, m² (drag = ½ ρ C_d A v²). Default 2.2.
+        frontal_area: f64 = 2.2,
     }
 }
 
@@ -744,6 +803,28 @@ impl Map {
             "car: {} x {} m, {} kg, front at x = {} m, {} m/s; accel {} m/s², brake {} m/s², max {} m/s, damping {}",
             v.length, v.width, v.mass, v.start_x, v.start_speed, v.max_accel, v.max_brake, v.max_speed, v.damping
         );
+        if v.dynamics == Dynamics::Forces {
+            let _ = writeln!(
+                s,
+                "dynamics: forces: drive {} N up to {} W, brake {} N after {} s dead time and a {} s lag, \
+                 rolling {}, drag C_d {} x {} m²",
+                v.drive_force,
+                v.power,
+                v.brake_force,
+                v.brake_dead_time,
+                v.brake_lag,
+                v.rolling_resistance,
+                v.drag_coefficient,
+                v.frontal_area
+            );
+        }
+        if v.dynamics == Dynamics::Forces || !r.surface.is_empty() {
+            let _ = writeln!(s, "surface: μ {}, air {} kg/m³", r.friction, r.air_density);
+        }
+        for p in &r.surface {
+            let when = p.trigger.map(|t| format!(" (appears {t:?})")).unwrap_or_default();
+            let _ = writeln!(s, "surface patch: x {}..{} m, μ {}{when}", p.from, p.to, p.friction);
+        }
         let cycle: Vec<String> = self
             .light
             .cycle

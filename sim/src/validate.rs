@@ -7,7 +7,7 @@
 //! bins give a bounded number of joint states (so the agent's model fits in memory).
 
 use crate::light::LightPhase;
-use crate::map::{DistanceEdges, Map, Offset, Trigger};
+use crate::map::{DistanceEdges, Dynamics, Map, Offset, Trigger};
 
 /// Largest number of physics sub-steps per decision tick.
 pub const MAX_SUBSTEPS: f64 = 10_000.0;
@@ -279,6 +279,7 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
         "70 m/s is 252 km/h",
     );
     c.within("vehicle.damping", v.damping, (0.0, 10.0), "1/s", body);
+    check_forces(&mut c, map);
     if v.start_speed.is_finite() && v.max_speed.is_finite() && v.start_speed > v.max_speed {
         c.fail(
             "vehicle.start_speed",
@@ -601,6 +602,130 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
         }
     }
     c.out
+}
+
+/// The road surface (always: a map may set it before switching to `Forces`) and the
+/// parameters of the force-driven vehicle model (under `dynamics: Forces`).
+fn check_forces(c: &mut Check, map: &Map) {
+    let friction = |c: &mut Check, path: &str, mu: f64| {
+        let hint = "μ is about 0.8 on dry asphalt, 0.4 wet, 0.1 on ice; racing tyres reach 2";
+        if mu.is_finite() && mu <= 0.0 {
+            c.fail(
+                path,
+                format!("a friction coefficient must be greater than 0, got {mu}"),
+                hint,
+            );
+        } else {
+            c.within(path, mu, (0.0, 2.0), "", hint);
+        }
+    };
+    friction(c, "road.friction", map.road.friction);
+    c.within(
+        "road.air_density",
+        map.road.air_density,
+        (0.0, 5.0),
+        "kg/m³",
+        "air is 1.2 kg/m³ at sea level",
+    );
+    if map.road.surface.len() > MAX_LIST {
+        c.fail(
+            "road.surface",
+            format!(
+                "{} surface patches is too many (at most {MAX_LIST})",
+                map.road.surface.len()
+            ),
+            "merge neighbouring patches",
+        );
+    }
+    // The road the car can drive on: from its rear at the start to the destination.
+    let (start, end) = (map.vehicle.start_x - map.vehicle.length, map.road.goal_x);
+    for (i, p) in map.road.surface.iter().enumerate().take(MAX_LIST) {
+        let path = format!("road.surface[{i}]");
+        friction(c, &format!("{path}.friction"), p.friction);
+        if !(c.finite(&format!("{path}.from"), p.from) & c.finite(&format!("{path}.to"), p.to)) {
+            continue;
+        }
+        if p.from >= p.to {
+            c.fail(
+                &format!("{path}.to"),
+                format!(
+                    "the patch ends (x {} m) where or before it starts (x {} m)",
+                    p.to, p.from
+                ),
+                "give from < to",
+            );
+        } else if start.is_finite() && end.is_finite() && (p.to <= start || p.from >= end) {
+            c.fail(
+                &path,
+                format!(
+                    "the patch (x {}..{} m) lies outside the road the car drives (x {start}..{end} m)",
+                    p.from, p.to
+                ),
+                "place it between the car's rear at the start and road.goal_x",
+            );
+        }
+        match p.trigger {
+            None | Some(Trigger::RedStarts | Trigger::GreenStarts) => {}
+            Some(Trigger::AtTime(t)) => c.non_negative(&format!("{path}.trigger"), t),
+            Some(Trigger::CarWithin { min, max }) => c.range(&format!("{path}.trigger"), (min, max), false),
+            Some(Trigger::CarArrivesWithin(t)) => c.within(
+                &format!("{path}.trigger"),
+                t,
+                (0.0, 3600.0),
+                "s",
+                "use real units: seconds",
+            ),
+        }
+    }
+    let v = &map.vehicle;
+    if v.dynamics != Dynamics::Forces {
+        return;
+    }
+    let force = "a car's tyres carry up to about m g: 15 kN on 1500 kg";
+    c.within("vehicle.drive_force", v.drive_force, (1e-9, 1e6), "N", force);
+    c.within("vehicle.brake_force", v.brake_force, (1e-9, 1e6), "N", force);
+    if v.power.is_finite() && v.power <= 0.0 && v.max_speed > 0.0 {
+        c.fail(
+            "vehicle.power",
+            format!(
+                "a power of {} W cannot move the car, yet max_speed is {} m/s",
+                v.power, v.max_speed
+            ),
+            "give the engine's power at the tyres, e.g. 60000 W",
+        );
+    } else {
+        c.within(
+            "vehicle.power",
+            v.power,
+            (1e-9, 1e8),
+            "W",
+            "a car has about 60 kW, a lorry 400 kW",
+        );
+    }
+    let lag = "brakes respond in about 0.1 to 0.5 s";
+    c.within("vehicle.brake_lag", v.brake_lag, (0.0, 10.0), "s", lag);
+    c.within("vehicle.brake_dead_time", v.brake_dead_time, (0.0, 10.0), "s", lag);
+    c.within(
+        "vehicle.rolling_resistance",
+        v.rolling_resistance,
+        (0.0, 0.5),
+        "",
+        "about 0.012 for car tyres on asphalt",
+    );
+    c.within(
+        "vehicle.drag_coefficient",
+        v.drag_coefficient,
+        (0.0, 3.0),
+        "",
+        "a car's C_d is about 0.3",
+    );
+    c.within(
+        "vehicle.frontal_area",
+        v.frontal_area,
+        (0.0, 50.0),
+        "m²",
+        "a car's is about 2.2 m²",
+    );
 }
 
 /// The most pedestrians `map`'s rules can spawn in one episode: each one-off trigger

@@ -1,22 +1,27 @@
-//! The Rapier world built from a map: the car (a dynamic body under
-//! longitudinal velocity control), pedestrians (kinematic bodies with sensor colliders),
-//! the traffic light, spawn rules, and the episode's end.
+//! The Rapier world built from a map: the car (a dynamic body under longitudinal
+//! velocity control, `dynamics: Ideal`, or driven by forces, `dynamics: Forces`),
+//! pedestrians (kinematic bodies with sensor colliders), the road surface, the traffic
+//! light, spawn rules, and the episode's end.
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier2d::prelude::*;
 
+use crate::dynamics::{Drivetrain, Pedal};
 use crate::light::{LightPhase, light_at};
-use crate::map::{LightCondition, Map, Offset, Pause, Side, Trigger};
+use crate::map::{Dynamics, LightCondition, Map, Offset, Pause, Side, SurfacePatch, Trigger};
 
 /// The three longitudinal actions of the paper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Action {
-    /// Hold the current speed.
+    /// Hold the current speed (under `Forces`: a cruise controller, within the forces
+    /// available).
     Maintain = 0,
-    /// Accelerate at `vehicle.max_accel` (up to `vehicle.max_speed`).
+    /// Accelerate at `vehicle.max_accel` (under `Forces`: full drive force) up to
+    /// `vehicle.max_speed`.
     SpeedUp = 1,
-    /// Brake at `vehicle.max_brake` (never below 0 m/s).
+    /// Brake at `vehicle.max_brake` (under `Forces`: demand `vehicle.brake_force`), never
+    /// below 0 m/s.
     SlowDown = 2,
 }
 
@@ -79,6 +84,9 @@ pub struct Snapshot {
     pub light_time_left: f64,
     /// Pedestrians currently in the world (spawned and not yet gone).
     pub pedestrians: Vec<PedestrianSnapshot>,
+    /// The surface patches on the road now (`road.surface`'s, once appeared), in the
+    /// map's order.
+    pub surface: Vec<SurfacePatch>,
 }
 
 impl Snapshot {
@@ -168,6 +176,10 @@ pub struct World {
     peds: Vec<Pedestrian>,
     prev_phase: LightPhase,
     terminal: Option<StepOutcome>,
+    /// The drive train and brakes under `dynamics: Forces`.
+    drivetrain: Option<Drivetrain>,
+    /// Which of `road.surface` lie on the road now (a triggered patch appears later).
+    surface_on: Vec<bool>,
 }
 
 impl World {
@@ -215,6 +227,8 @@ impl World {
             .friction(0.0);
         let (car, car_collider) = phys.insert(body, collider);
         let prev_phase = light_at(&map.light, light_offset, 0.0).0;
+        let drivetrain = (v.dynamics == Dynamics::Forces)
+            .then(|| Drivetrain::new(v, map.road.air_density, 1.0 / map.episode.physics_hz));
         World {
             map: map.clone(),
             phys,
@@ -230,7 +244,37 @@ impl World {
             peds: Vec::new(),
             prev_phase,
             terminal: None,
+            drivetrain,
+            surface_on: map.road.surface.iter().map(|p| p.trigger.is_none()).collect(),
         }
+    }
+
+    /// The surface patches on the road now, in the map's order (a later one lies over
+    /// an earlier one).
+    pub fn surface(&self) -> impl Iterator<Item = &SurfacePatch> {
+        self.map
+            .road
+            .surface
+            .iter()
+            .zip(&self.surface_on)
+            .filter(|(_, on)| **on)
+            .map(|(p, _)| p)
+    }
+
+    /// The road's friction coefficient at `x`: the last patch on the road there, else
+    /// `road.friction`.
+    pub fn friction_at(&self, x: f64) -> f64 {
+        self.surface()
+            .filter(|p| p.from <= x && x <= p.to)
+            .last()
+            .map_or(self.map.road.friction, |p| p.friction)
+    }
+
+    /// The friction the car's tyres have: the mean of its two axles' road (each carries
+    /// half the weight), the axles a sixth of the body's length in from either end.
+    fn car_friction(&self) -> f64 {
+        let (front, length) = (self.car_front(), self.map.vehicle.length);
+        (self.friction_at(front - length / 6.0) + self.friction_at(front - length * 5.0 / 6.0)) / 2.0
     }
 
     /// The map this world was built from.
@@ -275,6 +319,7 @@ impl World {
         let v0 = self.car_speed();
         for k in 1..=self.substeps {
             self.spawn_due();
+            self.lay_surface();
             self.move_pedestrians();
             self.control_car(action, v0, k);
             let before = self.car_front();
@@ -332,7 +377,14 @@ impl World {
     /// is planned from `v0` (so ticks land exactly on `v0 ± a·dt` and f32
     /// rounding never accumulates); with damping it builds on the body's
     /// current, damped speed.
+    ///
+    /// Under `Forces` the drive train drives the car instead (`drive_by_forces`,
+    /// "maintain" holding `v0`).
     fn control_car(&mut self, action: Action, v0: f64, k: u32) {
+        if self.drivetrain.is_some() {
+            self.drive_by_forces(action, v0);
+            return;
+        }
         let v = &self.map.vehicle;
         let h = 1.0 / self.map.episode.physics_hz;
         let body = &mut self.phys.bodies[self.car];
@@ -348,6 +400,25 @@ impl World {
         };
         let target = target.clamp(0.0, v.max_speed);
         body.set_linvel(Vector::new(target as Real, 0.0), true);
+    }
+
+    /// `dynamics: Forces`: the drive train's net force for the coming sub-step, on the
+    /// friction under the car's axles, replaces the force on the car's body.
+    fn drive_by_forces(&mut self, action: Action, v0: f64) {
+        let mu = self.car_friction();
+        let speed = self.phys.bodies[self.car].linvel().x as f64;
+        let pedal = match action {
+            Action::SpeedUp => Pedal::Drive,
+            Action::SlowDown => Pedal::Brake,
+            Action::Maintain => Pedal::Cruise(v0),
+        };
+        let Some(drivetrain) = self.drivetrain.as_mut() else {
+            return;
+        };
+        let force = drivetrain.force(pedal, speed, mu);
+        let body = &mut self.phys.bodies[self.car];
+        body.reset_forces(true);
+        body.add_force(Vector::new(force as Real, 0.0), true);
     }
 
     /// Keep the car's speed within [0, max_speed] after f32 integration.
@@ -369,6 +440,30 @@ impl World {
             } else {
                 i += 1;
             }
+        }
+    }
+
+    /// Lay the surface patches whose trigger holds at the current sub-step (once laid, a
+    /// patch stays): `RedStarts` / `GreenStarts` hold while the light shows that phase,
+    /// the others as for a spawn rule.
+    fn lay_surface(&mut self) {
+        if self.surface_on.iter().all(|on| *on) {
+            return;
+        }
+        let t = self.time_at(self.substep);
+        let phase = light_at(&self.map.light, self.light_offset, t).0;
+        let to_cross = self.map.crosswalk_near_x() - self.car_front();
+        let speed = self.car_speed();
+        for (on, patch) in self.surface_on.iter_mut().zip(&self.map.road.surface) {
+            *on = *on
+                || match patch.trigger {
+                    None => true,
+                    Some(Trigger::RedStarts) => phase == LightPhase::Red,
+                    Some(Trigger::GreenStarts) => phase == LightPhase::Green,
+                    Some(Trigger::AtTime(at)) => t + 1e-9 >= at,
+                    Some(Trigger::CarWithin { min, max }) => to_cross >= min && to_cross <= max,
+                    Some(Trigger::CarArrivesWithin(secs)) => to_cross > 0.0 && speed > 1e-3 && to_cross <= secs * speed,
+                };
         }
     }
 
@@ -556,6 +651,7 @@ impl World {
             light,
             light_time_left: left,
             pedestrians,
+            surface: self.surface().copied().collect(),
         }
     }
 }

@@ -469,3 +469,19 @@ fn scripted_methods_alone_train_no_agent() {
         );
     }
 }
+
+/// The force-driven maps (brakes through a lag, an ice patch) give the same results on
+/// one worker and on two.
+#[test]
+fn force_driven_maps_do_not_depend_on_jobs() {
+    let paths = ["maps/ice_before_crosswalk.ron", "maps/worn_brakes.ron"];
+    let scenarios = load_scenarios(&paths.iter().map(Into::into).collect::<Vec<_>>()).unwrap();
+    let params = vec![ParamSet(Vec::new())];
+    let dir = tempfile::tempdir().unwrap();
+    let one = dir.path().join("one.jsonl");
+    let two = dir.path().join("two.jsonl");
+    let a = run(&config(&scenarios, &params, 1, None), &one, false, &NoProgress).unwrap();
+    let b = run(&config(&scenarios, &params, 2, None), &two, false, &NoProgress).unwrap();
+    assert_eq!(a.len(), 2 * (1 + 2 + 2));
+    assert_eq!(without_timing(&a), without_timing(&b));
+}

@@ -397,3 +397,28 @@ fn the_cli_exits_2_on_bad_space_files() {
         "nothing is written for a bad space"
     );
 }
+
+/// `maps/spaces/dynamics.ron` on the ice map sets the road's and the patch's friction,
+/// the patch's start (its length kept, then set), the mass and the brakes, and its
+/// candidates load as maps; a patch the base map does not have is an error.
+#[test]
+fn the_dynamics_space_sets_surface_and_brakes() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = Map::load(&root.join("maps/ice_before_crosswalk.ron")).unwrap();
+    let space = Space::load(&root.join("maps/spaces/dynamics.ron"), &base).expect("valid");
+    let values = space.values_at(&vec![0.0; space.params.len()]);
+    let map = space.apply(&values, "low").expect("the lowest corner is a valid map");
+    assert_eq!(map.road.friction, 0.3);
+    let patch = map.road.surface[0];
+    assert_eq!((patch.from, patch.to, patch.friction), (0.0, 2.0, 0.05));
+    assert_eq!((map.vehicle.mass, map.vehicle.brake_force), (1000.0, 3000.0));
+    assert_eq!((map.vehicle.brake_dead_time, map.vehicle.brake_lag), (0.0, 0.0));
+    let err = Space::parse(
+        "bad.ron",
+        "Space(params: [(field: \"road.surface[1].friction\", range: (0.1, 0.2))])",
+        &base,
+    )
+    .expect_err("the ice map has one patch")
+    .to_string();
+    assert!(err.contains("1 surface patch(es), not 2"), "{err}");
+}

@@ -585,9 +585,18 @@ pub fn theta_trace(path: &Path, title: &str, ticks: &[(u32, Option<f64>, bool, S
     })
 }
 
+/// The colour of road with friction `mu`: the asphalt's grey at the dry road's μ 0.8 and
+/// above, shading to blue as the road gets slippery (ice, μ ≤ 0.1, the palest blue).
+pub fn surface_tint(mu: f64) -> RGBColor {
+    let slip = ((0.8 - mu) / 0.7).clamp(0.0, 1.0);
+    let mix = |dry: f64, slick: f64| (dry + (slick - dry) * slip).round() as u8;
+    RGBColor(mix(205.0, 150.0), mix(205.0, 200.0), mix(205.0, 245.0))
+}
+
 /// Top-down filmstrip of an episode: a title, a key, then one strip per decision tick
 /// showing the road, the crosswalk, the light's colour, the car (orange on ticks that
-/// reasoned, blue on feed-forward ticks) and the pedestrians; left of each strip the
+/// reasoned, blue on feed-forward ticks), the pedestrians and the road's surface patches
+/// on that tick (tinted by their friction, [`surface_tint`]); left of each strip the
 /// tick, the action taken and the discrete state.
 pub fn filmstrip(
     path: &Path,
@@ -605,7 +614,7 @@ pub fn filmstrip(
     let x0 = map.vehicle.start_x - map.vehicle.length - 2.0;
     let x1 = map.road.goal_x + 4.0;
     let verge = RGBColor(190, 225, 180);
-    let asphalt = RGBColor(205, 205, 205);
+    let asphalt = surface_tint(map.road.friction);
     let walk = RGBColor(245, 245, 245);
     let amber = RGBColor(255, 170, 0);
     let key = [
@@ -618,6 +627,8 @@ pub fn filmstrip(
         KeyEntry::new(Swatch::Fill(walk.to_rgba()), "crosswalk"),
         KeyEntry::new(Swatch::Fill(BLACK.to_rgba()), "destination"),
         KeyEntry::new(Swatch::Fill(asphalt.to_rgba()), "road"),
+        KeyEntry::new(Swatch::Fill(surface_tint(0.4).to_rgba()), "wet (μ 0.4)"),
+        KeyEntry::new(Swatch::Fill(surface_tint(0.1).to_rgba()), "ice (μ 0.1)"),
         KeyEntry::new(Swatch::Fill(verge.to_rgba()), "sidewalk"),
     ];
     let note =
@@ -663,6 +674,18 @@ pub fn filmstrip(
                 .draw_series([
                     Rectangle::new([(x0, -y_span), (x1, y_span)], verge.filled()),
                     Rectangle::new([(x0, -road_half), (x1, road_half)], asphalt.filled()),
+                ])
+                .map_err(plot_err)?;
+            chart
+                .draw_series(t.snapshot.surface.iter().map(|p| {
+                    Rectangle::new(
+                        [(p.from.max(x0), -road_half), (p.to.min(x1), road_half)],
+                        surface_tint(p.friction).filled(),
+                    )
+                }))
+                .map_err(plot_err)?;
+            chart
+                .draw_series([
                     Rectangle::new(
                         [
                             (map.crosswalk.x - map.crosswalk.width / 2.0, -road_half),

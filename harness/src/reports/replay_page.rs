@@ -25,6 +25,8 @@ struct Scene {
     crosswalk_width: f64,
     goal_x: f64,
     light_x: f64,
+    /// The road's colour: its friction's tint (`figures::surface_tint`).
+    road_colour: String,
 }
 
 /// One decision tick of the replay.
@@ -38,6 +40,8 @@ struct Frame {
     light_left: f64,
     /// (x, y, on the crosswalk) per pedestrian.
     pedestrians: Vec<(f64, f64, bool)>,
+    /// (from, to, friction, CSS colour) per surface patch on the road at this tick.
+    surface: Vec<(f64, f64, f64, String)>,
     /// The action taken at this tick (none on the final frame).
     action: Option<String>,
     reasoned: bool,
@@ -110,6 +114,10 @@ pub fn replay_html(
             crosswalk_width: map.crosswalk.width,
             goal_x: map.road.goal_x,
             light_x: map.crosswalk.x - map.crosswalk.width,
+            road_colour: {
+                let c = crate::reports::figures::surface_tint(map.road.friction);
+                format!("rgb({},{},{})", c.0, c.1, c.2)
+            },
         },
         ticks: ticks
             .iter()
@@ -126,6 +134,15 @@ pub fn replay_html(
                     .pedestrians
                     .iter()
                     .map(|p| (p.x, p.y, p.on_crosswalk))
+                    .collect(),
+                surface: t
+                    .snapshot
+                    .surface
+                    .iter()
+                    .map(|p| {
+                        let c = crate::reports::figures::surface_tint(p.friction);
+                        (p.from, p.to, p.friction, format!("rgb({},{},{})", c.0, c.1, c.2))
+                    })
                     .collect(),
                 action: (i < last).then(|| t.action.to_string()),
                 reasoned: t.reasoned && i < last,
@@ -209,6 +226,8 @@ const PAGE: &str = r##"<!DOCTYPE html>
       <span><span class="sw dot" style="background:#1db31d"></span><span class="sw dot" style="background:#ffaa00"></span><span class="sw dot" style="background:#e02020"></span>traffic light</span>
       <span><span class="sw" style="background:#f5f5f5"></span>crosswalk</span>
       <span><span class="sw" style="background:#000"></span>destination</span>
+      <span><span class="sw" style="background:rgb(174,202,228)"></span>wet road (μ 0.4)</span>
+      <span><span class="sw" style="background:rgb(150,200,245)"></span>ice (μ 0.1): road surface tinted by its friction</span>
       <span><span class="sw" style="border:2px solid #d01818"></span>car outlined red: that tick entered the crosswalk on red</span>
     </div>
   </div>
@@ -254,7 +273,8 @@ const half = S.road_half + S.sidewalk;
 const scene = $("scene");
 scene.setAttribute("viewBox", `${S.x0} ${-half} ${S.x1 - S.x0} ${2 * half}`);
 el(scene, "rect", { x: S.x0, y: -half, width: S.x1 - S.x0, height: 2 * half, fill: "#bee1b4" });
-el(scene, "rect", { x: S.x0, y: -S.road_half, width: S.x1 - S.x0, height: 2 * S.road_half, fill: "#cdcdcd" });
+el(scene, "rect", { x: S.x0, y: -S.road_half, width: S.x1 - S.x0, height: 2 * S.road_half, fill: S.road_colour });
+const surface = el(scene, "g", {});
 el(scene, "line", { x1: S.x0, x2: S.x1, y1: 0, y2: 0, stroke: "#fff", "stroke-width": 0.15, "stroke-dasharray": "2 2" });
 for (let y = -S.road_half; y < S.road_half - 0.01; y += 0.8)
   el(scene, "rect", { x: S.crosswalk_x - S.crosswalk_width / 2, y: y + 0.1, width: S.crosswalk_width, height: 0.5, fill: "#f5f5f5" });
@@ -340,6 +360,12 @@ function show(t) {
   car.setAttribute("stroke", a.red_light ? "#d01818" : "none");
   car.setAttribute("stroke-width", a.red_light ? 0.6 : 0);
   light.setAttribute("fill", LIGHT[a.light]);
+  surface.replaceChildren();
+  for (const [from, to, mu, colour] of a.surface) {
+    const x0 = Math.max(from, S.x0), x1 = Math.min(to, S.x1);
+    const patch = el(surface, "rect", { x: x0, y: -S.road_half, width: Math.max(x1 - x0, 0), height: 2 * S.road_half, fill: colour });
+    el(patch, "title", {}, `surface μ ${mu}`);
+  }
   const same = a.pedestrians.length === b.pedestrians.length;
   peds.replaceChildren();
   a.pedestrians.forEach((p, k) => {

@@ -413,3 +413,52 @@ fn the_shipped_maps_are_within_the_limits() {
     }
     assert!(loaded >= 13, "only {loaded} map files found under maps/");
 }
+
+/// The road surface and the force model's parameters: each bad value is named by its
+/// field, with the accepted range or the reason.
+#[test]
+fn bad_surface_and_force_parameters_are_rejected() {
+    let cases: [(&str, &[&str]); 8] = [
+        ("Map(road: (friction: 0.0))", &["road.friction", "greater than 0"]),
+        (
+            "Map(road: (friction: 2.5))",
+            &["road.friction", "above the accepted range"],
+        ),
+        (
+            "Map(road: (surface: [(from: 10.0, to: 20.0, friction: -0.1)]))",
+            &["road.surface[0].friction", "greater than 0"],
+        ),
+        (
+            "Map(road: (surface: [(from: 200.0, to: 220.0, friction: 0.1)]))",
+            &["road.surface[0]", "outside the road"],
+        ),
+        (
+            "Map(road: (surface: [(from: 30.0, to: 20.0, friction: 0.1)]))",
+            &["road.surface[0].to", "before it starts"],
+        ),
+        (
+            "Map(vehicle: (dynamics: Forces, brake_lag: -0.1))",
+            &["vehicle.brake_lag", "below"],
+        ),
+        ("Map(vehicle: (mass: 0.0))", &["vehicle.mass", "greater than 0"]),
+        (
+            "Map(vehicle: (dynamics: Forces, power: 0.0))",
+            &["vehicle.power", "cannot move the car"],
+        ),
+    ];
+    for (text, needles) in cases {
+        let (_, lines) = reject(text);
+        assert!(has(&lines, needles), "{text}: {lines:?}");
+    }
+}
+
+/// A map on the force model with patches, one appearing at run time, loads.
+#[test]
+fn a_surface_with_a_triggered_patch_loads() {
+    let text = "Map(vehicle: (dynamics: Forces), road: (friction: 0.4, surface: [\
+                (from: 40.0, to: 64.0, friction: 0.1, trigger: Some(CarWithin(min: 0.0, max: 30.0)))]))";
+    let (_dir, _path, result) = load_files(&[("ok.ron", text.as_bytes())]);
+    let map = result.expect("valid");
+    assert_eq!(map.road.surface.len(), 1);
+    assert_eq!(map.road.friction, 0.4);
+}

@@ -7,4 +7,5 @@ mod determinism;
 mod red_light;
 mod scenarios;
 mod triggers;
+mod vehicle_forces;
 mod vehicle_kinematics;

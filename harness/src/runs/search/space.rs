@@ -79,6 +79,29 @@ pub enum Field {
     ObservationNoise,
     /// `crosswalk.x`, m.
     CrosswalkX,
+    /// `road.friction`, μ.
+    Friction,
+    /// `vehicle.mass`, kg.
+    Mass,
+    /// `vehicle.brake_lag`, s.
+    BrakeLag,
+    /// `vehicle.brake_dead_time`, s.
+    BrakeDeadTime,
+    /// `vehicle.brake_force`, N.
+    BrakeForce,
+    /// A field of the base map's surface patch `i` (`road.surface[i]`).
+    Surface(usize, SurfaceField),
+}
+
+/// A field of one surface patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SurfaceField {
+    /// Where it starts, m (its length kept).
+    From,
+    /// Its length, m (its start kept).
+    Length,
+    /// Its friction coefficient μ.
+    Friction,
 }
 
 /// A field of one pedestrian rule.
@@ -126,7 +149,7 @@ const RULE_FIELDS: [(&str, RuleField); 12] = [
     ("copies", RuleField::Copies),
 ];
 
-const GLOBAL_FIELDS: [(&str, Field); 7] = [
+const GLOBAL_FIELDS: [(&str, Field); 12] = [
     ("vehicle.start_speed", Field::StartSpeed),
     ("vehicle.max_brake", Field::MaxBrake),
     ("vehicle.max_accel", Field::MaxAccel),
@@ -134,6 +157,17 @@ const GLOBAL_FIELDS: [(&str, Field); 7] = [
     ("light.offset", Field::LightOffset),
     ("bins.observation_noise", Field::ObservationNoise),
     ("crosswalk.x", Field::CrosswalkX),
+    ("road.friction", Field::Friction),
+    ("vehicle.mass", Field::Mass),
+    ("vehicle.brake_lag", Field::BrakeLag),
+    ("vehicle.brake_dead_time", Field::BrakeDeadTime),
+    ("vehicle.brake_force", Field::BrakeForce),
+];
+
+const SURFACE_FIELDS: [(&str, SurfaceField); 3] = [
+    ("from", SurfaceField::From),
+    ("length", SurfaceField::Length),
+    ("friction", SurfaceField::Friction),
 ];
 
 const TRIGGER_KINDS: [&str; 3] = ["CarArrivesWithin", "AtTime", "CarWithin"];
@@ -144,7 +178,16 @@ const SIDES: [&str; 3] = ["Near", "Far", "Random"];
 fn field_list() -> String {
     let rule: Vec<String> = RULE_FIELDS.iter().map(|(n, _)| format!("pedestrians[i].{n}")).collect();
     let global: Vec<&str> = GLOBAL_FIELDS.iter().map(|(n, _)| *n).collect();
-    format!("{}, light.cycle[i].duration, {}", global.join(", "), rule.join(", "))
+    let surface: Vec<String> = SURFACE_FIELDS
+        .iter()
+        .map(|(n, _)| format!("road.surface[i].{n}"))
+        .collect();
+    format!(
+        "{}, light.cycle[i].duration, {}, {}",
+        global.join(", "),
+        surface.join(", "),
+        rule.join(", ")
+    )
 }
 
 impl Field {
@@ -160,6 +203,14 @@ impl Field {
         if let Some(rest) = text.strip_prefix("light.cycle[") {
             let (i, tail) = index(rest)?;
             return (tail == ".duration").then_some(Field::PhaseDuration(i));
+        }
+        if let Some(rest) = text.strip_prefix("road.surface[") {
+            let (i, tail) = index(rest)?;
+            let name = tail.strip_prefix('.')?;
+            return SURFACE_FIELDS
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, f)| Field::Surface(i, *f));
         }
         let rest = text.strip_prefix("pedestrians[")?;
         let (i, tail) = index(rest)?;
@@ -199,6 +250,16 @@ impl Field {
             Field::StartSpeed => (0.0, 70.0, "m/s"),
             Field::MaxBrake | Field::MaxAccel => (0.1, 20.0, "m/s²"),
             Field::MaxSpeed => (0.1, 70.0, "m/s"),
+            Field::Friction | Field::Surface(_, SurfaceField::Friction) => (0.01, 2.0, "(μ)"),
+            Field::Mass => (50.0, 60_000.0, "kg"),
+            Field::BrakeLag | Field::BrakeDeadTime => (0.0, 10.0, "s"),
+            Field::BrakeForce => (1.0, 1e6, "N"),
+            Field::Surface(_, SurfaceField::From) => (
+                base.vehicle.start_x - base.vehicle.length,
+                base.road.goal_x,
+                "m (on the road)",
+            ),
+            Field::Surface(_, SurfaceField::Length) => (0.01, unforeseen_sim::MAX_METRES, "m"),
             Field::PhaseDuration(_) => (1.0 / base.episode.physics_hz, 1e6, "s"),
             Field::LightOffset => (0.0, 1e6, "s"),
             Field::ObservationNoise => (0.0, 0.999, "(a probability below 1)"),
@@ -459,6 +520,19 @@ impl Space {
                         file.rules.len()
                     ),
                     format!("use an index below {n_rules}, or add the rule to the space's `rules`"),
+                );
+                continue;
+            }
+            if let Field::Surface(k, _) = field
+                && k >= base.road.surface.len()
+            {
+                bad(
+                    format!(
+                        "the base map's road has {} surface patch(es), not {}",
+                        base.road.surface.len(),
+                        k + 1
+                    ),
+                    "add the patch to the base map's road.surface, or use a lower index".to_string(),
                 );
                 continue;
             }
@@ -727,6 +801,24 @@ impl Space {
                 Field::LightOffset => map.light.offset = Offset::Fixed(num()?),
                 Field::ObservationNoise => map.bins.observation_noise = num()?,
                 Field::CrosswalkX => map.crosswalk.x = num()?,
+                Field::Friction => map.road.friction = num()?,
+                Field::Mass => map.vehicle.mass = num()?,
+                Field::BrakeLag => map.vehicle.brake_lag = num()?,
+                Field::BrakeDeadTime => map.vehicle.brake_dead_time = num()?,
+                Field::BrakeForce => map.vehicle.brake_force = num()?,
+                Field::Surface(k, f) => {
+                    let patch = &mut map.road.surface[k];
+                    let x = num()?;
+                    match f {
+                        SurfaceField::From => {
+                            let length = patch.to - patch.from;
+                            patch.from = x;
+                            patch.to = x + length;
+                        }
+                        SurfaceField::Length => patch.to = patch.from + x,
+                        SurfaceField::Friction => patch.friction = x,
+                    }
+                }
             }
         }
         let total: u64 = copies.iter().map(|&c| u64::from(c)).sum();
@@ -833,6 +925,19 @@ fn global_value(map: &Map, f: Field) -> Option<Value> {
         },
         Field::ObservationNoise => map.bins.observation_noise,
         Field::CrosswalkX => map.crosswalk.x,
+        Field::Friction => map.road.friction,
+        Field::Mass => map.vehicle.mass,
+        Field::BrakeLag => map.vehicle.brake_lag,
+        Field::BrakeDeadTime => map.vehicle.brake_dead_time,
+        Field::BrakeForce => map.vehicle.brake_force,
+        Field::Surface(k, f) => {
+            let patch = map.road.surface.get(k)?;
+            match f {
+                SurfaceField::From => patch.from,
+                SurfaceField::Length => patch.to - patch.from,
+                SurfaceField::Friction => patch.friction,
+            }
+        }
         Field::Rule(..) => return None,
     };
     Some(Value::Num(x))
