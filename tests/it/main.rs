@@ -29,3 +29,4 @@ mod stream;
 mod stream_memory;
 mod svg_text;
 mod train_seeds;
+mod writers;
