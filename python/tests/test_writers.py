@@ -41,7 +41,7 @@ HELD = {
     "candidates": "holds a search's candidates",
     "model": "holds a planning model",
     "stream": "holds a deployment stream",
-    "html": "holds a replay page",
+    "html": "holds an HTML page",
     "svg": "holds an SVG figure",
 }
 
@@ -58,7 +58,7 @@ def foreign(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     run = lambda *a: subprocess.run([str(cli), *a], check=True, capture_output=True, timeout=300)  # noqa: E731
     run("search", "--method", "never-brake", "--budget", "2", "--episodes", "1", "--jobs", "1", "--space",
         str(MAPS / "spaces" / "jaywalk.ron"), "--out", str(d / "search"))
-    run("export-model", "--agent", str(d / "agent.ron"), "--out", str(d / "model.json"))
+    run("export-model", "--agent", str(d / "agent.ron"), "--obs", "1,1,1,1", "--out", str(d / "model.json"))
     run("trace", "--map", str(d / "tiny.ron"), "--agent", str(d / "agent.ron"), "-q", "--out", str(d / "trace"),
         "--html", str(d / "page.html"))
     files = {

@@ -186,7 +186,7 @@ pub fn error_message(err: &anyhow::Error) -> String {
 
 /// The fields of a request that the output guard names (inputs and outputs), longest
 /// first.
-const GUARDED_FIELDS: [&str; 7] = ["stream", "agent", "space", "maps", "html", "map", "out"];
+const GUARDED_FIELDS: [&str; 8] = ["stream", "agent", "space", "cache", "maps", "html", "map", "out"];
 
 /// A message of the output guard with the fields it names (at its start, in "given as
 /// FIELD" and in "give FIELD ...") spelt as their flags.
@@ -287,7 +287,8 @@ impl AgentArgs {
 }
 
 /// Parses an episode count that may be 0 (`check-map --survivability-episodes`, where 0
-/// turns the check off): a whole number in 0..=MAX_EPISODES.
+/// turns the check off), or an episode's number counted from 0 (`trace --episode`): a
+/// whole number in 0..=MAX_EPISODES, digits only (`+5` is refused).
 pub fn episodes_or_none(s: &str) -> Result<u64, String> {
     if s == "0" { Ok(0) } else { episodes(s) }
 }

@@ -59,7 +59,7 @@ impl Kind {
             Kind::Candidates => "holds a search's candidates",
             Kind::Model => "holds a planning model",
             Kind::Stream => "holds a deployment stream",
-            Kind::Html => "holds a replay page",
+            Kind::Html => "holds an HTML page",
             Kind::Svg => "holds an SVG figure",
         }
     }
@@ -89,7 +89,19 @@ impl Foreign {
         let search = f.path("search");
         assert_exit(&run_cli(&search_args(&search, &[])), 0, &[]);
         let model = f.path("model.json");
-        assert_exit(&run_cli(&["export-model", "--agent", &f.p("agent.ron"), "--out", s(&model)]), 0, &[]);
+        assert_exit(
+            &run_cli(&[
+                "export-model",
+                "--agent",
+                &f.p("agent.ron"),
+                "--obs",
+                "1,1,1,1",
+                "--out",
+                s(&model),
+            ]),
+            0,
+            &[],
+        );
         let trace = f.path("trace");
         let html = f.path("page.html");
         assert_exit(&run_cli(&f.trace_args(&trace, &["--html", s(&html)])), 0, &[]);
@@ -140,9 +152,16 @@ impl Foreign {
     }
 
     fn trace_args(&self, out: &Path, extra: &[&str]) -> Vec<String> {
-        let mut a: Vec<String> = ["trace", "--map", &self.p("tiny.ron"), "--agent", &self.p("agent.ron"), "-q"]
-            .map(String::from)
-            .to_vec();
+        let mut a: Vec<String> = [
+            "trace",
+            "--map",
+            &self.p("tiny.ron"),
+            "--agent",
+            &self.p("agent.ron"),
+            "-q",
+        ]
+        .map(String::from)
+        .to_vec();
         a.extend(["--out".into(), s(out).into()]);
         a.extend(extra.iter().map(|x| x.to_string()));
         a
@@ -195,9 +214,18 @@ fn writers() -> Vec<Writer> {
             folder: false,
             outputs: &[("", Some(Kind::Agent))],
             args: |f, out, x| {
-                let mut a: Vec<String> = ["train", "--map", &f.p("tiny.ron"), "--episodes", "2", "--seed", "1", "-q"]
-                    .map(String::from)
-                    .to_vec();
+                let mut a: Vec<String> = [
+                    "train",
+                    "--map",
+                    &f.p("tiny.ron"),
+                    "--episodes",
+                    "2",
+                    "--seed",
+                    "1",
+                    "-q",
+                ]
+                .map(String::from)
+                .to_vec();
                 a.extend(["--out".into(), s(out).into()]);
                 a.extend(x.iter().map(|x| x.to_string()));
                 a
@@ -208,9 +236,17 @@ fn writers() -> Vec<Writer> {
             folder: false,
             outputs: &[("", Some(Kind::Model))],
             args: |f, out, x| {
-                let mut a: Vec<String> = ["export-model", "--agent", &f.p("agent.ron"), "--out", s(out)]
-                    .map(String::from)
-                    .to_vec();
+                let mut a: Vec<String> = [
+                    "export-model",
+                    "--agent",
+                    &f.p("agent.ron"),
+                    "--obs",
+                    "1,1,1,1",
+                    "--out",
+                    s(out),
+                ]
+                .map(String::from)
+                .to_vec();
                 a.extend(x.iter().map(|x| x.to_string()));
                 a
             },
@@ -241,7 +277,11 @@ fn writers() -> Vec<Writer> {
         Writer {
             name: "trace",
             folder: true,
-            outputs: &[("trace.csv", None), ("theta.svg", Some(Kind::Svg)), ("filmstrip.svg", Some(Kind::Svg))],
+            outputs: &[
+                ("trace.csv", None),
+                ("theta.svg", Some(Kind::Svg)),
+                ("filmstrip.svg", Some(Kind::Svg)),
+            ],
             args: |f, out, x| f.trace_args(out, x),
         },
         Writer {
@@ -279,7 +319,11 @@ fn writers() -> Vec<Writer> {
         Writer {
             name: "learn",
             folder: true,
-            outputs: &[("learn.csv", None), ("learn.json", None), ("learn.svg", Some(Kind::Svg))],
+            outputs: &[
+                ("learn.csv", None),
+                ("learn.json", None),
+                ("learn.svg", Some(Kind::Svg)),
+            ],
             args: |f, out, x| {
                 let mut a: Vec<String> = ["learn", "--map", &f.p("tiny.ron"), "--agent", &f.p("agent.ron")]
                     .map(String::from)
@@ -371,7 +415,12 @@ fn no_writer_replaces_a_file_of_another_kind() {
         }
     }
     eprintln!("{cases} cases (writer, output, foreign kind), {} failed", failed.len());
-    assert!(failed.is_empty(), "{} of {cases} cases failed:\n{}", failed.len(), failed.join("\n"));
+    assert!(
+        failed.is_empty(),
+        "{} of {cases} cases failed:\n{}",
+        failed.len(),
+        failed.join("\n")
+    );
 }
 
 /// `--force` replaces a foreign file, and a file of the writer's own kind from an
@@ -394,7 +443,11 @@ fn force_replaces_a_foreign_file_and_an_earlier_runs_file_is_replaced() {
         }
         let again = run(&(w.args)(&f, &out, &[]));
         if !ok(&again) {
-            failed.push(format!("{} over its own earlier output: {}", w.name, output_text(&again)));
+            failed.push(format!(
+                "{} over its own earlier output: {}",
+                w.name,
+                output_text(&again)
+            ));
         }
     }
     assert!(failed.is_empty(), "{}", failed.join("\n"));
@@ -438,7 +491,11 @@ fn a_refused_batch_resume_keeps_the_earlier_summary() {
     assert!(unforeseen_harness::runs::batch::summary_path(&out).is_file());
     let before = snapshot(&dir);
     // Another run's settings.
-    assert_exit(&run(&f.batch_args(&out, &["--episodes", "3", "--resume"])), 2, &["episodes"]);
+    assert_exit(
+        &run(&f.batch_args(&out, &["--episodes", "3", "--resume"])),
+        2,
+        &["episodes"],
+    );
     assert_unchanged(&before, &dir, "batch --resume --episodes 3");
     // A hand-edited line.
     let text = std::fs::read_to_string(&out).unwrap();
@@ -491,7 +548,10 @@ fn a_refused_merge_keeps_the_earlier_merge() {
     for (what, ps) in [
         ("a gap", vec![parts[0].as_path()]),
         ("a part of another run", vec![parts[0].as_path(), other.as_path()]),
-        ("a part given twice", vec![parts[0].as_path(), parts[1].as_path(), parts[1].as_path()]),
+        (
+            "a part given twice",
+            vec![parts[0].as_path(), parts[1].as_path(), parts[1].as_path()],
+        ),
     ] {
         assert_exit(&merge(&ps), 2, &[]);
         assert_unchanged(&before, &dir, what);
@@ -520,7 +580,11 @@ fn plot_sweep_refuses_a_partial_run_unless_asked() {
         assert!(svg.is_file());
         std::fs::remove_file(&svg).unwrap();
     }
-    assert_exit(&run_cli(&["plot-sweep", s(f.file(Kind::Results)), "--out", s(&svg)]), 0, &[]);
+    assert_exit(
+        &run_cli(&["plot-sweep", s(f.file(Kind::Results)), "--out", s(&svg)]),
+        0,
+        &[],
+    );
 }
 
 /// A `--cache` that is a file is refused before any training, with exit 2.
@@ -531,7 +595,11 @@ fn a_bad_cache_is_refused_before_any_training() {
     let out = f.path("c.jsonl");
     let seeds = ["--train-seeds", "1..2", "--train-episodes", "50", "--cache", s(cache)];
     let batch = run_cli(
-        &[&["batch", &f.p("tiny.ron"), "--episodes", "1", "--out", s(&out)], &seeds[..]].concat(),
+        &[
+            &["batch", &f.p("tiny.ron"), "--episodes", "1", "--out", s(&out)],
+            &seeds[..],
+        ]
+        .concat(),
     );
     assert_exit(&batch, 2, &["--cache", "map.ron"]);
     assert!(!output_text(&batch).contains("training"), "{}", output_text(&batch));
@@ -539,7 +607,13 @@ fn a_bad_cache_is_refused_before_any_training() {
     let o = f.path("cmp");
     let compare = run_cli(
         &[
-            &["compare", "--train-map", &f.p("tiny.ron"), "--test-map", &f.p("tiny.ron")],
+            &[
+                "compare",
+                "--train-map",
+                &f.p("tiny.ron"),
+                "--test-map",
+                &f.p("tiny.ron"),
+            ],
             &seeds[..],
             &["--episodes", "1", "--protocol", "zero-shot", "--out", s(&o)],
         ]
@@ -547,7 +621,10 @@ fn a_bad_cache_is_refused_before_any_training() {
     );
     assert_exit(&compare, 2, &["--cache", "map.ron"]);
     assert!(!output_text(&compare).contains("training"), "{}", output_text(&compare));
-    assert_eq!(std::fs::read(cache).unwrap(), std::fs::read("maps/jaywalk.ron").unwrap());
+    assert_eq!(
+        std::fs::read(cache).unwrap(),
+        std::fs::read("maps/jaywalk.ron").unwrap()
+    );
 }
 
 /// A map whose name is 70,000 characters long is refused at load (check-map, batch,
@@ -563,7 +640,17 @@ fn long_names_are_refused_at_load_and_tables_never_panic() {
     std::fs::write(&agent, tiny_agent_text()).unwrap();
     assert_exit(&run_cli(&["check-map", s(&map)]), 2, &["name", "long.ron"]);
     let out = d.path().join("r.jsonl");
-    let b = run_cli(&["batch", s(&map), "--method", "never-brake", "--episodes", "1", "-q", "--out", s(&out)]);
+    let b = run_cli(&[
+        "batch",
+        s(&map),
+        "--method",
+        "never-brake",
+        "--episodes",
+        "1",
+        "-q",
+        "--out",
+        s(&out),
+    ]);
     assert_exit(&b, 2, &["name", "long.ron"]);
     assert!(!out.exists(), "refused before writing");
     let c = run_cli(&[
@@ -595,7 +682,12 @@ fn long_names_are_refused_at_load_and_tables_never_panic() {
         "--out",
         s(&d.path().join("o.jsonl")),
     ]);
-    assert!(matches!(b.status.code(), Some(0..=2)), "exit {:?}: {}", b.status.code(), output_text(&b));
+    assert!(
+        matches!(b.status.code(), Some(0..=2)),
+        "exit {:?}: {}",
+        b.status.code(),
+        output_text(&b)
+    );
     assert!(!output_text(&b).contains("panicked"), "{}", output_text(&b));
 }
 
@@ -627,7 +719,8 @@ fn inspect_refuses_a_pipe_and_a_device() {
     let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
     assert!(made.success());
     for model in [s(&fifo), "/dev/zero"] {
-        let r = run_within(&["inspect", "--model", model], 30).unwrap_or_else(|| panic!("inspect --model {model} never ended"));
+        let r = run_within(&["inspect", "--model", model], 30)
+            .unwrap_or_else(|| panic!("inspect --model {model} never ended"));
         assert_exit(&r, 2, &[model, "not a regular file"]);
     }
 }
@@ -639,7 +732,17 @@ fn trace_episode_with_a_sign_is_refused() {
     std::fs::write(&map, TINY_MAP).unwrap();
     std::fs::write(&agent, tiny_agent_text()).unwrap();
     let out = d.path().join("t");
-    let r = run_cli(&["trace", "--episode", "+5", "--map", s(&map), "--agent", s(&agent), "--out", s(&out)]);
+    let r = run_cli(&[
+        "trace",
+        "--episode",
+        "+5",
+        "--map",
+        s(&map),
+        "--agent",
+        s(&agent),
+        "--out",
+        s(&out),
+    ]);
     assert_exit(&r, 2, &["--episode"]);
     assert!(!out.exists());
 }

@@ -14,6 +14,7 @@
 pub mod batch;
 pub mod compare;
 pub mod evaluate;
+pub mod file_kinds;
 pub mod learn;
 pub mod merge;
 pub mod outputs;

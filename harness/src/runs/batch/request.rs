@@ -271,7 +271,12 @@ impl<'a> AgentFields<'a> {
             (None, None) => None,
         };
         match (self.train_seeds, given, scripted) {
-            (Some(seeds), _, _) => trained(seeds.0.clone(), self.cache.cloned()),
+            (Some(seeds), _, _) => {
+                if let Some(dir) = self.cache {
+                    crate::training::seed_agents::check_cache(dir)?;
+                }
+                trained(seeds.0.clone(), self.cache.cloned())
+            }
             (None, Some(bundle), _) => {
                 let identity = agent_file_identity(&bundle);
                 let agent = Agent::from_bundle(bundle);
