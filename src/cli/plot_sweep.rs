@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use unforeseen_harness::error::Error;
 use unforeseen_harness::reports::figures::{Series, line_panels};
 use unforeseen_harness::runs::batch::{ResultLine, read_results};
+use unforeseen_harness::runs::outputs::Own;
 
 /// Arguments of `plot-sweep`.
 #[derive(Debug, Clone, Args)]
@@ -19,6 +20,10 @@ pub struct PlotSweepArgs {
     /// Output SVG.
     #[arg(long, value_name = "FILE", default_value = "sweep.svg")]
     pub out: PathBuf,
+    /// Replace --out even when it holds something other than an SVG figure; without it such a
+    /// file is refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// One series before plotting: key label, colour, points.
@@ -90,6 +95,8 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
     super::outputs::file(
         "--out",
         &args.out,
+        Own::Svg,
+        args.force,
         unforeseen_harness::runs::outputs::Outputs::new().input("RESULTS.jsonl", &args.results),
     )?;
     let lines = checked_lines(&args.results)?;

@@ -38,6 +38,11 @@ pub struct TraceArgs {
     /// continual (after learning from the episodes before it).
     #[arg(long, default_value_t = Protocol::ZeroShot, value_parser = super::protocol_parser())]
     pub protocol: Protocol,
+    /// Replace an output that holds something other than what this command writes there
+    /// (a map, an agent file, another command's results); without it such a file is
+    /// refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -47,6 +52,7 @@ impl TraceArgs {
     /// The library's request of these arguments ([`TraceRequest`]).
     pub fn request(&self) -> TraceRequest {
         TraceRequest {
+            force: self.force,
             map: self.map.clone(),
             method: self.method,
             episode: self.episode,

@@ -139,7 +139,8 @@ fn json_kind(path: &Path, body: &str) -> Held {
     if first.starts_with("{\"search\":") {
         return Held::Candidates;
     }
-    if serde_json::from_str::<crate::runs::batch::ResultLine>(first).is_ok() {
+    if first.starts_with("{\"unit\":") && serde_json::from_str::<serde_json::Value>(first).is_ok_and(|v| v.is_object())
+    {
         return Held::ResultLines;
     }
     let len = std::fs::metadata(path).map_or(u64::MAX, |m| m.len());

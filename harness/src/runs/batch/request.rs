@@ -362,7 +362,7 @@ impl BatchRequest {
             plan,
             out: self.out.clone(),
             shard: self.shard,
-            _guard: guard,
+            guard,
         })
     }
 }
@@ -396,7 +396,9 @@ pub struct BatchJob {
     pub out: PathBuf,
     /// The shard run.
     pub shard: Option<Shard>,
-    _guard: Guarded,
+    /// The output guard, held while the job lives; [`BatchJob::run`] clears the summary
+    /// of an earlier run once every check has passed.
+    guard: Guarded,
 }
 
 /// Worker threads for a run, bounded by memory ([`BatchJob::workers`]).
@@ -467,6 +469,7 @@ impl BatchJob {
     /// threads ([`BatchJob::workers`]), streaming each line to the results file, then
     /// writes the summary beside it. One phase of `progress`.
     pub fn run(&self, agents: &[Agent], jobs: usize, progress: &dyn Progress) -> Result<BatchReport, Error> {
+        self.guard.clear_at_end()?;
         let cfg = self.setup.config(agents, jobs, self.shard);
         let lines = run_plan(&cfg, &self.plan, &self.out, progress)?;
         let rows = summarize(&lines);
