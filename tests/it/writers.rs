@@ -669,12 +669,16 @@ fn long_names_are_refused_at_load_and_tables_never_panic() {
     ]);
     assert_exit(&c, 2, &["name", "long.ron"]);
     assert!(!d.path().join("c").exists(), "refused before writing");
-    let omega = format!("omega=0.{}", "0".repeat(100_000));
+    let omega = format!("omega=1.{}", "0".repeat(100_000));
+    let tiny = d.path().join("tiny.ron");
+    std::fs::write(&tiny, TINY_MAP).unwrap();
     let b = run_cli(&[
         "batch",
-        "jaywalk",
+        s(&tiny),
+        "--agent",
+        s(&agent),
         "--method",
-        "never-brake",
+        "scaled",
         "--episodes",
         "1",
         "-q",
