@@ -143,7 +143,10 @@ impl Foreign {
         let mut a: Vec<String> = ["batch", &self.p("tiny.ron"), "--agent", &self.p("agent.ron")]
             .map(String::from)
             .to_vec();
-        a.extend(["--seed", "5", "--jobs", "1", "--quiet", "--out", s(out)].map(String::from));
+        a.extend(["--jobs", "1", "--quiet", "--out", s(out)].map(String::from));
+        if !extra.contains(&"--seed") {
+            a.extend(["--seed".into(), "5".into()]);
+        }
         if !extra.contains(&"--episodes") {
             a.extend(["--episodes".into(), "1".into()]);
         }
@@ -750,4 +753,164 @@ fn trace_episode_with_a_sign_is_refused() {
     ]);
     assert_exit(&r, 2, &["--episode"]);
     assert!(!out.exists());
+}
+
+/// The files of an output set in `dirs` (hidden files and locks aside), by name.
+fn set_files(dirs: &[PathBuf]) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let mut all = std::collections::BTreeMap::new();
+    for d in dirs {
+        for (p, bytes) in snapshot(d) {
+            let name = p.strip_prefix(d).unwrap().display().to_string();
+            if !name.starts_with('.') && !name.ends_with("lock") {
+                all.insert(format!("{}/{name}", d.file_name().unwrap().to_string_lossy()), bytes);
+            }
+        }
+    }
+    all
+}
+
+/// Hidden files left in `dirs` (temporaries, journals).
+fn leftovers(dirs: &[PathBuf]) -> Vec<String> {
+    dirs.iter()
+        .filter_map(|d| std::fs::read_dir(d).ok())
+        .flat_map(|r| r.flatten().map(|e| e.file_name().to_string_lossy().into_owned()))
+        .filter(|n| n.starts_with(".unforeseen-") || n.starts_with(".tmp"))
+        .collect()
+}
+
+/// Kills the job `args(seed)` at every rename of its output set in `dirs`, over the set
+/// of an earlier run (seed 7), and finds, once the folders are recovered (what the next
+/// run into them does), the old set or the new set, never a mix, and no temporary left.
+/// A file is "old" when it is the earlier run's and differs from an uninterrupted new
+/// run's; "new" when it differs from the earlier run's. Returns the kills made.
+fn no_kill_mixes_a_set(name: &str, dirs: &[PathBuf], renames: usize, args: &dyn Fn(&str) -> Vec<String>) -> usize {
+    let clean = || {
+        for d in dirs {
+            let _ = std::fs::remove_dir_all(d);
+        }
+    };
+    let exit_ok = |r: &Output| matches!(r.status.code(), Some(0 | 1));
+    clean();
+    let r = run(&args("8"));
+    assert!(exit_ok(&r), "{name}: {}", output_text(&r));
+    let fresh = set_files(dirs);
+    clean();
+    let r = run(&args("7"));
+    assert!(exit_ok(&r), "{name}: {}", output_text(&r));
+    let old = set_files(dirs);
+    assert!(old.len() >= 2, "{name}: {old:?}");
+    let mut kills = 0;
+    for at in 0..renames {
+        // The earlier set back in place.
+        clean();
+        for (f, bytes) in &old {
+            let (top, rest) = f.split_once('/').unwrap();
+            let dir = dirs
+                .iter()
+                .find(|d| d.file_name().unwrap().to_string_lossy() == top)
+                .unwrap();
+            let path = dir.join(rest);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, bytes).unwrap();
+        }
+        let r = std::process::Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+            .args(args("8"))
+            .env("UNFORESEEN_KILL_AT_RENAME", at.to_string())
+            .output()
+            .unwrap();
+        assert_eq!(
+            r.status.code(),
+            None,
+            "{name}: killed before rename {at}: {}",
+            output_text(&r)
+        );
+        for d in dirs {
+            unforeseen_harness::reports::files::recover(d).unwrap();
+        }
+        let now = set_files(dirs);
+        let is_old = |f: &String| now.get(f) == old.get(f) && fresh.get(f) != old.get(f);
+        let is_new = |f: &String| now.get(f) != old.get(f);
+        let olds: Vec<&String> = now.keys().filter(|f| is_old(f)).collect();
+        let news: Vec<&String> = now.keys().filter(|f| is_new(f)).collect();
+        assert!(
+            olds.is_empty() || news.is_empty(),
+            "{name}, killed before rename {at}: a mix: {olds:?} of the earlier run beside {news:?} of the new one"
+        );
+        assert!(
+            leftovers(dirs).is_empty(),
+            "{name}, rename {at}: {:?} left",
+            leftovers(dirs)
+        );
+        kills += 1;
+    }
+    kills
+}
+
+/// Every multi-file job killed before each rename of its set (the `fault-injection`
+/// hook of `reports::files`): compare, learn, trace with --html in another folder,
+/// batch and merge (results and summary), search.
+#[test]
+fn a_kill_between_two_renames_leaves_the_old_set_or_the_new_one() {
+    let f = Foreign::new();
+    let mut kills = 0;
+    let o = f.path("o");
+    let h = f.path("h");
+    let tiny = f.p("tiny.ron");
+    let agent = f.p("agent.ron");
+    let common = |cmd: &str, seed: &str| -> Vec<String> {
+        [cmd, "--agent", &agent, "--seed", seed, "-q", "--out", s(&o)]
+            .map(String::from)
+            .to_vec()
+    };
+    kills += no_kill_mixes_a_set("compare", std::slice::from_ref(&o), 4, &|seed| {
+        let mut a = common("compare", seed);
+        a.extend(
+            [
+                "--train-map",
+                &tiny,
+                "--test-map",
+                &tiny,
+                "--episodes",
+                "2",
+                "--protocol",
+                "zero-shot",
+            ]
+            .map(String::from),
+        );
+        a
+    });
+    kills += no_kill_mixes_a_set("learn", std::slice::from_ref(&o), 3, &|seed| {
+        let mut a = common("learn", seed);
+        a.extend(["--map", &tiny, "--episodes", "3"].map(String::from));
+        a
+    });
+    kills += no_kill_mixes_a_set("trace --html", &[o.clone(), h.clone()], 4, &|seed| {
+        let mut a = common("trace", seed);
+        let page = h.join("page.html");
+        a.extend(["--map".into(), tiny.clone(), "--html".into(), s(&page).into()]);
+        a
+    });
+    let r = f.path("r");
+    let results = r.join("r.jsonl");
+    kills += no_kill_mixes_a_set("batch", std::slice::from_ref(&r), 2, &|seed| {
+        f.batch_args(&results, &["--seed", seed, "--episodes", "2"])
+    });
+    let parts = f.path("parts");
+    std::fs::create_dir_all(&parts).unwrap();
+    for seed in ["7", "8"] {
+        let made = run(&f.batch_args(&parts.join(format!("p{seed}.jsonl")), &["--seed", seed]));
+        assert!(matches!(made.status.code(), Some(0 | 1)), "{}", output_text(&made));
+    }
+    kills += no_kill_mixes_a_set("merge", std::slice::from_ref(&r), 2, &|seed| {
+        ["merge", s(&parts.join(format!("p{seed}.jsonl"))), "--out", s(&results)]
+            .map(String::from)
+            .to_vec()
+    });
+    kills += no_kill_mixes_a_set("search", std::slice::from_ref(&o), 3, &|seed| {
+        let mut a = search_args(&o, &[]);
+        let i = a.iter().position(|x| x == "--seed").unwrap();
+        a[i + 1] = seed.into();
+        a
+    });
+    eprintln!("{kills} kills (job, rename), none left a mix");
 }

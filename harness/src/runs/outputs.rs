@@ -361,6 +361,15 @@ impl Outputs {
         for (_, dir, _) in &self.folders {
             std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
         }
+        // What a killed writer left: its committed set completed, its temporaries removed.
+        let parents = self.files.iter().filter_map(|f| f.path.parent());
+        for dir in self.folders.iter().map(|(_, d, _)| d.as_path()).chain(parents) {
+            crate::reports::files::recover(if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            })?;
+        }
         let at_end = self
             .files
             .iter()

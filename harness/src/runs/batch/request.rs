@@ -29,7 +29,7 @@ use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs, Trai
 use super::identity::{SCRIPTED_ONLY, agent_file_identity, trained_agents_identity};
 use super::plan::{BatchConfig, Plan};
 use super::result_line::ResultLine;
-use super::run::run_plan;
+use super::run::run_plan_then;
 use super::scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};
 use super::summary::{SummaryRow, summarize, summary_path};
 use super::sweep::{ParamSet, checked_sweep};
@@ -471,14 +471,16 @@ impl BatchJob {
     pub fn run(&self, agents: &[Agent], jobs: usize, progress: &dyn Progress) -> Result<BatchReport, Error> {
         self.guard.clear_at_end()?;
         let cfg = self.setup.config(agents, jobs, self.shard);
-        let lines = run_plan(&cfg, &self.plan, &self.out, progress)?;
-        let rows = summarize(&lines);
         let summary = summary_path(&self.out);
         let shard = self.shard.map(String::from);
-        write_json(
-            &summary,
-            &summary_document(&self.out, shard.as_deref(), &self.plan.identity, &rows),
-        )?;
+        let lines = run_plan_then(&cfg, &self.plan, &self.out, progress, |lines| {
+            let rows = summarize(lines);
+            write_json(
+                &summary,
+                &summary_document(&self.out, shard.as_deref(), &self.plan.identity, &rows),
+            )
+        })?;
+        let rows = summarize(&lines);
         Ok(BatchReport {
             checked: rows.iter().map(|r| r.checks.len()).sum(),
             failures: crate::reports::tables::expectation_failures(&rows),
