@@ -1,7 +1,7 @@
 //! The agents from Python: training and agent files ([`unforeseen_harness::training`],
 //! [`unforeseen_harness::training::agent_file`]), a controller of every method the command line has
 //! ([`unforeseen_harness::episodes::methods::Method`]) with parameters through `--set`'s path
-//! ([`unforeseen_harness::overrides`]), and the library's evaluation ([`unforeseen_harness::episodes::experiments`]).
+//! ([`unforeseen_harness::overrides`]), and the library's evaluation ([`unforeseen_harness::episodes::evaluation`]).
 
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -367,14 +367,14 @@ impl PyController {
 /// `(world, controller)` seeds of evaluation episode `episode` of the method named
 /// `method` on `map`, as `unforeseen eval` uses them: a built-in method's, or a Python
 /// policy's under the name its lines carry
-/// ([`unforeseen_harness::episodes::experiments::eval_seeds_named`]).
+/// ([`unforeseen_harness::episodes::evaluation::eval_seeds_named`]).
 #[pyfunction]
 fn eval_seeds(seed: u64, map: &str, method: &str, episode: u64) -> PyResult<(u64, u64)> {
     if method.is_empty() {
         return Err(errors::value("method: give a method's name, e.g. 'scaled'"));
     }
     let map = crate::maps::load(map, None)?;
-    let s = unforeseen_harness::episodes::experiments::eval_seeds_named(seed, &map, method, episode);
+    let s = unforeseen_harness::episodes::evaluation::eval_seeds_named(seed, &map, method, episode);
     Ok((s.world, s.controller))
 }
 
@@ -386,7 +386,7 @@ fn eval_seeds(seed: u64, map: &str, method: &str, episode: u64) -> PyResult<(u64
 #[pyfunction]
 #[pyo3(signature = (request, agent = None))]
 fn evaluate(py: Python<'_>, request: &str, agent: Option<&PyAgent>) -> PyResult<EvalResult> {
-    let request: EvalRequest = crate::units::request(request)?;
+    let request: EvalRequest = crate::requests::request(request)?;
     let given = agent.map(|a| a.bundle.clone());
     let outcome = crate::interrupt::interruptible(py, |progress| {
         let job = request.plan(given)?;

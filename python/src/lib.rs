@@ -29,6 +29,7 @@ mod maps;
 mod policy;
 mod render;
 mod reports;
+mod requests;
 mod results;
 mod search_units;
 mod units;
@@ -61,6 +62,7 @@ fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     reports::register(m)?;
     wrapper::register(m)?;
     policy::register(m)?;
+    requests::register(m)?;
     units::register(m)?;
     search_units::register(m)?;
     Ok(())

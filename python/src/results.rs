@@ -38,7 +38,7 @@ fn agents_of(agents: &Bound<'_, PyAny>) -> PyResult<Vec<Agent>> {
 #[pyfunction]
 #[pyo3(signature = (request, agents = None))]
 fn compare(py: Python<'_>, request: &str, agents: Option<&Bound<'_, PyAny>>) -> PyResult<CompareResult> {
-    let request: CompareRequest = crate::units::request(request)?;
+    let request: CompareRequest = crate::requests::request(request)?;
     let given = match agents {
         Some(a) => agents_of(a)?,
         None => Vec::new(),
@@ -62,7 +62,7 @@ fn compare(py: Python<'_>, request: &str, agents: Option<&Bound<'_, PyAny>>) -> 
 #[pyfunction]
 #[pyo3(signature = (request, agent = None))]
 fn batch(py: Python<'_>, request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<BatchResult> {
-    let request: BatchRequest = crate::units::request(request)?;
+    let request: BatchRequest = crate::requests::request(request)?;
     let given = agent.map(|a| a.bundle.clone());
     let report = crate::interrupt::interruptible(py, |progress| {
         let job = request.plan(given)?;

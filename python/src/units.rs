@@ -31,6 +31,7 @@ use unforeseen_harness::training::{TimeoutAs, TrainConfig};
 use crate::agent::PyAgent;
 use crate::errors;
 use crate::reports::BatchResult;
+use crate::requests::request;
 
 pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
     unforeseen_harness::limits::check_episodes(what, n).map_err(errors::to_py)?;
@@ -49,37 +50,6 @@ fn locate(source: &str) -> String {
             .display()
             .to_string(),
     }
-}
-
-/// The request of a job (`BatchRequest`, `SearchRequest`) from the JSON text of its
-/// fields (Python's keyword arguments); errors name the field
-/// ([`unforeseen_harness::runs::request::from_fields`]).
-pub(crate) fn request<T>(fields: &str) -> PyResult<T>
-where
-    T: serde::Serialize + serde::de::DeserializeOwned + Default,
-{
-    let fields: serde_json::Map<String, Value> =
-        serde_json::from_str(fields).map_err(|e| errors::value(format!("request: not a JSON object ({e})")))?;
-    unforeseen_harness::runs::request::from_fields(fields).map_err(errors::to_py)
-}
-
-/// The fields of the request of `job` (`batch`, `search`, `compare` or `eval`) with
-/// their defaults, as JSON text: what the Python functions of that job take.
-#[pyfunction]
-fn request_defaults(job: &str) -> PyResult<String> {
-    use unforeseen_harness::runs::request::defaults;
-    let defaults = match job {
-        "batch" => defaults::<BatchRequest>(),
-        "search" => defaults::<unforeseen_harness::runs::search::SearchRequest>(),
-        "compare" => defaults::<unforeseen_harness::runs::compare::CompareRequest>(),
-        "eval" => defaults::<unforeseen_harness::runs::evaluate::EvalRequest>(),
-        other => {
-            return Err(errors::value(format!(
-                "job: no request named '{other}'; the jobs are batch, search, compare, eval"
-            )));
-        }
-    };
-    Ok(defaults.map_err(errors::to_py)?.to_string())
 }
 
 /// Plans the batch `request` (JSON text of its fields) as `unforeseen batch` does (the
@@ -121,7 +91,7 @@ fn plan_batch(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<Stri
         "head": head,
         "total": plan.units.len(),
         "kept": plan.kept.len(),
-        "summary": unforeseen_harness::runs::batch::summary_path(&request.out),
+        "summary": unforeseen_harness::runs::outputs::summary_path(&request.out),
         "todo": todo.iter().map(|u| u.index).collect::<Vec<_>>(),
         "todo_seeds": todo.iter().map(|u| u.train_seed).collect::<Vec<_>>(),
         "train_seeds_to_run": job.to_train(),
@@ -177,7 +147,7 @@ static PARSED: Mutex<Option<HashMap<String, Agent>>> = Mutex::new(None);
 const MAX_PARSED: usize = 16;
 
 pub(crate) fn parse_agent(text: &[u8]) -> PyResult<Agent> {
-    let key = unforeseen_harness::seeds::content_hash(text);
+    let key = unforeseen_env::seeds::content_hash(text);
     let mut parsed = PARSED.lock().unwrap_or_else(|e| e.into_inner());
     let map = parsed.get_or_insert_with(HashMap::new);
     if let Some(a) = map.get(&key) {
@@ -313,7 +283,6 @@ fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<BatchResult> {
 
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(plan_batch, m)?)?;
     m.add_function(wrap_pyfunction!(train_agent, m)?)?;
     m.add_function(wrap_pyfunction!(run_units, m)?)?;

@@ -12,7 +12,7 @@ use unforeseen_harness::runs::outputs::Own;
 
 use super::AgentArgs;
 use unforeseen_harness::error::Error;
-use unforeseen_harness::reports::files::write_json;
+use unforeseen_harness::files::write_json;
 
 /// Arguments of `export-model`.
 #[derive(Debug, Clone, Args)]

@@ -114,7 +114,7 @@ impl Foreign {
             (Kind::Space, copy("space.ron", SPACE)),
             (Kind::Agent, f.path("agent.ron")),
             (Kind::Results, results.clone()),
-            (Kind::Summary, unforeseen_harness::runs::batch::summary_path(&results)),
+            (Kind::Summary, unforeseen_harness::runs::outputs::summary_path(&results)),
             (Kind::Candidates, search.join("candidates.jsonl")),
             (Kind::Model, model),
             (Kind::Stream, copy("stream.ron", "maps/streams/deployment.ron")),
@@ -377,7 +377,7 @@ fn place(w: &Writer, scratch: &Path, name: &str) -> (PathBuf, PathBuf) {
         let target = if name.is_empty() {
             out.clone()
         } else {
-            unforeseen_harness::runs::batch::summary_path(&out)
+            unforeseen_harness::runs::outputs::summary_path(&out)
         };
         (out, target)
     }
@@ -492,7 +492,7 @@ fn a_refused_batch_resume_keeps_the_earlier_summary() {
     let out = dir.join("r.jsonl");
     let first = run(&f.batch_args(&out, &["--episodes", "2"]));
     assert!(matches!(first.status.code(), Some(0 | 1)), "{}", output_text(&first));
-    assert!(unforeseen_harness::runs::batch::summary_path(&out).is_file());
+    assert!(unforeseen_harness::runs::outputs::summary_path(&out).is_file());
     let before = snapshot(&dir);
     // Another run's settings.
     assert_exit(
@@ -547,7 +547,7 @@ fn a_refused_merge_keeps_the_earlier_merge() {
     };
     let r = merge(&[&parts[0], &parts[1]]);
     assert!(matches!(r.status.code(), Some(0 | 1)), "{}", output_text(&r));
-    assert!(unforeseen_harness::runs::batch::summary_path(&m).is_file());
+    assert!(unforeseen_harness::runs::outputs::summary_path(&m).is_file());
     let before = snapshot(&dir);
     for (what, ps) in [
         ("a gap", vec![parts[0].as_path()]),
@@ -825,7 +825,7 @@ fn no_kill_mixes_a_set(name: &str, dirs: &[PathBuf], renames: usize, args: &dyn 
             output_text(&r)
         );
         for d in dirs {
-            unforeseen_harness::reports::files::recover(d).unwrap();
+            unforeseen_harness::files::recover(d).unwrap();
         }
         let now = set_files(dirs);
         let is_old = |f: &String| now.get(f) == old.get(f) && fresh.get(f) != old.get(f);
@@ -847,7 +847,7 @@ fn no_kill_mixes_a_set(name: &str, dirs: &[PathBuf], renames: usize, args: &dyn 
 }
 
 /// Every multi-file job killed before each rename of its set (the `fault-injection`
-/// hook of `reports::files`): compare, learn, trace with --html in another folder,
+/// hook of `unforeseen_harness::files`): compare, learn, trace with --html in another folder,
 /// batch and merge (results and summary), search.
 #[test]
 fn a_kill_between_two_renames_leaves_the_old_set_or_the_new_one() {

@@ -51,6 +51,11 @@ pub fn file_name(field: &str, name: &str) -> Result<(), String> {
     ))
 }
 
+/// Where the summary of results file `out` goes: `results.jsonl` -> `results.summary.json`.
+pub fn summary_path(out: &Path) -> PathBuf {
+    out.with_extension("summary.json")
+}
+
 /// What a run writes into an output, so that a file holding something else (recognised
 /// by its content: [`Held`]) is refused, unless `force`, instead of being replaced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -172,10 +177,11 @@ impl Outputs {
         self
     }
 
-    /// A stream file given as `flag` and every map file it lists.
-    pub fn stream(mut self, flag: &str, file: &Path, stream: &crate::runs::stream::Stream) -> Outputs {
+    /// A stream file given as `flag` and the map files it lists (`maps`, by position in
+    /// its `maps`; `None` for an embedded map).
+    pub fn stream(mut self, flag: &str, file: &Path, maps: &[Option<PathBuf>]) -> Outputs {
         self.inputs.push((flag.to_string(), file.to_path_buf()));
-        for (i, f) in stream.files.iter().enumerate() {
+        for (i, f) in maps.iter().enumerate() {
             if let Some(f) = f {
                 self.inputs
                     .push((format!("{flag} {} (its maps[{i}])", file.display()), f.clone()));
@@ -207,7 +213,7 @@ impl Outputs {
     pub fn results(flag: &str, out: &Path) -> Outputs {
         Outputs::new().file(flag, out, Own::Results).file_at_end(
             &format!("{flag} (its summary)"),
-            crate::runs::batch::summary_path(out),
+            summary_path(out),
             Own::BatchSummary,
         )
     }
@@ -364,7 +370,7 @@ impl Outputs {
         // What a killed writer left: its committed set completed, its temporaries removed.
         let parents = self.files.iter().filter_map(|f| f.path.parent());
         for dir in self.folders.iter().map(|(_, d, _)| d.as_path()).chain(parents) {
-            crate::reports::files::recover(if dir.as_os_str().is_empty() {
+            crate::files::recover(if dir.as_os_str().is_empty() {
                 Path::new(".")
             } else {
                 dir

@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
 
-use crate::episodes::experiments::{evaluate_scripted, evaluate_under};
+use crate::episodes::evaluation::{evaluate_scripted, evaluate_under};
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::runner::EpisodeResult;
 use crate::error::Error;
@@ -126,7 +126,7 @@ pub fn run_plan(
 }
 
 /// [`run_plan`], with the files `then` writes from the lines (a summary) written as one
-/// set with the rewritten `out` ([`crate::reports::files::all_or_none`]).
+/// set with the rewritten `out` ([`crate::files::all_or_none`]).
 pub fn run_plan_then(
     cfg: &BatchConfig<'_>,
     plan: &Plan,
@@ -141,7 +141,7 @@ pub fn run_plan_then(
     let head: String = std::iter::once(identity.to_line())
         .chain(plan.kept.iter().map(|l| l.raw.clone()))
         .collect();
-    crate::reports::files::write_atomic(out, head.as_bytes())?;
+    crate::files::write_atomic(out, head.as_bytes())?;
     let file = std::fs::OpenOptions::new()
         .append(true)
         .open(out)
@@ -174,8 +174,8 @@ pub fn run_plan_then(
         .chain(lines.iter().map(|l| l.raw.clone()))
         .collect();
     let lines: Vec<ResultLine> = lines.into_iter().map(|l| l.parsed).collect();
-    crate::reports::files::all_or_none(|| {
-        crate::reports::files::write_atomic(out, text.as_bytes())?;
+    crate::files::all_or_none(|| {
+        crate::files::write_atomic(out, text.as_bytes())?;
         then(&lines)
     })?;
     Ok(lines)
