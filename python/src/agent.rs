@@ -185,6 +185,9 @@ fn train_agents(
     let timeout_as = timeout_as
         .parse()
         .map_err(|e: String| errors::value(format!("timeout_as: {e}")))?;
+    if let Some(dir) = &cache {
+        unforeseen_harness::runs::outputs::check_cache(dir).map_err(errors::to_py)?;
+    }
     let map = crate::maps::load(map, None)?;
     let cfg = unforeseen_harness::training::TrainConfig {
         timeout_as,

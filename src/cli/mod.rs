@@ -77,8 +77,8 @@ pub mod train_seeds;
 /// What each command writes by default (`--out` changes it), shown under `--help`.
 const OUTPUTS: &str = "\
 Outputs (default places; --out changes them; a rerun replaces them, with a warning,
-except batch, which replaces its results unless --resume completes them, and refuses
-an --out that is not a results file unless --force; no output may be an input):
+except batch, which replaces its results unless --resume completes them; a file there
+of another kind is refused unless --force; no output may be an input):
   compare       out/compare/: compare.json, compare.csv, compare_seeds.csv, compare.svg
                 (agents trained with --train-seeds are cached in out/agents/)
   train         agent.ron

@@ -407,6 +407,13 @@ impl Guarded {
     }
 }
 
+/// Checks the agent cache folder `dir` (given as `cache`) before any training, as an
+/// output of the run: a folder, or a path where one can be made; not a file (exit 2, or
+/// `ValueError` in Python).
+pub fn check_cache(dir: &Path) -> Result<(), Error> {
+    Outputs::new().place("cache", dir).check(false)
+}
+
 /// The same file: both exist and resolve (links followed) to one path.
 fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {

@@ -194,13 +194,6 @@ fn load_cached(path: &Path, map: &Map, key: &str, progress: &dyn Progress) -> Op
     }
 }
 
-/// Checks the agent cache folder `dir` before any training, as an output of the run
-/// (`cache`): a folder, or a path where one can be made; not a file (exit 2, or
-/// `ValueError` in Python).
-pub fn check_cache(dir: &Path) -> Result<(), Error> {
-    crate::runs::outputs::Outputs::new().place("cache", dir).check(false)
-}
-
 /// Trains one agent per seed on `map` with `base`'s configuration (its seed replaced),
 /// in parallel on the current rayon pool, or loads it from `cache` when a valid copy is
 /// there (and stores fresh ones there, atomically). Agents come back in seed order, and
@@ -214,9 +207,6 @@ pub fn train_agents(
     cache: Option<&Path>,
     progress: &dyn Progress,
 ) -> Result<Vec<Agent>, Error> {
-    if let Some(dir) = cache {
-        check_cache(dir)?;
-    }
     progress.phase(
         &format!("training {} agents", seeds.len()),
         base.episodes * seeds.len() as u64,

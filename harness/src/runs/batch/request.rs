@@ -274,7 +274,7 @@ impl<'a> AgentFields<'a> {
         match (self.train_seeds, given, scripted) {
             (Some(seeds), _, _) => {
                 if let Some(dir) = self.cache {
-                    crate::training::seed_agents::check_cache(dir)?;
+                    crate::runs::outputs::check_cache(dir)?;
                 }
                 trained(seeds.0.clone(), self.cache.cloned())
             }
