@@ -100,7 +100,9 @@ impl ResultsGuard {
     fn new(out: PathBuf, inputs: Vec<PathBuf>, force: bool) -> PyResult<ResultsGuard> {
         let guard = inputs
             .iter()
-            .fold(Outputs::new().file("out", &out, Own::ResultLines), |g, m| g.input("maps", m));
+            .fold(Outputs::new().file("out", &out, Own::ResultLines), |g, m| {
+                g.input("maps", m)
+            });
         let held = guard.guard(force).map_err(errors::to_py)?;
         Ok(ResultsGuard { held: Some(held) })
     }

@@ -238,8 +238,7 @@ fn drive_search(
         }
     };
     let done = interruptible_then(py, on_signal, |cancel| {
-        let summary =
-            unforeseen_harness::runs::search::run_with(
+        let summary = unforeseen_harness::runs::search::run_with(
             &cfg,
             Path::new(&out),
             request.resume,

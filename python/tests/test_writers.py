@@ -115,7 +115,8 @@ def _search(f, out, force):
 #: ".summary.json" beside it; the kind written there, None for one not in HELD)).
 WRITERS = [
     ("Agent.save", _save, False, [("", "agent")]),
-    ("evaluate", _evaluate, False, [("", "results"), (".summary.json", "summary")]),
+    # evaluate appends result lines (its own kind); a batch run's file is refused too (below).
+    ("evaluate", _evaluate, False, [("", "results")]),
     ("batch", _batch, False, [("", "results"), (".summary.json", "summary")]),
     ("evaluate_builtin", _eval_builtin, True, [("eval.json", None)]),
     ("compare", _compare, True, [("compare.json", None), ("compare.csv", None), ("compare_seeds.csv", None),
