@@ -139,7 +139,10 @@ fn json_kind(path: &Path, body: &str) -> Held {
     if first.starts_with("{\"search\":") {
         return Held::Candidates;
     }
-    if first.starts_with("{\"unit\":") && serde_json::from_str::<serde_json::Value>(first).is_ok_and(|v| v.is_object())
+    let has = |v: &serde_json::Value, keys: &[&str]| keys.iter().all(|k| v.get(k).is_some());
+    // A result line, whatever its keys' order and spacing (Python's `json.dumps`).
+    if serde_json::from_str::<serde_json::Value>(first)
+        .is_ok_and(|v| has(&v, &["unit", "scenario", "method", "param_set", "protocol"]))
     {
         return Held::ResultLines;
     }
@@ -151,7 +154,6 @@ fn json_kind(path: &Path, body: &str) -> Held {
     let Some(value) = value else {
         return Held::Text;
     };
-    let has = |v: &serde_json::Value, keys: &[&str]| keys.iter().all(|k| v.get(k).is_some());
     if let Some(first) = value.as_array().and_then(|a| a.first()) {
         return if has(first, &["episode", "inference_rate", "reasoning_ticks"]) {
             Held::LearningCurves
@@ -245,6 +247,8 @@ mod tests {
         assert_eq!(held("// notes\nMap(base: \"x\")"), Held::Map);
         assert_eq!(held("{\"run\":{}}\n"), Held::BatchRun);
         assert_eq!(held("{\"search\":{}}\n"), Held::Candidates);
+        let line = "{\"method\": \"m\", \"param_set\": \"default\", \"protocol\": \"zero-shot\", \"scenario\": \"s\", \"unit\": 0}\n";
+        assert_eq!(held(line), Held::ResultLines);
         assert_eq!(
             held("{\"A\": [], \"B\": [], \"C\": [], \"D\": [], \"policy_len\": 1}"),
             Held::Model
