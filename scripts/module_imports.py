@@ -18,7 +18,7 @@ FLOORS = {'harness': [
     ['maps', 'overrides', 'episodes'],
     ['training'],
     ['reports'],
-    ['runs::outputs'],
+    ['runs::outputs', 'runs::file_kinds'],
     ['runs'],
     ['fixtures'],
 ]}

@@ -1,5 +1,15 @@
 //! Writing results: atomically (temporary file, then rename), so a killed run never
 //! leaves a half-written file behind, and a failed write leaves no temporary file.
+//!
+//! A set of files ([`all_or_none`]) is committed through a journal: every file is written
+//! to a temporary part (`.unforeseen-part-ID-*`), then a journal listing the renames
+//! (`.unforeseen-set-ID.json`, one in each folder of the set) is written and synced (the
+//! commit), then the parts are renamed into place and the journal removed. A kill before
+//! the commit leaves the earlier set and parts that [`recover`] removes; a kill between
+//! two renames leaves a journal that [`recover`] completes, so the set becomes the new
+//! one. The output guard runs [`recover`] in every output folder before a run writes,
+//! and any reader may. Every temporary is locked while its writer lives, so [`recover`]
+//! tells a live writer's files from a dead one's.
 
 use std::collections::BTreeSet;
 use std::io::Write;
@@ -59,16 +69,21 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         _ => Path::new("."),
     };
     std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
+    recover(dir)?;
     let result = (|| -> std::io::Result<()> {
+        let prefix = STAGED.with_borrow(|s| s.as_ref().map(|(id, _)| format!("{PART_PREFIX}{id}-")));
         let mut builder = tempfile::Builder::new();
+        builder.prefix(prefix.as_deref().unwrap_or(TEMP_PREFIX));
         #[cfg(unix)]
         builder.permissions(new_file_permissions(path));
         let mut tmp = builder.tempfile_in(dir)?;
         let _registered = Registered::new(tmp.path());
+        // Held while the writer lives: `recover` leaves a locked temporary alone.
+        let _ = tmp.as_file().try_lock();
         tmp.write_all(bytes)?;
         tmp.as_file().sync_all()?;
         let tmp = match STAGED.with_borrow_mut(|staged| match staged {
-            Some(list) => {
+            Some((_, list)) => {
                 list.push((tmp, path.to_path_buf(), _registered));
                 None
             }
@@ -100,34 +115,210 @@ fn new_file_permissions(path: &Path) -> std::fs::Permissions {
 /// A staged write: the temporary file, where it goes, its registration.
 type Staged = (tempfile::NamedTempFile, PathBuf, Registered);
 
+/// Name prefix of a single file's temporary.
+const TEMP_PREFIX: &str = ".unforeseen-tmp-";
+/// Name prefix of a set's parts (`.unforeseen-part-ID-*`).
+const PART_PREFIX: &str = ".unforeseen-part-";
+/// Name prefix of a set's journal (`.unforeseen-set-ID.json`).
+const JOURNAL_PREFIX: &str = ".unforeseen-set-";
+
 std::thread_local! {
-    /// The writes [`all_or_none`] holds back on this thread until its closure succeeds.
-    static STAGED: std::cell::RefCell<Option<Vec<Staged>>> = const { std::cell::RefCell::new(None) };
+    /// The set [`all_or_none`] is writing on this thread (its id) and the writes it
+    /// holds back until its closure succeeds.
+    static STAGED: std::cell::RefCell<Option<(String, Vec<Staged>)>> = const { std::cell::RefCell::new(None) };
+}
+
+/// A set's journal: the renames that make it, part to file (absolute paths).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Journal {
+    renames: Vec<(PathBuf, PathBuf)>,
+}
+
+/// A fresh id for a set (process, time and a counter: unique among the writers of a
+/// folder, which the lock makes one at a time).
+fn set_id() -> String {
+    static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let t = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    format!("{:x}{:x}{n:x}", std::process::id(), t % (1 << 40))
+}
+
+/// The folder a file is written in (`.` for a bare name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
 }
 
 /// Runs `write` (which writes files with [`write_atomic`] on this thread) so that its
-/// files appear together: each is written to a temporary file first, and only when
-/// `write` succeeds are they all renamed into place; when it fails (a full disk) every
-/// temporary is removed and the previous files stay as they were, never a mix of old and
-/// new outputs.
+/// files appear together: each is written to a temporary part first, and only when
+/// `write` succeeds are they committed (module docs: a journal, then the renames); when
+/// it fails (a full disk) every part is removed and the previous files stay as they
+/// were, never a mix of old and new outputs.
 pub fn all_or_none<T, E: From<Error>>(write: impl FnOnce() -> Result<T, E>) -> Result<T, E> {
-    let outer = STAGED.with_borrow_mut(|s| s.replace(Vec::new()));
+    let outer = STAGED.with_borrow_mut(|s| s.replace((set_id(), Vec::new())));
     let result = write();
-    let staged = STAGED
-        .with_borrow_mut(|s| std::mem::replace(s, outer))
-        .unwrap_or_default();
+    let staged = STAGED.with_borrow_mut(|s| std::mem::replace(s, outer));
     let value = result?;
-    for (tmp, path, _registered) in staged {
-        tmp.persist(&path).map_err(|e| Error::io("write", &path, e.error))?;
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        if let Ok(d) = std::fs::File::open(dir) {
-            let _ = d.sync_all();
-        }
+    if let Some((id, staged)) = staged {
+        commit(&id, staged)?;
     }
     Ok(value)
+}
+
+/// Commits the staged set `id`: the journal in every folder of the set, then the
+/// renames, then the journals removed. Holds [`TEMPORARIES`] throughout, so that SIGINT
+/// or SIGTERM ([`remove_temporaries`]) waits for the set instead of cutting it.
+fn commit(id: &str, staged: Vec<Staged>) -> Result<(), Error> {
+    if staged.is_empty() {
+        return Ok(());
+    }
+    let absolute = |p: &Path| std::path::absolute(p).map_err(|e| Error::io("resolve", p, e));
+    let mut renames = Vec::new();
+    for (tmp, path, _) in &staged {
+        renames.push((absolute(tmp.path())?, absolute(path)?));
+    }
+    let mut folders: Vec<PathBuf> = renames.iter().map(|(_, p)| folder_of(p).to_path_buf()).collect();
+    folders.sort();
+    folders.dedup();
+    let journal = serde_json::to_vec(&Journal { renames })?;
+    let registry = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+    let mut journals = Vec::new();
+    for dir in &folders {
+        let path = dir.join(format!("{JOURNAL_PREFIX}{id}.json"));
+        let written = (|| -> std::io::Result<std::fs::File> {
+            let mut f = std::fs::File::create(&path)?;
+            let _ = f.try_lock();
+            f.write_all(&journal)?;
+            f.sync_all()?;
+            sync_folder(dir);
+            Ok(f)
+        })();
+        match written {
+            Ok(f) => journals.push((path, f)),
+            Err(e) => {
+                // Not committed: no rename was made; the earlier set stays.
+                let _ = std::fs::remove_file(&path);
+                for (p, _) in &journals {
+                    let _ = std::fs::remove_file(p);
+                }
+                return Err(Error::io("write", &path, e));
+            }
+        }
+    }
+    // Committed: from here the parts belong to the journal (a failed rename leaves them
+    // for `recover` to complete the set), so dropping them removes nothing. No early
+    // return while `registry` is held: a registration's drop takes that lock too.
+    let mut registered = Vec::new();
+    let mut parts = Vec::new();
+    for (tmp, path, reg) in staged {
+        parts.push((tmp.into_temp_path(), path));
+        registered.push(reg);
+    }
+    let renamed = parts.iter().enumerate().try_for_each(|(done, (part, path))| {
+        fault::before_rename(done);
+        std::fs::rename(part, path).map_err(|e| Error::io("write", path, e))
+    });
+    if renamed.is_ok() {
+        for dir in &folders {
+            sync_folder(dir);
+        }
+        for (p, _) in &journals {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+    for (part, _) in parts {
+        // Renamed (nothing to remove), or the journal's to complete.
+        let _ = part.keep();
+    }
+    drop(journals);
+    drop(registry);
+    drop(registered);
+    renamed
+}
+
+/// Makes the renames in `dir` durable (a folder can be opened and synced on Unix;
+/// elsewhere this is best effort).
+fn sync_folder(dir: &Path) {
+    if let Ok(d) = std::fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+}
+
+/// Finishes or undoes what a killed writer left in `dir`: completes every set whose
+/// journal is there (its remaining parts renamed into place, the set becoming the new
+/// one), then removes the temporaries and uncommitted parts no live writer holds. The
+/// output guard calls it in every output folder before a run writes.
+pub fn recover(dir: &Path) -> Result<(), Error> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    let mut names: Vec<String> = entries
+        .flatten()
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|n| n.starts_with(".unforeseen-"))
+        .collect();
+    names.sort();
+    // Only a writer that is gone released its lock.
+    let unheld = |p: &Path| std::fs::File::open(p).is_ok_and(|f| f.try_lock().is_ok());
+    for name in names.iter().filter(|n| n.starts_with(JOURNAL_PREFIX)) {
+        let path = dir.join(name);
+        if !unheld(&path) {
+            continue;
+        }
+        let text = std::fs::read(&path).map_err(|e| Error::io("read", &path, e))?;
+        if let Ok(journal) = serde_json::from_slice::<Journal>(&text) {
+            let mut folders = Vec::new();
+            for (part, file) in &journal.renames {
+                if part.exists() {
+                    std::fs::rename(part, file).map_err(|e| Error::io("write", file, e))?;
+                }
+                folders.push(folder_of(file).to_path_buf());
+            }
+            folders.dedup();
+            for f in &folders {
+                sync_folder(f);
+                let _ = std::fs::remove_file(f.join(name));
+            }
+        }
+        let _ = std::fs::remove_file(&path);
+    }
+    let committed = |n: &str| {
+        n.strip_prefix(PART_PREFIX)
+            .and_then(|rest| rest.split_once('-'))
+            .is_some_and(|(id, _)| dir.join(format!("{JOURNAL_PREFIX}{id}.json")).exists())
+    };
+    for name in &names {
+        let path = dir.join(name);
+        let leftover = name.starts_with(TEMP_PREFIX) || (name.starts_with(PART_PREFIX) && !committed(name));
+        if leftover && path.is_file() && unheld(&path) {
+            let _ = std::fs::remove_file(&path);
+        }
+    }
+    Ok(())
+}
+
+/// A kill between two renames of a set, for the tests of [`all_or_none`]: with the
+/// `fault-injection` feature (which only the tests enable), the environment variable
+/// `UNFORESEEN_KILL_AT_RENAME=N` aborts the process just before the set's rename `N`
+/// (0-based), as `kill -9` would: no destructor runs, and the journal and the parts not
+/// yet renamed stay on disk.
+mod fault {
+    /// Aborts before rename `done` when asked (see the module docs).
+    #[cfg(feature = "fault-injection")]
+    pub fn before_rename(done: usize) {
+        let at = std::env::var("UNFORESEEN_KILL_AT_RENAME").ok();
+        if at.and_then(|v| v.parse::<usize>().ok()) == Some(done) {
+            std::process::abort();
+        }
+    }
+
+    /// Nothing, without the `fault-injection` feature.
+    #[cfg(not(feature = "fault-injection"))]
+    pub fn before_rename(_done: usize) {}
 }
 
 /// Serializes `value` as pretty JSON to `path`, atomically.

@@ -29,6 +29,38 @@ pub fn check_episodes(field: &str, n: u64) -> Result<u64, Error> {
     }
 }
 
+/// Largest model file `inspect --model` reads (bytes): a single-factor model of at most
+/// 1024 states and 64 actions is far smaller.
+pub const MAX_MODEL_BYTES: u64 = 64 << 20;
+
+/// The text of the model file `path` (`inspect --model`): a regular file (a pipe or a
+/// device such as `/dev/zero` would be read forever) of at most [`MAX_MODEL_BYTES`],
+/// UTF-8 text; else an [`Error::ModelFile`] naming the problem.
+pub fn read_model_file(path: &std::path::Path) -> Result<String, Error> {
+    use std::io::Read;
+    let bad = |problem: String| Error::ModelFile {
+        path: path.to_path_buf(),
+        problem,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| bad(format!("cannot read ({e})")))?;
+    if !meta.is_file() {
+        return Err(bad(
+            "not a regular file (a folder, a pipe, a device); give a model JSON file".into(),
+        ));
+    }
+    let file = std::fs::File::open(path).map_err(|e| bad(format!("cannot read ({e})")))?;
+    let mut bytes = Vec::new();
+    file.take(MAX_MODEL_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| bad(format!("cannot read ({e})")))?;
+    if bytes.len() as u64 > MAX_MODEL_BYTES {
+        return Err(bad(format!(
+            "larger than {MAX_MODEL_BYTES} bytes; a single-factor model is far smaller"
+        )));
+    }
+    String::from_utf8(bytes).map_err(|_| bad("not text (invalid UTF-8); give a model JSON file".into()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -91,8 +91,16 @@ pub struct PyAgent {
 
 #[pymethods]
 impl PyAgent {
-    /// Writes the agent file (atomically), as `unforeseen train --out` does.
-    fn save(&self, path: PathBuf) -> PyResult<()> {
+    /// Writes the agent file (atomically), as `unforeseen train --out` does: a `path`
+    /// that holds something other than an agent file (a map, results) raises
+    /// `ValueError` naming it, unless `force`.
+    #[pyo3(signature = (path, force = false))]
+    fn save(&self, path: PathBuf, force: bool) -> PyResult<()> {
+        use unforeseen_harness::runs::outputs::{Outputs, Own};
+        Outputs::new()
+            .file("path", &path, Own::Agent)
+            .check(force)
+            .map_err(errors::to_py)?;
         unforeseen_harness::training::agent_file::save(&path, &self.bundle).map_err(errors::to_py)
     }
 
@@ -175,6 +183,9 @@ fn train_agents(
     let timeout_as = timeout_as
         .parse()
         .map_err(|e: String| errors::value(format!("timeout_as: {e}")))?;
+    if let Some(dir) = &cache {
+        unforeseen_harness::runs::outputs::check_cache(dir).map_err(errors::to_py)?;
+    }
     let map = crate::maps::load(map, None)?;
     let cfg = unforeseen_harness::training::TrainConfig {
         timeout_as,

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use pyo3::prelude::*;
 use unforeseen_harness::runs::batch::{BatchRequest, ResultLine};
 use unforeseen_harness::runs::compare::CompareRequest;
-use unforeseen_harness::runs::outputs::{Guarded, Outputs};
+use unforeseen_harness::runs::outputs::{Guarded, Outputs, Own};
 use unforeseen_harness::training::seed_agents::Agent;
 
 use crate::agent::PyAgent;
@@ -85,7 +85,8 @@ fn batch_result(lines: &str) -> PyResult<BatchResult> {
 
 /// The output guard of a results file `out` written from Python (`evaluate`): refuses,
 /// with a `ValueError`, an `out` that is one of `inputs` (map files) or holds something
-/// other than batch results (unless `force`), and holds the lock on it until
+/// other than result lines (a batch run's file, whose first line names its run,
+/// included) unless `force`, and holds the lock on it until
 /// [`ResultsGuard::release`] (or until collected).
 #[pyclass(module = "unforeseen._unforeseen")]
 pub struct ResultsGuard {
@@ -99,7 +100,9 @@ impl ResultsGuard {
     fn new(out: PathBuf, inputs: Vec<PathBuf>, force: bool) -> PyResult<ResultsGuard> {
         let guard = inputs
             .iter()
-            .fold(Outputs::results("out", &out), |g, m| g.input("maps", m));
+            .fold(Outputs::new().file("out", &out, Own::ResultLines), |g, m| {
+                g.input("maps", m)
+            });
         let held = guard.guard(force).map_err(errors::to_py)?;
         Ok(ResultsGuard { held: Some(held) })
     }

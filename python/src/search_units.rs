@@ -238,8 +238,14 @@ fn drive_search(
         }
     };
     let done = interruptible_then(py, on_signal, |cancel| {
-        let summary =
-            unforeseen_harness::runs::search::run_with(&cfg, Path::new(&out), request.resume, cancel, Some(&remote))?;
+        let summary = unforeseen_harness::runs::search::run_with(
+            &cfg,
+            Path::new(&out),
+            request.resume,
+            job.guard(),
+            cancel,
+            Some(&remote),
+        )?;
         Ok(serde_json::to_string(&summary)?)
     });
     // The error `evaluate` raised as is (not the search's report of it), unless a signal

@@ -91,6 +91,7 @@ fn plan_batch(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<Stri
         "head": head,
         "total": plan.units.len(),
         "kept": plan.kept.len(),
+        "summary": unforeseen_harness::runs::outputs::summary_path(&request.out),
         "todo": todo.iter().map(|u| u.index).collect::<Vec<_>>(),
         "todo_seeds": todo.iter().map(|u| u.train_seed).collect::<Vec<_>>(),
         "train_seeds_to_run": job.to_train(),

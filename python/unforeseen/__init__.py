@@ -131,6 +131,7 @@ def evaluate_builtin(
     seed: int = 7,
     out: str | os.PathLike[str] | None = "out/eval",
     agent: str | os.PathLike[str] | Agent | None = None,
+    force: bool = False,
 ) -> EvalResult:
     """``unforeseen eval`` in this process: the same request, planned and run by the
     library as the command line runs it, writing the same ``eval.json`` into ``out``
@@ -140,7 +141,8 @@ def evaluate_builtin(
     (``"KEY=VALUE"`` each, the ``--set`` keys). ``agent`` is an agent file or an
     :class:`Agent`; without one, a method that needs an agent trains one on
     ``intersection`` with ``seed`` (scripted references need none). A bad argument
-    raises ``ValueError`` naming it. Returns an :class:`EvalResult`: ``print(result)``
+    raises ``ValueError`` naming it, and so does a file in ``out`` that is not an
+    earlier ``eval.json`` (unless ``force``). Returns an :class:`EvalResult`: ``print(result)``
     gives the line ``eval`` prints, ``result["aggregate"]`` and ``result["episodes"]``
     (or ``to_dict()``) eval.json's data, and ``to_pandas()`` one row per episode."""
     fields = dict(locals())
@@ -184,6 +186,7 @@ def compare(
     train_seeds: Iterable[int] | str | None = None,
     timeout_as: str = "truncation",
     cache: str | os.PathLike[str] | None = "out/agents",
+    force: bool = False,
 ) -> CompareResult:
     """``unforeseen compare`` in this process: the paper's table (§VI), the same request
     planned, trained and run by the library as the command line runs it, writing the
@@ -196,7 +199,8 @@ def compare(
     ``test_map`` for ``episodes`` episodes per method under ``protocol``
     (``"zero-shot"``, ``"continual"`` or ``"both"``), with the ablations when
     ``ablations``, and the scaled agent's overrides ``sets`` (``"KEY=VALUE"`` each). A
-    bad argument raises ``ValueError`` naming it. Returns a :class:`CompareResult`:
+    bad argument raises ``ValueError`` naming it, and so does a file in ``out`` that is
+    not one of an earlier comparison's (unless ``force``). Returns a :class:`CompareResult`:
     ``print(result)`` gives the tables ``compare`` prints, ``result["tables"]`` (or
     ``to_dict()``) compare.json's data, and ``to_pandas()`` one row per (protocol,
     method)."""

@@ -307,6 +307,9 @@ def run_batch(
     ray = _ray()
     lock = _lock(out)
     try:
+        # Every check has passed (the plan's, Ray's import): the earlier run's summary
+        # goes, so it never describes this run's lines.
+        Path(plan["summary"]).unlink(missing_ok=True)
         _write_atomic(out, plan["head"])
         _connect(ray, address)
         options = _task_options(max_retries)

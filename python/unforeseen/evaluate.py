@@ -144,8 +144,8 @@ def evaluate(
     for the summary table ``unforeseen batch`` prints); with ``out``, appends them to that JSON Lines
     file (one line per unit as it finishes), beside the lines of other methods. ``out``
     is checked first as ``unforeseen batch --out`` is: a ``ValueError`` if it is one of
-    the map files, if it holds something other than batch results (unless ``force``:
-    then it is replaced), if it already holds a line of the same map, method, protocol
+    the map files, if it holds something other than result lines (a batch run's file,
+    whose first line names its run, included; unless ``force``: then it is replaced), if it already holds a line of the same map, method, protocol
     and training seed (a second call would count it twice), or if another run is writing
     it.
 
@@ -178,11 +178,16 @@ def evaluate(
     unit = 0
     guard = None
     if out is not None:
+        # Every check before the file is touched: the maps load, the guard passes, no
+        # line would be counted twice; only then does force=True empty it.
+        for m in maps:
+            _source(m)
         files = [m for m in maps if os.path.exists(m)]
         guard = _unforeseen.ResultsGuard(os.fspath(out), files, force=force)
         if force:
             open(out, "w").close()
-        _refuse_repeats(out, maps, seeds, method or getattr(policy, "method", None), guard)
+        else:
+            _refuse_repeats(out, maps, seeds, method or getattr(policy, "method", None), guard)
     fh = open(out, "a", encoding="utf-8") if out is not None else None
     try:
         for m in maps:

@@ -36,6 +36,11 @@ pub const MAX_PEDESTRIANS: f64 = 100.0;
 /// action, about 370 bytes x N² per trained agent (400 MB at 1024 states). Equal to
 /// the agent crate's `limits::MAX_STATES`.
 pub const MAX_JOINT_STATES: usize = 1024;
+/// Longest map name, characters: a name is printed in tables and logs and becomes
+/// part of a file name (a search's failure maps).
+pub const MAX_NAME_CHARS: usize = 128;
+/// Longest map description, characters (printed in `check-map`'s summary).
+pub const MAX_DESCRIPTION_CHARS: usize = 4096;
 /// Decision interval range, s.
 pub const DECISION_DT: (f64, f64) = (0.05, 60.0);
 /// Physics rate range, Hz.
@@ -195,8 +200,18 @@ fn short(v: f64) -> String {
 /// All rule violations of `map` (empty when it is valid).
 pub(crate) fn validate(map: &Map) -> Vec<Problem> {
     let mut c = Check { out: Vec::new() };
-    for (path, text) in [("name", &map.name), ("description", &map.description)] {
-        if text.chars().any(char::is_control) {
+    for (path, text, most) in [
+        ("name", &map.name, MAX_NAME_CHARS),
+        ("description", &map.description, MAX_DESCRIPTION_CHARS),
+    ] {
+        let chars = text.chars().count();
+        if chars > most {
+            c.fail(
+                path,
+                format!("is {chars} characters long (at most {most})"),
+                "names and descriptions are printed in tables and logs: shorten it",
+            );
+        } else if text.chars().any(char::is_control) {
             c.fail(
                 path,
                 format!("contains a control character ({text:?})"),

@@ -43,6 +43,11 @@ pub struct CompareArgs {
     /// Training seeds and the agent cache.
     #[command(flatten)]
     pub seeds: TrainSeedArgs,
+    /// Replace an output that holds something other than what this command writes there
+    /// (a map, an agent file, another command's results); without it such a file is
+    /// refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -65,6 +70,7 @@ impl CompareArgs {
     /// The library's request of these arguments ([`CompareRequest`]).
     pub fn request(&self) -> CompareRequest {
         CompareRequest {
+            force: self.force,
             train_map: self.train_map.clone(),
             test_map: self.test_map.clone(),
             train_episodes: self.train_episodes,

@@ -37,6 +37,11 @@ pub struct EvalArgs {
     /// `--map`, and report per map within the stream.
     #[arg(long, value_name = "FILE", conflicts_with = "map")]
     pub stream: Option<PathBuf>,
+    /// Replace an output that holds something other than what this command writes there
+    /// (a map, an agent file, another command's results); without it such a file is
+    /// refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -46,6 +51,7 @@ impl EvalArgs {
     /// The library's request of these arguments ([`EvalRequest`]).
     pub fn request(&self) -> EvalRequest {
         EvalRequest {
+            force: self.force,
             map: self.map.clone(),
             stream: self.stream.clone(),
             method: self.method,

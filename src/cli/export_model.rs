@@ -8,6 +8,7 @@
 use clap::Args;
 use std::path::PathBuf;
 use unforeseen_agent::inspect::InspectModel;
+use unforeseen_harness::runs::outputs::Own;
 
 use super::AgentArgs;
 use unforeseen_harness::error::Error;
@@ -23,6 +24,10 @@ pub struct ExportModelArgs {
     /// Output file.
     #[arg(long, default_value = "out/model.json", value_name = "FILE.json")]
     pub out: PathBuf,
+    /// Replace --out even when it holds something other than a planning model (JSON); without it such a
+    /// file is refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
     /// Trained agent; `--set horizon=H --set gamma=G` choose the exported policy length
     /// and precision.
     #[command(flatten)]
@@ -32,7 +37,7 @@ pub struct ExportModelArgs {
 /// Runs `export-model`: writes A, the planning B (terminal states absorbing), C, D, the
 /// observation, the horizon and γ of the scaled agent's parameters.
 pub fn run(args: ExportModelArgs) -> anyhow::Result<()> {
-    super::outputs::file("--out", &args.out, args.agent.inputs())?;
+    super::outputs::file("--out", &args.out, Own::Model, args.force, args.agent.inputs())?;
     let params = args.agent.params()?;
     let values: Vec<usize> = args
         .obs

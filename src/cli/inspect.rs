@@ -16,10 +16,7 @@ pub struct InspectArgs {
 
 /// Runs `inspect`, printing the report as JSON on stdout.
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(&args.model).map_err(|e| Error::ModelFile {
-        path: args.model.clone(),
-        problem: format!("cannot read ({e})"),
-    })?;
+    let text = unforeseen_harness::limits::read_model_file(&args.model)?;
     let out = unforeseen_agent::inspect::inspect_json(&text).map_err(|e| Error::ModelFile {
         path: args.model.clone(),
         problem: e.to_string(),

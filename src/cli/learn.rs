@@ -29,6 +29,11 @@ pub struct LearnArgs {
     /// gives the figures per map.
     #[arg(long, value_name = "FILE", conflicts_with = "map")]
     pub stream: Option<PathBuf>,
+    /// Replace an output that holds something other than what this command writes there
+    /// (a map, an agent file, another command's results); without it such a file is
+    /// refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -38,6 +43,7 @@ impl LearnArgs {
     /// The library's request of these arguments ([`LearnRequest`]).
     pub fn request(&self) -> LearnRequest {
         LearnRequest {
+            force: self.force,
             map: self.map.clone(),
             stream: self.stream.clone(),
             episodes: self.episodes,

@@ -77,8 +77,8 @@ pub mod train_seeds;
 /// What each command writes by default (`--out` changes it), shown under `--help`.
 const OUTPUTS: &str = "\
 Outputs (default places; --out changes them; a rerun replaces them, with a warning,
-except batch, which replaces its results unless --resume completes them, and refuses
-an --out that is not a results file unless --force; no output may be an input):
+except batch, which replaces its results unless --resume completes them; a file there
+of another kind is refused unless --force; no output may be an input):
   compare       out/compare/: compare.json, compare.csv, compare_seeds.csv, compare.svg
                 (agents trained with --train-seeds are cached in out/agents/)
   train         agent.ron
@@ -182,7 +182,7 @@ pub fn error_message(err: &anyhow::Error) -> String {
 
 /// The fields of a request that the output guard names (inputs and outputs), longest
 /// first.
-const GUARDED_FIELDS: [&str; 7] = ["stream", "agent", "space", "maps", "html", "map", "out"];
+const GUARDED_FIELDS: [&str; 8] = ["stream", "agent", "space", "cache", "maps", "html", "map", "out"];
 
 /// A message of the output guard with the fields it names (at its start, in "given as
 /// FIELD" and in "give FIELD ...") spelt as their flags.
@@ -283,7 +283,8 @@ impl AgentArgs {
 }
 
 /// Parses an episode count that may be 0 (`check-map --survivability-episodes`, where 0
-/// turns the check off): a whole number in 0..=MAX_EPISODES.
+/// turns the check off), or an episode's number counted from 0 (`trace --episode`): a
+/// whole number in 0..=MAX_EPISODES, digits only (`+5` is refused).
 pub fn episodes_or_none(s: &str) -> Result<u64, String> {
     if s == "0" { Ok(0) } else { episodes(s) }
 }

@@ -1,7 +1,8 @@
 //! Output paths checked before any work, by the harness's output guard
-//! ([`unforeseen_harness::runs::outputs`]), for the commands whose outputs are plain
-//! files (an agent file, a figure, a trace) replaced whatever they hold; the folders the
-//! writers will create are mentioned on stderr.
+//! ([`unforeseen_harness::runs::outputs`]), for the commands whose output is one file
+//! (an agent file, a model, a figure): replaced when it holds what the command writes,
+//! else refused unless `--force`; the folders the writers will create are mentioned on
+//! stderr.
 
 use std::path::Path;
 
@@ -30,10 +31,11 @@ pub fn creating(flag: &str, top: Option<std::path::PathBuf>) {
 }
 
 /// Checks the output file `out` (given as `out_flag`) before any work: a regular file or
-/// not there yet, in a folder that can hold files, and none of the inputs `guard` holds.
-pub fn file(out_flag: &str, out: &Path, guard: Outputs) -> Result<(), Error> {
-    let guard = guard.file(out_flag, out, Own::Any);
-    guard.check(true)?;
+/// not there yet, in a folder that can hold files, none of the inputs `guard` holds, and
+/// (unless `force`) empty or holding what the command writes (`own`).
+pub fn file(out_flag: &str, out: &Path, own: Own, force: bool, guard: Outputs) -> Result<(), Error> {
+    let guard = guard.file(out_flag, out, own);
+    guard.check(force)?;
     note_created(out_flag, out.parent().unwrap_or(Path::new("")));
     Ok(())
 }

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use unforeseen_harness::error::Error;
 use unforeseen_harness::reports::figures::{Series, line_panels};
 use unforeseen_harness::runs::batch::{ResultLine, read_results};
+use unforeseen_harness::runs::outputs::Own;
 
 /// Arguments of `plot-sweep`.
 #[derive(Debug, Clone, Args)]
@@ -19,6 +20,14 @@ pub struct PlotSweepArgs {
     /// Output SVG.
     #[arg(long, value_name = "FILE", default_value = "sweep.svg")]
     pub out: PathBuf,
+    /// Plot a run that is not whole (a shard, a run cut short), saying which units are
+    /// missing; without it such a file is refused (exit 2), listing them.
+    #[arg(long)]
+    pub partial: bool,
+    /// Replace --out even when it holds something other than an SVG figure; without it such a
+    /// file is refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// One series before plotting: key label, colour, points.
@@ -44,10 +53,12 @@ const COLORS: [RGBColor; 12] = [
 ];
 
 /// The result lines of `path` for one plot: refuses a file holding two runs (two
-/// different `{"run": ...}` identity lines: concatenated results of different runs);
-/// says on stderr how many lines were cut (a last line without its newline, not read)
-/// and how many repeated a unit already read (left out, the first kept).
-fn checked_lines(path: &std::path::Path) -> Result<Vec<ResultLine>, Error> {
+/// different `{"run": ...}` identity lines: concatenated results of different runs),
+/// and, unless `partial`, a file missing units of the run its identity names (a shard,
+/// a cut line), listing them; says on stderr how many lines were cut (a last line
+/// without its newline, not read) and how many repeated a unit already read (left out,
+/// the first kept).
+fn checked_lines(path: &std::path::Path, partial: bool) -> Result<Vec<ResultLine>, Error> {
     let file = read_results(path)?;
     if let Some((first_line, first)) = file.identities.first()
         && let Some((line, other)) = file.identities.iter().find(|(_, id)| id != first)
@@ -82,6 +93,22 @@ fn checked_lines(path: &std::path::Path) -> Result<Vec<ResultLine>, Error> {
             path.display()
         );
     }
+    if let Some((_, identity)) = file.identities.first() {
+        let results_error = |problem: String| Error::Results {
+            path: path.to_path_buf(),
+            problem,
+        };
+        let missing = unforeseen_harness::runs::merge::missing_units(identity, &lines).map_err(results_error)?;
+        if let Some((n, total, text)) = missing {
+            let what = format!("{} of the run's {total} units are missing: {text}", n);
+            if !partial {
+                return Err(results_error(format!(
+                    "{what}; plot the whole run (`unforeseen merge` its shards, or `unforeseen batch --resume`), or add --partial to plot what is there"
+                )));
+            }
+            errln!("warning: {}: --partial: {what}", path.display());
+        }
+    }
     Ok(lines)
 }
 
@@ -90,9 +117,11 @@ pub fn run(args: PlotSweepArgs) -> anyhow::Result<()> {
     super::outputs::file(
         "--out",
         &args.out,
+        Own::Svg,
+        args.force,
         unforeseen_harness::runs::outputs::Outputs::new().input("RESULTS.jsonl", &args.results),
     )?;
-    let lines = checked_lines(&args.results)?;
+    let lines = checked_lines(&args.results, args.partial)?;
     if lines.is_empty() {
         return Err(Error::Results {
             path: args.results.clone(),

@@ -32,12 +32,17 @@ pub struct TraceArgs {
     pub html: Option<PathBuf>,
     /// Evaluation episode to trace (0 = the first). Under `--protocol continual` the agent
     /// first runs and learns from episodes 0..N, as a continual evaluation does.
-    #[arg(long, default_value_t = TraceRequest::default().episode, value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
+    #[arg(long, default_value_t = TraceRequest::default().episode, value_parser = super::episodes_or_none)]
     pub episode: u64,
     /// Evaluation protocol of the traced episode: zero-shot (from the trained state) or
     /// continual (after learning from the episodes before it).
     #[arg(long, default_value_t = TraceRequest::default().protocol, value_parser = super::protocol_parser())]
     pub protocol: Protocol,
+    /// Replace an output that holds something other than what this command writes there
+    /// (a map, an agent file, another command's results); without it such a file is
+    /// refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]
     pub agent: AgentArgs,
@@ -47,6 +52,7 @@ impl TraceArgs {
     /// The library's request of these arguments ([`TraceRequest`]).
     pub fn request(&self) -> TraceRequest {
         TraceRequest {
+            force: self.force,
             map: self.map.clone(),
             method: self.method,
             episode: self.episode,

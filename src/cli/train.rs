@@ -2,6 +2,7 @@
 
 use clap::Args;
 use std::path::PathBuf;
+use unforeseen_harness::runs::outputs::Own;
 
 use super::progress::{self, Bars};
 use unforeseen_harness::maps;
@@ -29,6 +30,10 @@ pub struct TrainArgs {
     /// (they bootstrap through it) or `termination` (an absorbing end, the ablation).
     #[arg(long, value_name = "KIND", default_value = "truncation", value_parser = super::timeout_as)]
     pub timeout_as: TimeoutAs,
+    /// Replace --out even when it holds something other than an agent file; without it such a
+    /// file is refused (exit 2).
+    #[arg(long)]
+    pub force: bool,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -39,6 +44,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     super::outputs::file(
         "--out",
         &args.out,
+        Own::Agent,
+        args.force,
         unforeseen_harness::runs::outputs::Outputs::new().input("--map", &args.map),
     )?;
     let map = maps::load(&args.map)?;

@@ -23,3 +23,4 @@ mod search;
 mod stream;
 mod stream_memory;
 mod train_seeds;
+mod writers;

@@ -15,6 +15,14 @@ use unforeseen_sim::Map;
 use crate::common::{assert_exit, run_cli};
 use unforeseen_harness::fixtures::bundle;
 
+/// The output guard of a search into `out`, as a job holds it.
+fn guarded(out: &Path) -> unforeseen_harness::runs::outputs::Guarded {
+    unforeseen_harness::runs::outputs::Outputs::new()
+        .folder("out", out)
+        .guard(true)
+        .expect("the guard")
+}
+
 fn jaywalk() -> Map {
     unforeseen_harness::maps::load("jaywalk").expect("embedded jaywalk")
 }
@@ -172,8 +180,22 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
     let seeds = [agents[0].train_seed];
     let dir = tempfile::tempdir().expect("tempdir");
     let (one, two) = (dir.path().join("one"), dir.path().join("two"));
-    let s1 = search::run(&config(&space, &agents, &seeds, 1), &one, false, &NoProgress).expect("runs");
-    let s2 = search::run(&config(&space, &agents, &seeds, 2), &two, false, &NoProgress).expect("runs");
+    let s1 = search::run(
+        &config(&space, &agents, &seeds, 1),
+        &one,
+        false,
+        &guarded(&one),
+        &NoProgress,
+    )
+    .expect("runs");
+    let s2 = search::run(
+        &config(&space, &agents, &seeds, 2),
+        &two,
+        false,
+        &guarded(&two),
+        &NoProgress,
+    )
+    .expect("runs");
     assert_eq!(
         untimed(&one.join("candidates.jsonl")),
         untimed(&two.join("candidates.jsonl"))
@@ -233,7 +255,14 @@ fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
     let seeds = [agents[0].train_seed];
     let dir = tempfile::tempdir().expect("tempdir");
     let whole = dir.path().join("whole");
-    search::run(&config(&space, &agents, &seeds, 2), &whole, false, &NoProgress).expect("runs");
+    search::run(
+        &config(&space, &agents, &seeds, 2),
+        &whole,
+        false,
+        &guarded(&whole),
+        &NoProgress,
+    )
+    .expect("runs");
     let mut parts = String::new();
     for i in 1..=2 {
         let d = dir.path().join(format!("shard{i}"));
@@ -241,7 +270,7 @@ fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
             shard: Some(Shard { index: i, count: 2 }),
             ..config(&space, &agents, &seeds, 2)
         };
-        let s = search::run(&cfg, &d, false, &NoProgress).expect("runs");
+        let s = search::run(&cfg, &d, false, &guarded(&d), &NoProgress).expect("runs");
         assert_eq!(
             s.counts.adaptive + s.counts.minimise,
             0,
@@ -264,7 +293,14 @@ fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
         sobol_of(untimed(&whole.join("candidates.jsonl")))
     );
     // Resumed, the concatenation becomes the whole run's file.
-    search::run(&config(&space, &agents, &seeds, 1), &joined, true, &NoProgress).expect("resumes");
+    search::run(
+        &config(&space, &agents, &seeds, 1),
+        &joined,
+        true,
+        &guarded(&joined),
+        &NoProgress,
+    )
+    .expect("resumes");
     assert_eq!(
         untimed(&joined.join("candidates.jsonl")),
         untimed(&whole.join("candidates.jsonl"))
@@ -276,7 +312,14 @@ fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
     let full = std::fs::read_to_string(whole.join("candidates.jsonl")).expect("read");
     let cut = &full[..full.len() * 3 / 5];
     std::fs::write(killed.join("candidates.jsonl"), cut).expect("write");
-    search::run(&config(&space, &agents, &seeds, 2), &killed, true, &NoProgress).expect("resumes");
+    search::run(
+        &config(&space, &agents, &seeds, 2),
+        &killed,
+        true,
+        &guarded(&killed),
+        &NoProgress,
+    )
+    .expect("resumes");
     let resumed = std::fs::read_to_string(killed.join("candidates.jsonl")).expect("read");
     let complete = &cut[..cut.rfind('\n').expect("lines") + 1];
     assert!(
@@ -293,7 +336,7 @@ fn shards_concatenate_into_the_sobol_part_of_one_run_and_resume_finishes_it() {
         seed: 6,
         ..config(&space, &agents, &seeds, 1)
     };
-    let err = search::run(&other, &whole, true, &NoProgress).expect_err("another search");
+    let err = search::run(&other, &whole, true, &guarded(&whole), &NoProgress).expect_err("another search");
     assert!(err.to_string().contains("seed: the file has 5, this run 6"), "{err}");
 }
 

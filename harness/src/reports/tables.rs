@@ -72,10 +72,13 @@ impl Display for Grid {
                 .zip(&widths)
                 .enumerate()
                 .map(|(c, (cell, &w))| {
+                    // Padded by hand: `format!`'s width stops at 65,535 (a longer cell
+                    // would panic), and a cell may hold a user's long label.
+                    let pad = " ".repeat(w - cell.chars().count());
                     if c == 0 {
-                        format!("{cell:<w$}")
+                        format!("{cell}{pad}")
                     } else {
-                        format!("{cell:>w$}")
+                        format!("{pad}{cell}")
                     }
                 })
                 .collect();
@@ -254,6 +257,18 @@ fn html_escape(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_cell_of_any_length_is_aligned_without_a_panic() {
+        let long = "x".repeat(70_000);
+        let mut grid = Grid::new(vec!["name".into(), "n".into()]);
+        grid.rows.push(vec![long.clone(), "1".into()]);
+        grid.rows.push(vec!["a".into(), long.clone()]);
+        let text = grid.to_string();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[1], format!("{long}  {}1", " ".repeat(69_999)));
+        assert_eq!(lines[2].chars().count(), 70_000 + 2 + 70_000);
+    }
 
     #[test]
     fn cells_show_the_interval_only_over_several_values() {

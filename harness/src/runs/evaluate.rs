@@ -21,7 +21,7 @@ use crate::progress::Progress;
 use crate::reports::tables::Document;
 use crate::runs::batch::request::AgentFields;
 use crate::runs::batch::{AgentChoice, SCRIPTED_ONLY};
-use crate::runs::outputs::Outputs;
+use crate::runs::outputs::{Outputs, Own};
 use crate::runs::stream::{Stream, StreamEvalReport, evaluate_stream};
 
 /// The file an evaluation writes into its folder.
@@ -53,6 +53,9 @@ pub struct EvalRequest {
     /// a method that needs an agent trains one on `intersection` with the default
     /// episodes and `seed`. Default: none.
     pub agent: Option<PathBuf>,
+    /// Replace an output that holds something other than what this run writes there
+    /// (the output guard refuses it otherwise). Default: false.
+    pub force: bool,
 }
 
 impl Default for EvalRequest {
@@ -67,6 +70,7 @@ impl Default for EvalRequest {
             seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/eval")),
             agent: None,
+            force: false,
         }
     }
 }
@@ -157,8 +161,8 @@ impl EvalRequest {
         if let Some(dir) = &self.out {
             scene
                 .inputs(&self.map, self.agent.as_ref())
-                .files_in("out", dir, &[EVAL_FILE])
-                .check(true)?;
+                .files_in("out", dir, &[EVAL_FILE], &[Own::Evaluation])
+                .check(self.force)?;
         }
         let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
         // A scripted reference decodes the map's own observations: it needs no agent.

@@ -22,10 +22,14 @@ use crate::reports::figures::{Series, line_panels};
 use crate::runs::batch::AgentChoice;
 use crate::runs::batch::request::AgentFields;
 use crate::runs::evaluate::EvalScene;
+use crate::runs::outputs::Own;
 use crate::runs::stream::learn_stream;
 
 /// The files test-time learning writes into its folder, in order.
 pub const LEARN_FILES: [&str; 3] = ["learn.csv", "learn.json", "learn.svg"];
+
+/// What each of [`LEARN_FILES`] holds, for the output guard.
+const LEARN_KINDS: [Own; 3] = [Own::Csv, Own::LearningCurves, Own::Svg];
 
 /// Every choice of test-time learning, with its defaults ([`LearnRequest::default`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -49,6 +53,9 @@ pub struct LearnRequest {
     /// one is trained on `intersection` with the default episodes and `seed`. Default:
     /// none.
     pub agent: Option<PathBuf>,
+    /// Replace an output that holds something other than what this run writes there
+    /// (the output guard refuses it otherwise). Default: false.
+    pub force: bool,
 }
 
 impl Default for LearnRequest {
@@ -61,6 +68,7 @@ impl Default for LearnRequest {
             seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/learn")),
             agent: None,
+            force: false,
         }
     }
 }
@@ -134,8 +142,8 @@ impl LearnRequest {
         if let Some(dir) = &self.out {
             scene
                 .inputs(&self.map, self.agent.as_ref())
-                .files_in("out", dir, &LEARN_FILES)
-                .check(true)?;
+                .files_in("out", dir, &LEARN_FILES, &LEARN_KINDS)
+                .check(self.force)?;
         }
         let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
         let (agent, _, _) = fields.choose(given, None)?;

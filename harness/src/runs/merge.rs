@@ -123,7 +123,7 @@ fn unit_text(index: usize, key: &UnitKey) -> String {
 const MAX_NAMED: usize = 12;
 
 /// The missing units as ranges of positions, the first [`MAX_NAMED`] of them named.
-fn missing_text(missing: &[usize], all: &[(Unit, UnitKey)]) -> String {
+fn missing_text(missing: &[usize], all: &[(Unit, UnitKey)], place: &str) -> String {
     let mut ranges: Vec<(usize, usize)> = Vec::new();
     for &i in missing {
         match ranges.last_mut() {
@@ -142,7 +142,7 @@ fn missing_text(missing: &[usize], all: &[(Unit, UnitKey)]) -> String {
         .collect();
     let more = missing.len().saturating_sub(MAX_NAMED);
     format!(
-        "units {} are in no part: {}{}",
+        "units {} are {place}: {}{}",
         positions.join(", "),
         named.join("; "),
         if more > 0 {
@@ -151,6 +151,27 @@ fn missing_text(missing: &[usize], all: &[(Unit, UnitKey)]) -> String {
             String::new()
         }
     )
+}
+
+/// What a reader of one results file checks before it reports on the run the file's
+/// identity names (`plot-sweep`): the units of that run missing from `lines` (a shard,
+/// a run cut short), as `(missing, units of the run, text naming them)`; `None` when
+/// every unit is there.
+pub fn missing_units(identity: &RunIdentity, lines: &[ResultLine]) -> Result<Option<(usize, usize, String)>, String> {
+    let all = units_of(identity)?;
+    let present: std::collections::BTreeSet<usize> = lines
+        .iter()
+        .filter(|l| all.get(l.unit).is_some_and(|(_, key)| *key == l.key()))
+        .map(|l| l.unit)
+        .collect();
+    let missing: Vec<usize> = (0..all.len()).filter(|i| !present.contains(i)).collect();
+    Ok((!missing.is_empty()).then(|| {
+        (
+            missing.len(),
+            all.len(),
+            missing_text(&missing, &all, "not in the file"),
+        )
+    }))
 }
 
 /// Reads the parts and merges them into the lines of their run, in canonical order.
@@ -293,7 +314,7 @@ pub fn merge(parts: &[PathBuf]) -> Result<Merged, Error> {
                 "the parts do not cover the run: it has {} units, {} {}{cut}; run the missing shards (or `unforeseen batch --resume` on a part) and merge again",
                 all.len(),
                 found.len(),
-                missing_text(&missing, &all)
+                missing_text(&missing, &all, "in no part")
             ),
         ));
     }

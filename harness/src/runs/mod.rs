@@ -15,6 +15,7 @@
 pub mod batch;
 pub mod compare;
 pub mod evaluate;
+pub mod file_kinds;
 pub mod learn;
 pub mod merge;
 pub mod outputs;

@@ -8,20 +8,22 @@
 //! * refuses an output file that exists and is not a regular file, an output folder that
 //!   exists and is not a folder, and a place where nothing can be created;
 //! * refuses, unless `force`, an output that holds something other than what this kind
-//!   of run writes ([`Own`]): a map, an agent file, notes;
+//!   of run writes ([`Own`]), recognised by its content ([`Held`]): a map, an agent
+//!   file, another command's results, notes;
 //! * takes an advisory lock (`OUT.lock` beside a results file, `OUT/.lock` in a folder)
 //!   that refuses a second writer until the [`Guarded`] is dropped;
-//! * removes the outputs of the set that the run rewrites at its end (a summary beside a
-//!   results file, a search's summary, figure and failure maps), so the set on disk is
-//!   never one run's file beside another run's.
+//! * once the run's own checks have passed ([`Guarded::clear_at_end`]), removes the
+//!   outputs of the set that the run rewrites at its end (a summary beside a results
+//!   file, a search's summary, figure and failure maps), so the set on disk is never one
+//!   run's file beside another run's; a refusal before that changes no file.
 //!
 //! Names that become file names (a space's name, a map's name in a search's outputs)
 //! are checked by [`file_name`].
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use crate::error::Error;
+use crate::runs::file_kinds::Held;
 
 /// Longest name that becomes part of a file name (bytes): file systems take 255, and
 /// the name gets a suffix (`_c0046.ron`).
@@ -54,85 +56,78 @@ pub fn summary_path(out: &Path) -> PathBuf {
     out.with_extension("summary.json")
 }
 
-/// What a run writes into an output, so that a file holding something else is refused
-/// (unless `force`) instead of being replaced.
+/// What a run writes into an output, so that a file holding something else (recognised
+/// by its content: [`Held`]) is refused, unless `force`, instead of being replaced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Own {
-    /// Anything: the run replaces whatever file is there (an agent file of `train`, a
-    /// figure); only inputs and non-files are refused.
+    /// Anything: only inputs and non-files are refused.
     Any,
-    /// A batch results file (JSON Lines): its first line is a run identity
-    /// (`{"run": ...}`) or a result line (`{"unit": ...}`, Python's `evaluate`).
+    /// A batch results file (JSON Lines): a run identity first (`{"run": ...}`), or
+    /// result lines (Python's `evaluate`).
     Results,
+    /// Result lines without a run identity (Python's `evaluate`, which appends lines).
+    ResultLines,
     /// A search's candidates file: its first line is `{"search": ...}`.
     Candidates,
-    /// A JSON document (a summary, `eval.json`).
-    Json,
+    /// The summary beside a batch's results file.
+    BatchSummary,
+    /// A search's `summary.json`.
+    SearchSummary,
+    /// `eval.json`.
+    Evaluation,
+    /// `compare.json`.
+    Comparison,
+    /// `learn.json`.
+    LearningCurves,
+    /// A planning model in the `inspect` layout (`export-model`).
+    Model,
+    /// An agent file (`train`, Python's `Agent.save`).
+    Agent,
     /// A CSV table whose first line is a header of names.
     Csv,
     /// An SVG figure.
     Svg,
+    /// An HTML page (`trace --html`).
+    Html,
     /// A failure map a search wrote (its first line says so).
     FailureMap,
 }
 
 impl Own {
-    /// What it is, for the error.
-    fn what(self) -> &'static str {
+    /// The kinds of file this output may replace (besides an empty file).
+    fn accepts(self) -> &'static [Held] {
         match self {
-            Own::Any => "a file",
-            Own::Results => "a batch's results file (first line {\"run\": ...} or a result line)",
-            Own::Candidates => "a search's candidates file (first line {\"search\": ...})",
-            Own::Json => "a JSON document",
-            Own::Csv => "a CSV table",
-            Own::Svg => "an SVG figure",
-            Own::FailureMap => "a failure map written by `unforeseen search`",
+            Own::Any => &[],
+            Own::Results => &[Held::BatchRun, Held::ResultLines],
+            Own::ResultLines => &[Held::ResultLines],
+            Own::Candidates => &[Held::Candidates],
+            Own::BatchSummary => &[Held::BatchSummary],
+            Own::SearchSummary => &[Held::SearchSummary],
+            Own::Evaluation => &[Held::Evaluation],
+            Own::Comparison => &[Held::Comparison],
+            Own::LearningCurves => &[Held::LearningCurves],
+            Own::Model => &[Held::Model],
+            Own::Agent => &[Held::Agent],
+            Own::Csv => &[Held::Csv],
+            Own::Svg => &[Held::Svg],
+            Own::Html => &[Held::Html],
+            Own::FailureMap => &[Held::FailureMap],
         }
     }
 
-    /// Whether the file at `path` (which exists) holds what this run writes; an empty
-    /// file does.
-    fn holds(self, path: &Path) -> bool {
+    /// What it is, for the error.
+    fn what(self) -> &'static str {
+        self.accepts().first().map_or("a file", |h| h.describe())
+    }
+
+    /// What the file at `path` (which exists) holds when that is not what this run
+    /// writes; `None` when the run may replace it (an empty file, or one of its kind).
+    fn foreign(self, path: &Path) -> Option<Held> {
         if self == Own::Any {
-            return true;
+            return None;
         }
-        let mut head = Vec::new();
-        let Ok(f) = std::fs::File::open(path) else {
-            return false;
-        };
-        if f.take(4096).read_to_end(&mut head).is_err() {
-            return false;
-        }
-        if head.is_empty() {
-            return true;
-        }
-        let first = head.split(|&b| b == b'\n').next().unwrap_or_default();
-        let first = String::from_utf8_lossy(first);
-        match self {
-            Own::Any => true,
-            Own::Results => {
-                first.starts_with("{\"run\":")
-                    || (first.starts_with("{\"unit\":")
-                        && serde_json::from_str::<serde_json::Value>(first.trim_end()).is_ok_and(|v| v.is_object()))
-            }
-            Own::Candidates => first.starts_with("{\"search\":"),
-            Own::Json => {
-                let len = std::fs::metadata(path).map_or(u64::MAX, |m| m.len());
-                len <= 1 << 26
-                    && std::fs::read(path)
-                        .ok()
-                        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-                        .is_some_and(|v| v.is_object())
-            }
-            Own::Csv => {
-                let t = first.trim_end();
-                !t.is_empty()
-                    && t.split(',')
-                        .all(|c| !c.is_empty() && c.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_'))
-            }
-            Own::Svg => first.starts_with("<svg") || first.starts_with("<?xml"),
-            Own::FailureMap => first.starts_with("// ") && first.contains("found by `unforeseen search`"),
-        }
+        let held = Held::of(path);
+        (held != Held::Empty && !self.accepts().contains(&held)).then_some(held)
     }
 }
 
@@ -165,6 +160,8 @@ pub struct Guarded {
     _lock: std::fs::File,
     /// Folders that did not exist and were created (for a front to mention).
     pub created: Vec<PathBuf>,
+    /// The outputs written at the end of the run ([`Guarded::clear_at_end`]).
+    at_end: Vec<PathBuf>,
 }
 
 impl Outputs {
@@ -217,7 +214,7 @@ impl Outputs {
         Outputs::new().file(flag, out, Own::Results).file_at_end(
             &format!("{flag} (its summary)"),
             summary_path(out),
-            Own::Json,
+            Own::BatchSummary,
         )
     }
 
@@ -251,12 +248,14 @@ impl Outputs {
     }
 
     /// The output folder `dir` given as `flag` ([`Outputs::place`]) and the files `names`
-    /// the run writes in it, whatever they hold (a job's fixed set: eval.json, compare's
-    /// four files, ...).
-    pub fn files_in(self, flag: &str, dir: &Path, names: &[&str]) -> Outputs {
+    /// the run writes in it (a job's fixed set: eval.json, compare's four files, ...),
+    /// each holding what `kinds` says, in the same order.
+    pub fn files_in(self, flag: &str, dir: &Path, names: &[&str], kinds: &[Own]) -> Outputs {
+        debug_assert_eq!(names.len(), kinds.len());
         names
             .iter()
-            .fold(self.place(flag, dir), |g, n| g.file(flag, dir.join(n), Own::Any))
+            .zip(kinds)
+            .fold(self.place(flag, dir), |g, (n, own)| g.file(flag, dir.join(n), *own))
     }
 
     /// The files with extension `ext` in the output folder `dir` (a search's
@@ -332,11 +331,15 @@ impl Outputs {
                     ));
                 }
             }
-            if !force && f.path.is_file() && !f.own.holds(&f.path) {
+            if !force
+                && f.path.is_file()
+                && let Some(held) = f.own.foreign(&f.path)
+            {
                 return Err(Error::flag(
                     format!("{} {}", f.flag, f.path.display()),
                     format!(
-                        "exists and is not {}; give another path, or add --force (force=True) to replace it",
+                        "exists and holds {}, not {}; give another path, or add --force (force=True) to replace it",
+                        held.describe(),
                         f.own.what()
                     ),
                 ));
@@ -345,8 +348,10 @@ impl Outputs {
         Ok(())
     }
 
-    /// [`Outputs::check`], then creates the missing folders, takes the lock (refusing a
-    /// second writer) and removes the outputs written at the end of the run.
+    /// [`Outputs::check`], then creates the missing folders and takes the lock (refusing
+    /// a second writer). The outputs written at the end of the run stay until
+    /// [`Guarded::clear_at_end`]: a check of the run that refuses after the guard
+    /// (`--resume` of another run) leaves every file as it was.
     pub fn guard(&self, force: bool) -> Result<Guarded, Error> {
         self.check(force)?;
         let mut created = Vec::new();
@@ -362,16 +367,51 @@ impl Outputs {
         for (_, dir, _) in &self.folders {
             std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
         }
-        for f in self.files.iter().chain(&self.folder_files).filter(|f| f.at_end) {
-            match std::fs::remove_file(&f.path) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(Error::io("remove", &f.path, e));
-                }
+        // What a killed writer left: its committed set completed, its temporaries removed.
+        let parents = self.files.iter().filter_map(|f| f.path.parent());
+        for dir in self.folders.iter().map(|(_, d, _)| d.as_path()).chain(parents) {
+            crate::files::recover(if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            })?;
+        }
+        let at_end = self
+            .files
+            .iter()
+            .chain(&self.folder_files)
+            .filter(|f| f.at_end)
+            .map(|f| f.path.clone())
+            .collect();
+        Ok(Guarded {
+            _lock: lock,
+            created,
+            at_end,
+        })
+    }
+}
+
+impl Guarded {
+    /// Removes the outputs the run writes at its end (a summary beside a results file, a
+    /// search's summary, figure and failure maps), so that the set on disk never mixes
+    /// this run's streamed file with an earlier run's summary. Called once every check
+    /// of the run has passed, just before it writes.
+    pub fn clear_at_end(&self) -> Result<(), Error> {
+        for path in &self.at_end {
+            match std::fs::remove_file(path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io("remove", path, e)),
                 _ => {}
             }
         }
-        Ok(Guarded { _lock: lock, created })
+        Ok(())
     }
+}
+
+/// Checks the agent cache folder `dir` (given as `cache`) before any training, as an
+/// output of the run: a folder, or a path where one can be made; not a file (exit 2, or
+/// `ValueError` in Python).
+pub fn check_cache(dir: &Path) -> Result<(), Error> {
+    Outputs::new().place("cache", dir).check(false)
 }
 
 /// The same file: both exist and resolve (links followed) to one path.

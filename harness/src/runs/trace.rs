@@ -59,6 +59,9 @@ pub struct TraceRequest {
     /// one is trained on `intersection` with the default episodes and `seed`. Default:
     /// none.
     pub agent: Option<PathBuf>,
+    /// Replace an output that holds something other than what this run writes there
+    /// (the output guard refuses it otherwise). Default: false.
+    pub force: bool,
 }
 
 impl Default for TraceRequest {
@@ -73,6 +76,7 @@ impl Default for TraceRequest {
             out: Some(PathBuf::from("out/trace")),
             html: None,
             agent: None,
+            force: false,
         }
     }
 }
@@ -179,12 +183,12 @@ impl TraceRequest {
                 guard = guard.input("agent", agent);
             }
             if let Some(html) = &self.html {
-                guard = guard.file("html", html, Own::Any);
+                guard = guard.file("html", html, Own::Html);
             }
             if let Some(dir) = &self.out {
-                guard = guard.files_in("out", dir, &TRACE_FILES);
+                guard = guard.files_in("out", dir, &TRACE_FILES, &[Own::Csv, Own::Svg, Own::Svg]);
             }
-            guard.check(true)?;
+            guard.check(self.force)?;
         }
         let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
         let (agent, _, _) = fields.choose(given, None)?;

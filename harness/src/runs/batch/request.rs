@@ -29,7 +29,7 @@ use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs, Trai
 use super::identity::{SCRIPTED_ONLY, agent_file_identity, trained_agents_identity};
 use super::plan::{BatchConfig, Plan};
 use super::result_line::ResultLine;
-use super::run::run_plan;
+use super::run::run_plan_then;
 use super::scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};
 use super::summary::{SummaryRow, summarize};
 use super::sweep::{ParamSet, checked_sweep};
@@ -272,7 +272,12 @@ impl<'a> AgentFields<'a> {
             (None, None) => None,
         };
         match (self.train_seeds, given, scripted) {
-            (Some(seeds), _, _) => trained(seeds.0.clone(), self.cache.cloned()),
+            (Some(seeds), _, _) => {
+                if let Some(dir) = self.cache {
+                    crate::runs::outputs::check_cache(dir)?;
+                }
+                trained(seeds.0.clone(), self.cache.cloned())
+            }
             (None, Some(bundle), _) => {
                 let identity = agent_file_identity(&bundle);
                 let agent = Agent::from_bundle(bundle);
@@ -358,7 +363,7 @@ impl BatchRequest {
             plan,
             out: self.out.clone(),
             shard: self.shard,
-            _guard: guard,
+            guard,
         })
     }
 }
@@ -392,7 +397,9 @@ pub struct BatchJob {
     pub out: PathBuf,
     /// The shard run.
     pub shard: Option<Shard>,
-    _guard: Guarded,
+    /// The output guard, held while the job lives; [`BatchJob::run`] clears the summary
+    /// of an earlier run once every check has passed.
+    guard: Guarded,
 }
 
 /// Worker threads for a run, bounded by memory ([`BatchJob::workers`]).
@@ -463,15 +470,18 @@ impl BatchJob {
     /// threads ([`BatchJob::workers`]), streaming each line to the results file, then
     /// writes the summary beside it. One phase of `progress`.
     pub fn run(&self, agents: &[Agent], jobs: usize, progress: &dyn Progress) -> Result<BatchReport, Error> {
+        self.guard.clear_at_end()?;
         let cfg = self.setup.config(agents, jobs, self.shard);
-        let lines = run_plan(&cfg, &self.plan, &self.out, progress)?;
-        let rows = summarize(&lines);
         let summary = summary_path(&self.out);
         let shard = self.shard.map(String::from);
-        write_json(
-            &summary,
-            &summary_document(&self.out, shard.as_deref(), &self.plan.identity, &rows),
-        )?;
+        let lines = run_plan_then(&cfg, &self.plan, &self.out, progress, |lines| {
+            let rows = summarize(lines);
+            write_json(
+                &summary,
+                &summary_document(&self.out, shard.as_deref(), &self.plan.identity, &rows),
+            )
+        })?;
+        let rows = summarize(&lines);
         Ok(BatchReport {
             checked: rows.iter().map(|r| r.checks.len()).sum(),
             failures: crate::runs::batch::table::expectation_failures(&rows),

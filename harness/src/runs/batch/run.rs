@@ -122,6 +122,18 @@ pub fn run_plan(
     out: &Path,
     progress: &dyn Progress,
 ) -> Result<Vec<ResultLine>, Error> {
+    run_plan_then(cfg, plan, out, progress, |_| Ok(()))
+}
+
+/// [`run_plan`], with the files `then` writes from the lines (a summary) written as one
+/// set with the rewritten `out` ([`crate::files::all_or_none`]).
+pub fn run_plan_then(
+    cfg: &BatchConfig<'_>,
+    plan: &Plan,
+    out: &Path,
+    progress: &dyn Progress,
+    then: impl FnOnce(&[ResultLine]) -> Result<(), Error>,
+) -> Result<Vec<ResultLine>, Error> {
     let identity = &plan.identity;
     let todo = plan.todo();
 
@@ -161,6 +173,10 @@ pub fn run_plan(
     let text: String = std::iter::once(identity.to_line())
         .chain(lines.iter().map(|l| l.raw.clone()))
         .collect();
-    crate::files::write_atomic(out, text.as_bytes())?;
-    Ok(lines.into_iter().map(|l| l.parsed).collect())
+    let lines: Vec<ResultLine> = lines.into_iter().map(|l| l.parsed).collect();
+    crate::files::all_or_none(|| {
+        crate::files::write_atomic(out, text.as_bytes())?;
+        then(&lines)
+    })?;
+    Ok(lines)
 }

@@ -17,7 +17,7 @@ use crate::limits::check_episodes;
 use crate::progress::Progress;
 use crate::runs::batch::AgentChoice;
 use crate::runs::batch::request::AgentFields;
-use crate::runs::outputs::Outputs;
+use crate::runs::outputs::{Outputs, Own};
 use crate::training::seed_agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
 use crate::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP, TimeoutAs};
 
@@ -59,6 +59,9 @@ pub struct CompareRequest {
     /// The folder of the agent cache of `train_seeds`; none: no cache. Default
     /// [`DEFAULT_CACHE`].
     pub cache: Option<PathBuf>,
+    /// Replace an output that holds something other than what this run writes there
+    /// (the output guard refuses it otherwise). Default: false.
+    pub force: bool,
 }
 
 impl Default for CompareRequest {
@@ -77,6 +80,7 @@ impl Default for CompareRequest {
             train_seeds: None,
             timeout_as: TimeoutAs::Truncation,
             cache: Some(PathBuf::from(DEFAULT_CACHE)),
+            force: false,
         }
     }
 }
@@ -128,7 +132,14 @@ impl CompareRequest {
             if let Some(agent) = &self.agent {
                 guard = guard.input("agent", agent);
             }
-            guard.files_in("out", dir, &COMPARE_FILES).check(true)?;
+            guard
+                .files_in(
+                    "out",
+                    dir,
+                    &COMPARE_FILES,
+                    &[Own::Comparison, Own::Csv, Own::Csv, Own::Svg],
+                )
+                .check(self.force)?;
         }
         let train_map = crate::maps::load(&self.train_map)?;
         let test_map = crate::maps::load(&self.test_map)?;

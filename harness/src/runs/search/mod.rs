@@ -75,6 +75,7 @@ use crate::episodes::survivability::careful_witness;
 use crate::error::Error;
 use crate::progress::{CancelOnly, NoProgress, Progress};
 use crate::runs::batch::{ResultLine, Shard, UnitLabel};
+use crate::runs::outputs::Guarded;
 use crate::training::seed_agents::Agent;
 
 pub use candidates::{Candidate, CandidateLine, Evaluated, Role, Stage, candidate_name, sobol_candidates};
@@ -104,9 +105,17 @@ pub struct Outcome {
 
 /// Runs the search into folder `out` (`candidates.jsonl`, `failures/`, `summary.json`,
 /// `search.svg`); with `resume`, completes the search a file there holds. Progress: one
-/// phase per stage (`search sobol`, `search adaptive N`, `search minimise`).
-pub fn run(cfg: &SearchConfig<'_>, out: &Path, resume: bool, progress: &dyn Progress) -> Result<Summary, Error> {
-    run_with(cfg, out, resume, progress, None)
+/// phase per stage (`search sobol`, `search adaptive N`, `search minimise`). `guard` is
+/// the job's output guard: the earlier search's summary, figure and failure maps are
+/// removed once the kept lines are checked ([`Guarded::clear_at_end`]).
+pub fn run(
+    cfg: &SearchConfig<'_>,
+    out: &Path,
+    resume: bool,
+    guard: &Guarded,
+    progress: &dyn Progress,
+) -> Result<Summary, Error> {
+    run_with(cfg, out, resume, guard, progress, None)
 }
 
 /// [`run`], with the candidates evaluated by `remote` when given (each stage's
@@ -117,6 +126,7 @@ pub fn run_with(
     cfg: &SearchConfig<'_>,
     out: &Path,
     resume: bool,
+    guard: &Guarded,
     progress: &dyn Progress,
     remote: Option<&dyn Evaluator>,
 ) -> Result<Summary, Error> {
@@ -128,6 +138,7 @@ pub fn run_with(
     } else {
         BTreeMap::new()
     };
+    guard.clear_at_end()?;
     let head: String = std::iter::once(output::identity_line(&cfg.identity()))
         .chain(kept.values().flatten().map(|l| l.raw.clone()))
         .collect();

@@ -53,7 +53,7 @@ pub fn outputs(out: &Path) -> Outputs {
     Outputs::new()
         .folder("out", out)
         .file("out", out.join(CANDIDATES), Own::Candidates)
-        .file_at_end("out", out.join(SUMMARY), Own::Json)
+        .file_at_end("out", out.join(SUMMARY), Own::SearchSummary)
         .file_at_end("out", out.join(FIGURE), Own::Svg)
         .folder_files("out", &out.join(FAILURES), "ron", Own::FailureMap)
 }

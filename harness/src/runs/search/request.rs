@@ -174,7 +174,7 @@ impl SearchRequest {
             guard = guard.input("agent", agent);
         }
         let guard = guard.guard(self.force || self.resume)?;
-        Ok(SearchJob { setup, _guard: guard })
+        Ok(SearchJob { setup, guard })
     }
 }
 
@@ -234,7 +234,7 @@ impl SearchSetup {
 pub struct SearchJob {
     /// The request resolved.
     pub setup: SearchSetup,
-    _guard: Guarded,
+    guard: Guarded,
 }
 
 impl SearchJob {
@@ -244,7 +244,13 @@ impl SearchJob {
         let cfg = self.setup.config(agents, self.setup.jobs, command);
         cfg.check()?;
         let r = &self.setup.request;
-        super::run(&cfg, Path::new(&r.out), r.resume, progress)
+        super::run(&cfg, Path::new(&r.out), r.resume, &self.guard, progress)
+    }
+
+    /// The output guard held by the job (for a driver that runs the stages itself:
+    /// [`super::run_with`]).
+    pub fn guard(&self) -> &Guarded {
+        &self.guard
     }
 }
 
