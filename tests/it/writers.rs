@@ -15,7 +15,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use super::common::{TINY_MAP, assert_exit, output_text, run_cli, tiny_agent_text};
+use super::common::{assert_exit, output_text, run_cli};
+use unforeseen_harness::fixtures::{TINY_MAP, tiny_agent_text};
 
 const SPACE: &str = "maps/spaces/jaywalk.ron";
 

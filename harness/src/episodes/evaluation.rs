@@ -249,7 +249,7 @@ pub struct EvalReport {
     /// across episodes, whatever was asked ([`Protocol::effective`]).
     pub computed_under: Protocol,
     /// Whether the method learns across episodes with these parameters (the printed line
-    /// says so when it does not, [`crate::reports::tables::eval`]); not in the file.
+    /// says so when it does not, [`crate::runs::evaluate::eval_table`]); not in the file.
     #[serde(skip)]
     pub learns_across_episodes: bool,
     /// Evaluation seed (episode seeds derive from it).

@@ -262,7 +262,7 @@ pub struct StreamRow {
 }
 
 /// The report of a method run over a stream (`eval --stream`'s eval.json), built by
-/// [`StreamEvalReport::new`] alone; printed by [`crate::reports::tables::eval_stream`].
+/// [`StreamEvalReport::new`] alone; printed by [`crate::runs::evaluate::eval_stream_table`].
 #[derive(Debug, Clone, Serialize)]
 pub struct StreamEvalReport {
     /// The method.

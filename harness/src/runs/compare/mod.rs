@@ -208,7 +208,7 @@ pub struct CompareReport {
     /// The reward settings of both maps (`train_map`, `test_map`).
     pub reward: RewardPair,
     /// Each map's reward in words (`rewards::describe`: training map, test map), as the
-    /// printed tables give it ([`crate::reports::tables::compare`]); not in the file.
+    /// printed tables give it ([`crate::runs::compare::table::compare`]); not in the file.
     #[serde(skip)]
     pub reward_described: (String, String),
     /// Evaluation seed (episode seeds derive from it, the same for every agent).
