@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyDict};
 use serde_json::{Value, json};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::methods::Method;
@@ -93,8 +93,8 @@ fn request_defaults(job: &str) -> PyResult<String> {
 /// one is given, else null).
 #[pyfunction]
 #[pyo3(signature = (request, agent = None))]
-fn plan_batch(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
-    let request: BatchRequest = self::request(request)?;
+fn plan_batch(request: &Bound<'_, PyDict>, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
+    let request: BatchRequest = crate::convert::request(request)?;
     let job = request.plan(agent.map(|a| a.bundle.clone())).map_err(errors::to_py)?;
     let setup = &job.setup;
     let plan = &job.plan;
@@ -132,6 +132,17 @@ fn plan_batch(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<Stri
         "agent": agent_text,
     })
     .to_string())
+}
+
+/// Checks the batch `request` as [`plan_batch`] does, without taking the output guard
+/// (which removes an earlier run's summary): for a driver to refuse bad input before
+/// anything else can fail (Ray's import).
+#[pyfunction]
+#[pyo3(signature = (request, agent = None))]
+fn check_batch(request: &Bound<'_, PyDict>, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<()> {
+    let request: BatchRequest = crate::convert::request(request)?;
+    request.setup(agent.map(|a| a.bundle.clone())).map_err(errors::to_py)?;
+    Ok(())
 }
 
 /// Trains the agent of training seed `seed` on `train_map` (a file or an embedded name)
@@ -313,6 +324,7 @@ fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<BatchResult> {
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(check_batch, m)?)?;
     m.add_function(wrap_pyfunction!(plan_batch, m)?)?;
     m.add_function(wrap_pyfunction!(train_agent, m)?)?;
     m.add_function(wrap_pyfunction!(run_units, m)?)?;

@@ -31,7 +31,7 @@ def test_lines_are_read_by_the_batch_summary_beside_builtin_methods(agent, tmp_p
         for line in builtin["lines"]:
             f.write(json.dumps(line) + "\n")
     lines = unforeseen.evaluate({3: AlwaysFast(), 4: AlwaysFast()}, ["jaywalk", "intersection"], [3, 4],
-                                episodes=5, protocol=["zero-shot", "continual"], out=out)
+                                episodes=5, protocol=["zero-shot", "continual"], out=out, append=True)
     assert [(l["scenario"], l["train_seed"]) for l in lines] == [("jaywalk", 3), ("jaywalk", 4),
                                                                  ("intersection", 3), ("intersection", 4)]
     # A policy that does not learn runs once and covers both protocols, as the batch does.
