@@ -32,7 +32,7 @@ pub struct TraceArgs {
     pub html: Option<PathBuf>,
     /// Evaluation episode to trace (0 = the first). Under `--protocol continual` the agent
     /// first runs and learns from episodes 0..N, as a continual evaluation does.
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
+    #[arg(long, default_value_t = 0, value_parser = super::episode_index)]
     pub episode: u64,
     /// Evaluation protocol of the traced episode: zero-shot (from the trained state) or
     /// continual (after learning from the episodes before it).

@@ -15,6 +15,7 @@ mod fuzz;
 mod golden;
 mod guard;
 mod merge;
+mod newcomer;
 mod outputs;
 mod overrides;
 mod protocols;
