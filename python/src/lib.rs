@@ -55,6 +55,10 @@ fn version() -> &'static str {
 /// The extension module.
 #[pymodule]
 fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // NumPy's C API, fetched now, at import: the numpy crate fetches it on first use and
+    // reports a failure as a panic, which a Ctrl-C pending at that moment made (a
+    // `PanicException` instead of `KeyboardInterrupt` while stepping a vector env).
+    numpy::PyArray1::<f32>::zeros(m.py(), [0], false);
     m.add_function(wrap_pyfunction!(embedded_maps, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     convert::register(m)?;

@@ -165,6 +165,7 @@ calls = {
                                       out=os.path.join(os.environ["TMPDIR"], "r.jsonl")),
     "compare": lambda: unforeseen.compare(agents=agent, episodes=1_000_000),
     "evaluate_builtin": lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=1_000_000),
+    "rust_loop": lambda: unforeseen._unforeseen.rust_loop("jaywalk", [0], 10**12),
 }
 threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
 start = time.monotonic()
@@ -176,7 +177,7 @@ except KeyboardInterrupt:
 """
 
 
-@pytest.mark.parametrize("which", ["train", "train_agents", "batch", "compare", "evaluate_builtin"])
+@pytest.mark.parametrize("which", ["train", "train_agents", "batch", "compare", "evaluate_builtin", "rust_loop"])
 def test_long_calls_stop_on_ctrl_c(which, tmp_path):
     import os
     import subprocess

@@ -456,6 +456,17 @@ fn build(origin: &str, src: &str, resolve: &Resolver, chain: &mut Vec<String>) -
 fn parse_patch(origin: &str, src: &str) -> Result<MapPatch, MapError> {
     let opts = ron_options();
     let value: ron::Value = opts.from_str(src).map_err(|e| MapError::one(spanned(origin, "", &e)))?;
+    if is_agent_file(&value) {
+        return Err(MapError::one(Diagnostic::new(
+            origin,
+            "",
+            "is an agent file, not a map (it has the `format_version` and `world_model` that `unforeseen train` writes)",
+            Some(
+                "give a map file (e.g. maps/jaywalk.ron) or an embedded map's name; an agent file goes after --agent"
+                    .into(),
+            ),
+        )));
+    }
     let mut unknown = Vec::new();
     walk(&value, Kind::Map, "", origin, &mut unknown);
     if !unknown.is_empty() {
@@ -475,6 +486,17 @@ fn parse_patch(origin: &str, src: &str) -> Result<MapPatch, MapError> {
     de.end()
         .map_err(|e| MapError::one(spanned(origin, "", &de.span_error(e))))?;
     Ok(patch)
+}
+
+/// Whether `value`, a file's top level, is an agent file (its `format_version` and
+/// `world_model`) rather than a map: said as such, not as a map's unknown fields.
+fn is_agent_file(value: &ron::Value) -> bool {
+    let ron::Value::Map(fields) = value else {
+        return false;
+    };
+    ["format_version", "world_model"]
+        .iter()
+        .all(|k| fields.get(&ron::Value::String((*k).to_string())).is_some())
 }
 
 // ---------------------------------------------------------------------------

@@ -47,6 +47,8 @@ pub fn lines(n: usize) -> String {
 /// file): what a notice of its replacement says.
 pub fn line_count(path: &Path) -> Option<usize> {
     use std::io::BufRead;
-    let file = std::fs::File::open(path).ok().filter(|f| f.metadata().is_ok_and(|m| m.is_file()))?;
+    let file = std::fs::File::open(path)
+        .ok()
+        .filter(|f| f.metadata().is_ok_and(|m| m.is_file()))?;
     Some(std::io::BufReader::new(file).split(b'\n').count())
 }

@@ -68,7 +68,10 @@ fn batch_says_which_results_file_it_replaces_and_how_many_lines_it_held() {
     assert_exit(
         &second,
         0,
-        &[&format!("replacing {} ({held} lines) from an earlier run", out.display())],
+        &[&format!(
+            "replacing {} ({held} lines) from an earlier run",
+            out.display()
+        )],
     );
     let quiet = batch(&out, &["--seed", "5", "--quiet"]);
     assert_exit(&quiet, 0, &[]);
