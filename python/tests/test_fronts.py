@@ -138,6 +138,37 @@ def test_compare_and_eval_take_the_request_with_the_librarys_defaults(job: str):
     assert taken == {**defaults, **own}, "the request's fields, names and defaults"
 
 
+@pytest.mark.parametrize(
+    "function,field,request_field",
+    [
+        ("train", "map", ("compare", "train_map")),
+        ("train", "episodes", ("compare", "train_episodes")),
+        ("train", "seed", ("compare", "seed")),
+        ("train_agents", "map", ("compare", "train_map")),
+        ("train_agents", "episodes", ("compare", "train_episodes")),
+        ("train_agents", "timeout_as", ("compare", "timeout_as")),
+        ("rollout", "map", ("eval", "map")),
+        ("rollout", "method", ("eval", "method")),
+        ("rollout", "episodes", ("eval", "episodes")),
+        ("rollout", "protocol", ("eval", "protocol")),
+        ("rollout", "seed", ("eval", "seed")),
+        ("evaluate", "episodes", ("eval", "episodes")),
+        ("evaluate", "seed", ("eval", "seed")),
+        ("evaluate_policy", "episodes", ("eval", "episodes")),
+        ("evaluate_policy", "protocol", ("eval", "protocol")),
+        ("evaluate_policy", "seed", ("eval", "seed")),
+    ],
+)
+def test_the_other_functions_take_the_requests_defaults(function: str, field: str, request_field: tuple[str, str]):
+    """A default the functions outside the requests spell (training episodes, the seed,
+    the maps) is the library's: a default changed by hand in one place fails here."""
+    from unforeseen.requests import COMPARE_DEFAULTS, EVAL_DEFAULTS
+
+    job, name = request_field
+    expected = {"compare": COMPARE_DEFAULTS, "eval": EVAL_DEFAULTS}[job][name]
+    assert inspect.signature(getattr(unforeseen, function)).parameters[field].default == expected
+
+
 def test_the_same_compare_and_eval_through_python_and_the_command_line_write_the_same_files(agent_file, tmp_path):
     cli = required_cli()
     common = ["--agent", str(agent_file), "--episodes", "2", "--seed", "5", "--set", "horizon=2", "--quiet"]
