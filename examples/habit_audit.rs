@@ -24,7 +24,7 @@ use unforeseen_agent::maths::argmax;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_env::{Env, EnvConfig};
-use unforeseen_harness::episodes::experiments::eval_seeds;
+use unforeseen_harness::episodes::evaluation::eval_seeds;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::runner::{EpisodeResult, run_episode};
 

@@ -16,7 +16,7 @@ use std::path::Path;
 
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_env::{Env, EnvConfig};
-use unforeseen_harness::episodes::experiments::eval_seeds;
+use unforeseen_harness::episodes::evaluation::eval_seeds;
 use unforeseen_harness::episodes::methods::{Method, scaled_agent};
 use unforeseen_harness::episodes::runner::run_episode;
 

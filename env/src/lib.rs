@@ -45,6 +45,7 @@
 
 pub mod kinematic;
 pub mod reward;
+pub mod seeds;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

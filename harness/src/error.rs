@@ -3,7 +3,7 @@
 //! file, a map, a flag, a results file), and say what is wrong and how to fix it; the
 //! others are failures of the machine or of a component (a file that cannot be written,
 //! an episode the env refused, a learner that cannot be built). [`Error::is_user_input`]
-//! tells them apart, and [`crate::user_input::in_chain`] over a chain of causes; only the fronts
+//! tells them apart, and [`in_chain`] over a chain of causes; only the fronts
 //! (the command line, the Python package) turn an error into a message and an exit code
 //! or an exception. The errors of other crates keep their own types and messages inside
 //! it (map errors, [`unforeseen_env::EnvError`], [`unforeseen_agent::error::AgentError`], ...).
@@ -124,7 +124,7 @@ pub enum Error {
     },
     /// No map of that name or path, or a map that does not validate.
     #[error(transparent)]
-    Map(#[from] MapLookupError),
+    Map(#[from] unforeseen_sim::embedded::LookupError),
     /// A map file that does not validate (every diagnostic).
     #[error(transparent)]
     MapFile(#[from] unforeseen_sim::MapError),
@@ -147,7 +147,7 @@ pub enum Error {
     Env(#[from] unforeseen_env::EnvError),
     /// An episode could not run (the controller chose an action the env refused).
     #[error(transparent)]
-    Episode(#[from] crate::episodes::runner::EpisodeError),
+    Episode(#[from] EpisodeError),
     /// A learner or an agent could not be built from its parameters and sizes.
     #[error(transparent)]
     Learner(#[from] unforeseen_agent::error::AgentError),
@@ -257,22 +257,37 @@ impl Error {
     }
 }
 
-/// Why a map could not be had.
+/// Whether `err` or anything in its chain of causes is input the user can fix: an
+/// [`Error`] for which [`Error::is_user_input`] holds, a map that cannot be found or
+/// loaded ([`unforeseen_sim::embedded::LookupError`], [`unforeseen_sim::MapError`]) or a bad
+/// deployment stream ([`StreamError`]). The command line exits with 2 for these and the
+/// Python package raises `ValueError`; anything else is a failure of the machine or of a
+/// component.
+pub fn in_chain(err: &(dyn std::error::Error + 'static)) -> bool {
+    let mut cause = Some(err);
+    while let Some(e) = cause {
+        let bad_input = e.downcast_ref::<Error>().is_some_and(Error::is_user_input)
+            || e.is::<unforeseen_sim::embedded::LookupError>()
+            || e.is::<StreamError>()
+            || e.is::<unforeseen_sim::MapError>();
+        if bad_input {
+            return true;
+        }
+        cause = e.source();
+    }
+    false
+}
+
+/// Why an episode could not run: the controller chose an action that is not one of the
+/// three (a bug in the controller, or a policy given from outside).
 #[derive(Debug, thiserror::Error)]
-pub enum MapLookupError {
-    /// Neither a readable file nor an embedded map of that name.
-    #[error(
-        "{arg}: no such map file, and no embedded map of that name (embedded maps: {names}); pass a path to a .ron map file"
-    )]
-    NotFound {
-        /// What the user passed.
-        arg: String,
-        /// The embedded names, comma separated.
-        names: String,
-    },
-    /// The file or embedded map did not validate (its diagnostics, printed once).
-    #[error(transparent)]
-    Invalid(#[from] unforeseen_sim::MapError),
+#[error("{controller}: {source}")]
+pub struct EpisodeError {
+    /// The controller's name.
+    pub controller: String,
+    /// What the env refused.
+    #[source]
+    pub source: unforeseen_env::EnvError,
 }
 
 /// A stream file that cannot be used.
@@ -319,6 +334,6 @@ pub enum StreamError {
         index: usize,
         /// Why the map could not be loaded.
         #[source]
-        source: MapLookupError,
+        source: unforeseen_sim::embedded::LookupError,
     },
 }

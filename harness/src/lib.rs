@@ -19,7 +19,8 @@
 //!   the [`metrics`](episodes::metrics) of the paper's table, the per-state
 //!   [`rewards`](episodes::rewards) (the C vector of §IV), the
 //!   [`survivability`](episodes::survivability) check of a scenario, the
-//!   [`experiments`](episodes::experiments) (evaluate under a protocol, `trace`, `learn`)
+//!   [`evaluation`](episodes::evaluation) of a method on a map under a protocol, one
+//!   [`trace`](episodes::trace)d episode, the test-time [`learning_curves`](episodes::learning_curves)
 //!   and the [`tick_recording`](episodes::tick_recording) of reasoning ticks for the
 //!   benches;
 //! * [`training`]: the training loop (Q-learning, the world model and Bayesian RL on the
@@ -36,17 +37,15 @@
 //!   [`LearnRequest`](runs::learn::LearnRequest), [`TraceRequest`](runs::trace::TraceRequest)),
 //!   the same value from every front, whose planning owns defaults, checks, agents, the
 //!   output guard and identity, and whose job writes its files;
-//! * [`external`]: methods given from outside the library (a Python policy), evaluated
-//!   by the same runner and reported as the batch's result lines;
-//! * [`reports`]: result [`files`](reports::files) written atomically, SVG
-//!   [`figures`](reports::figures) and the HTML [`replay_page`](reports::replay_page) of
-//!   an episode.
+//! * [`reports`]: what the jobs render with: SVG [`figures`](reports::figures), the HTML
+//!   [`replay_page`](reports::replay_page) of an episode and printed
+//!   [`tables`](reports::tables).
 //!
-//! Shared by all of them: [`maps`] finds a map by path or by embedded name,
+//! Shared by all of them: [`files`] are written atomically, [`maps`] finds a map by path or by embedded name,
 //! [`overrides`] applies `KEY=VALUE` parameter overrides, [`limits`] bounds what one
-//! run may ask for, [`seeds`] derives seeds,
+//! run may ask for (seeds derive in [`unforeseen_env::seeds`]),
 //! [`stats`] summarizes over seeds (mean, 95% Student-t interval, range, worst seed),
-//! [`error`] is the typed error every public function returns ([`user_input`] tells
+//! [`error`] is the typed error every public function returns (and tells
 //! which are input the user can fix), and [`progress`] is how
 //! long runs report progress ([`progress::Progress`]). The library prints nothing; its
 //! fronts (the command line, the Python package) choose messages and exit codes.
@@ -56,14 +55,12 @@
 
 pub mod episodes;
 pub mod error;
-pub mod external;
+pub mod files;
 pub mod limits;
 pub mod maps;
 pub mod overrides;
 pub mod progress;
 pub mod reports;
 pub mod runs;
-pub mod seeds;
 pub mod stats;
 pub mod training;
-pub mod user_input;

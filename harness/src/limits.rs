@@ -3,6 +3,10 @@
 
 use crate::error::Error;
 
+/// Evaluation episodes per method and map unless a job is given a number (`eval`,
+/// `compare`, `batch`).
+pub const DEFAULT_EPISODES: u64 = 100;
+
 /// Most episodes one run may ask for: a million takes about an hour per method and map
 /// here, and each episode keeps a result in memory; run more as shards or seeds.
 pub const MAX_EPISODES: u64 = 1_000_000;

@@ -4,29 +4,27 @@
 //! [`Method`]s and [`Protocol`]s ([`check_expectation_names`]).
 
 use std::path::Path;
-use unforeseen_sim::{Diagnostic, Map, MapError, embedded};
+use unforeseen_sim::embedded::{self, LookupError};
+use unforeseen_sim::{Diagnostic, EMBEDDED_PREFIX, Map, MapError};
 
 use crate::episodes::methods::Method;
 use crate::episodes::protocol::Protocol;
-pub use crate::error::MapLookupError;
+
+/// The map the jobs test on unless given one: the embedded jaywalk (the paper's
+/// unforeseen event).
+pub const DEFAULT_TEST_MAP: &str = "jaywalk";
 
 /// Loads `arg` as a map file if such a path exists, else as an embedded map name
-/// (with or without `.ron`).
-pub fn load(arg: &str) -> Result<Map, MapLookupError> {
-    let path = Path::new(arg);
-    if path.exists() {
-        return Ok(load_file(path)?);
-    }
-    let name = arg.strip_suffix(".ron").unwrap_or(arg);
-    if embedded::names().contains(&name) {
-        let map = embedded::load(name)?;
-        check_expectation_names(&map, &format!("embedded:{name}"))?;
-        return Ok(map);
-    }
-    Err(MapLookupError::NotFound {
-        arg: arg.to_string(),
-        names: embedded::names().join(", "),
-    })
+/// (with or without `.ron`), [`embedded::find`], and checks its expectations' names.
+pub fn load(arg: &str) -> Result<Map, LookupError> {
+    let map = embedded::find(arg)?;
+    let file = if Path::new(arg).exists() {
+        arg.to_string()
+    } else {
+        format!("{EMBEDDED_PREFIX}{}", arg.strip_suffix(".ron").unwrap_or(arg))
+    };
+    check_expectation_names(&map, &file)?;
+    Ok(map)
 }
 
 /// Loads a map file ([`Map::load`]) and checks its expectations' names

@@ -1,7 +1,7 @@
 //! The agents from Python: training and agent files ([`unforeseen_harness::training`],
 //! [`unforeseen_harness::training::agent_file`]), a controller of every method the command line has
 //! ([`unforeseen_harness::episodes::methods::Method`]) with parameters through `--set`'s path
-//! ([`unforeseen_harness::overrides`]), and the library's evaluation ([`unforeseen_harness::episodes::experiments`]).
+//! ([`unforeseen_harness::overrides`]), and the library's evaluation ([`unforeseen_harness::episodes::evaluation`]).
 
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -374,7 +374,7 @@ impl PyController {
 /// `(world, controller)` seeds of evaluation episode `episode` of the method named
 /// `method` on `map`, as `unforeseen eval` uses them: a built-in method's, or a Python
 /// policy's under the name its lines carry
-/// ([`unforeseen_harness::episodes::experiments::eval_seeds_named`]).
+/// ([`unforeseen_harness::episodes::evaluation::eval_seeds_named`]).
 #[pyfunction]
 fn eval_seeds(
     seed: &Bound<'_, PyAny>,
@@ -387,7 +387,7 @@ fn eval_seeds(
     let method = convert::text("method", method)?;
     let episode = convert::whole("episode", episode, convert::SEEDS)?;
     let map = crate::maps::load(&map.to_string_lossy(), None)?;
-    let s = unforeseen_harness::episodes::experiments::eval_seeds_named(seed, &map, &method, episode);
+    let s = unforeseen_harness::episodes::evaluation::eval_seeds_named(seed, &map, &method, episode);
     Ok((s.world, s.controller))
 }
 

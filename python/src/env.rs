@@ -21,7 +21,7 @@ use crate::render;
 
 /// World seed of episode `episode` of the stream keyed `key`.
 pub fn stream_seed(key: u64, episode: u64) -> u64 {
-    unforeseen_harness::seeds::episode_seed(key, "gymnasium", episode)
+    unforeseen_env::seeds::episode_seed(key, "gymnasium", episode)
 }
 
 /// [`stream_seed`] for Python: `key` and `episode` any whole numbers of `u64`.

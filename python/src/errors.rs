@@ -1,6 +1,6 @@
 //! Rust errors as Python exceptions. What the command line reports with exit code 2 (a
 //! bad map, agent file, parameter, ...;
-//! [`unforeseen_harness::user_input::in_chain`]) and what the env
+//! [`unforeseen_harness::error::in_chain`]) and what the env
 //! refuses as bad input (an action out of range, a configuration value) raise
 //! `ValueError` with the message the command line prints (after its `error: `);
 //! anything else raises `RuntimeError`.
@@ -13,7 +13,7 @@ type DynError = dyn std::error::Error + 'static;
 
 /// Whether `err` is bad input: exit code 2 on the command line, or an env input error.
 fn is_user_error(err: &DynError) -> bool {
-    if unforeseen_harness::user_input::in_chain(err) {
+    if unforeseen_harness::error::in_chain(err) {
         return true;
     }
     let mut cause = Some(err);

@@ -32,6 +32,7 @@ mod maps;
 mod policy;
 mod render;
 mod reports;
+mod requests;
 mod results;
 mod search_units;
 mod units;
@@ -69,6 +70,7 @@ fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     reports::register(m)?;
     wrapper::register(m)?;
     policy::register(m)?;
+    requests::register(m)?;
     units::register(m)?;
     search_units::register(m)?;
     Ok(())

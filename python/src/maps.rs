@@ -1,4 +1,4 @@
-//! Maps from Python: a file or embedded name ([`unforeseen_harness::maps::load`], the command
+//! Maps from Python: a file or embedded name ([`unforeseen_sim::embedded::find`], the command
 //! line's lookup) with keyword overrides (`max_steps=60`, `lane_width=3.0`,
 //! `episode__max_steps=60`). Overrides become a RON patch laid over the loaded map
 //! (`base:` the map itself) and go through the map loader, so a bad value fails with the
@@ -15,7 +15,7 @@ const BASE: &str = "<the map being overridden>";
 
 /// Loads `arg` (a map file or an embedded name) and applies `overrides`.
 pub fn load(arg: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Map> {
-    let map = unforeseen_harness::maps::load(arg).map_err(errors::to_py)?;
+    let map = unforeseen_sim::embedded::find(arg).map_err(errors::to_py)?;
     match overrides {
         Some(o) if !o.is_empty() => {
             let sections = sections();

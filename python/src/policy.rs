@@ -3,7 +3,7 @@
 //! `(d, v, L, p)`, or the float32 kinematic vector), and the controllers here implement
 //! the runner's [`Controller`] around it, so that a Python policy runs in the loop, and is
 //! reported by the builders, of the command line's methods
-//! ([`unforeseen_harness::external`]). Python computes no figure.
+//! ([`unforeseen_harness::runs::outside_methods`]). Python computes no figure.
 //!
 //! The one protocol a Python policy follows (`unforeseen.evaluate` documents it): a
 //! callable `policy(obs) -> action`, or an object with `act(obs) -> action`; optionally
@@ -26,9 +26,9 @@ use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_discretizer::Discretizer;
 use unforeseen_env::{EnvConfig, Observation, ObservationForm};
 use unforeseen_harness::error::Error;
-use unforeseen_harness::external::{ExternalMethod, ExternalRun, LinePlace, evaluate_external};
 use unforeseen_harness::progress::{Message, Progress};
 use unforeseen_harness::runs::batch::load_scenarios;
+use unforeseen_harness::runs::outside_methods::{ExternalMethod, ExternalRun, LinePlace, evaluate_external};
 
 use crate::convert;
 use crate::errors;

@@ -10,9 +10,11 @@ use pyo3::exceptions::{PyImportError, PyKeyError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use serde_json::{Map, Value};
-use unforeseen_harness::reports::tables::{self, Document};
+use unforeseen_harness::reports::tables::Document;
+use unforeseen_harness::runs::batch::table::{batch_summary, expectation_failures};
 use unforeseen_harness::runs::batch::{ResultLine, summarize};
 use unforeseen_harness::runs::compare::CompareReport;
+use unforeseen_harness::runs::compare::table::compare;
 use unforeseen_harness::runs::evaluate::EvalOutcome;
 
 use crate::errors;
@@ -257,7 +259,7 @@ impl CompareResult {
         Ok(CompareResult {
             report: Report {
                 data,
-                doc: tables::compare(report),
+                doc: compare(report),
                 rows,
             },
         })
@@ -348,11 +350,11 @@ impl BatchResult {
         data.insert("summary".into(), rows.clone());
         let checked: usize = summary.iter().map(|r| r.checks.len()).sum();
         data.insert("checked".into(), checked.into());
-        data.insert("failures".into(), tables::expectation_failures(&summary).into());
+        data.insert("failures".into(), expectation_failures(&summary).into());
         let data = Value::Object(data);
         Ok(BatchResult {
             report: Report {
-                doc: tables::batch_summary(&summary),
+                doc: batch_summary(&summary),
                 rows: rows.as_array().cloned().unwrap_or_default(),
                 data,
             },

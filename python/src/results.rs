@@ -112,12 +112,12 @@ impl ResultsGuard {
 }
 
 /// Writes `text` to `path` as every job of the library writes its files
-/// ([`unforeseen_harness::reports::files::write_atomic`]: a temporary file beside it,
+/// ([`unforeseen_harness::files::write_atomic`]: a temporary file beside it,
 /// renamed over it), so a reader never sees half of it.
 #[pyfunction]
 fn write_atomic(py: Python<'_>, path: &Bound<'_, PyAny>, text: &str) -> PyResult<()> {
     let path = crate::convert::path("path", path)?;
-    py.detach(|| unforeseen_harness::reports::files::write_atomic(&path, text.as_bytes()))
+    py.detach(|| unforeseen_harness::files::write_atomic(&path, text.as_bytes()))
         .map_err(errors::to_py)
 }
 

@@ -26,7 +26,8 @@ use unforeseen_harness::training::seed_agents::Agent;
 use crate::agent::PyAgent;
 use crate::errors;
 use crate::interrupt::{interruptible, interruptible_then};
-use crate::units::{parse_agent, request};
+use crate::requests::request;
+use crate::units::parse_agent;
 
 /// A search rebuilt from its request and the agents given (what [`SearchConfig`]
 /// borrows).

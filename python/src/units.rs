@@ -41,7 +41,7 @@ pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
 /// map): an embedded map's name, or the map file's absolute path (a node's working
 /// folder is not the driver's).
 fn locate(source: &str) -> String {
-    match source.strip_prefix("embedded:") {
+    match source.strip_prefix(unforeseen_sim::EMBEDDED_PREFIX) {
         Some(name) => name.to_string(),
         None if !Path::new(source).exists() => source.to_string(),
         None => std::fs::canonicalize(source)
@@ -49,37 +49,6 @@ fn locate(source: &str) -> String {
             .display()
             .to_string(),
     }
-}
-
-/// The request of a job (`BatchRequest`, `SearchRequest`) from the JSON text of its
-/// fields (Python's keyword arguments); errors name the field
-/// ([`unforeseen_harness::runs::request::from_fields`]).
-pub(crate) fn request<T>(fields: &str) -> PyResult<T>
-where
-    T: serde::Serialize + serde::de::DeserializeOwned + Default,
-{
-    let fields: serde_json::Map<String, Value> =
-        serde_json::from_str(fields).map_err(|e| errors::value(format!("request: not a JSON object ({e})")))?;
-    unforeseen_harness::runs::request::from_fields(fields).map_err(errors::to_py)
-}
-
-/// The fields of the request of `job` (`batch`, `search`, `compare` or `eval`) with
-/// their defaults, as JSON text: what the Python functions of that job take.
-#[pyfunction]
-fn request_defaults(job: &str) -> PyResult<String> {
-    use unforeseen_harness::runs::request::defaults;
-    let defaults = match job {
-        "batch" => defaults::<BatchRequest>(),
-        "search" => defaults::<unforeseen_harness::runs::search::SearchRequest>(),
-        "compare" => defaults::<unforeseen_harness::runs::compare::CompareRequest>(),
-        "eval" => defaults::<unforeseen_harness::runs::evaluate::EvalRequest>(),
-        other => {
-            return Err(errors::value(format!(
-                "job: no request named '{other}'; the jobs are batch, search, compare, eval"
-            )));
-        }
-    };
-    Ok(defaults.map_err(errors::to_py)?.to_string())
 }
 
 /// Plans the batch `request` (JSON text of its fields) as `unforeseen batch` does (the
@@ -187,7 +156,7 @@ static PARSED: Mutex<Option<HashMap<String, Agent>>> = Mutex::new(None);
 const MAX_PARSED: usize = 16;
 
 pub(crate) fn parse_agent(text: &[u8]) -> PyResult<Agent> {
-    let key = unforeseen_harness::seeds::content_hash(text);
+    let key = unforeseen_env::seeds::content_hash(text);
     let mut parsed = PARSED.lock().unwrap_or_else(|e| e.into_inner());
     let map = parsed.get_or_insert_with(HashMap::new);
     if let Some(a) = map.get(&key) {
@@ -231,7 +200,7 @@ fn run_units(
     let located: Vec<(String, String)> = from(&spec, "scenarios")?;
     let mut scenarios = Vec::new();
     for (source, place) in &located {
-        let map = if source.starts_with("embedded:") {
+        let map = if source.starts_with(unforeseen_sim::EMBEDDED_PREFIX) {
             unforeseen_harness::maps::load(place).map_err(errors::to_py)?
         } else {
             unforeseen_harness::maps::load_file(Path::new(place)).map_err(errors::to_py)?
@@ -323,7 +292,6 @@ fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<BatchResult> {
 
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(check_batch, m)?)?;
     m.add_function(wrap_pyfunction!(plan_batch, m)?)?;
     m.add_function(wrap_pyfunction!(train_agent, m)?)?;

@@ -1,5 +1,6 @@
 //! The maps shipped in `maps/`, compiled into the binary. Bases named in an
-//! embedded map (e.g. `base: "jaywalk.ron"`) resolve among these.
+//! embedded map (e.g. `base: "jaywalk.ron"`) resolve among these. [`find`] takes what a
+//! user gives: a map file's path, or an embedded map's name.
 
 use crate::load::{Diagnostic, MapError};
 use crate::map::Map;
@@ -25,6 +26,41 @@ pub fn load(name: &str) -> Result<Map, MapError> {
             let b = base.strip_suffix(".ron").unwrap_or(base);
             (format!("{b}.ron"), s.to_string())
         })
+    })
+}
+
+/// Why a map could not be had.
+#[derive(Debug, thiserror::Error)]
+pub enum LookupError {
+    /// Neither a readable file nor an embedded map of that name.
+    #[error(
+        "{arg}: no such map file, and no embedded map of that name (embedded maps: {names}); pass a path to a .ron map file"
+    )]
+    NotFound {
+        /// What the user passed.
+        arg: String,
+        /// The embedded names, comma separated.
+        names: String,
+    },
+    /// The file or embedded map did not validate (its diagnostics, printed once).
+    #[error(transparent)]
+    Invalid(#[from] MapError),
+}
+
+/// Loads `arg` as a map file if such a path exists, else as an embedded map name (with
+/// or without `.ron`).
+pub fn find(arg: &str) -> Result<Map, LookupError> {
+    let path = std::path::Path::new(arg);
+    if path.exists() {
+        return Ok(Map::load(path)?);
+    }
+    let name = arg.strip_suffix(".ron").unwrap_or(arg);
+    if names().contains(&name) {
+        return Ok(load(name)?);
+    }
+    Err(LookupError::NotFound {
+        arg: arg.to_string(),
+        names: names().join(", "),
     })
 }
 

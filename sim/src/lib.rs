@@ -36,7 +36,7 @@ mod validate;
 pub mod world;
 
 pub use light::{LightPhase, light_at};
-pub use load::{Diagnostic, MAX_BASE_DEPTH, MAX_FILE_BYTES, MAX_NESTING, MapError};
+pub use load::{Diagnostic, EMBEDDED_PREFIX, MAX_BASE_DEPTH, MAX_FILE_BYTES, MAX_NESTING, MapError};
 pub use map::{
     Bins, Crosswalk, CrosswalkBins, DistanceEdges, Episode, Expectation, Light, LightCondition, Map, Offset, Pause,
     Phase, Reward, Road, Side, SpawnRule, Trigger, Vehicle,

@@ -105,8 +105,9 @@ impl fmt::Display for MapError {
 
 impl std::error::Error for MapError {}
 
-/// How the origin of an embedded base map starts in diagnostics (`embedded:jaywalk`).
-const EMBEDDED_PREFIX: &str = "embedded:";
+/// How an embedded map's origin starts, in diagnostics and in results' sources
+/// (`embedded:jaywalk`).
+pub const EMBEDDED_PREFIX: &str = "embedded:";
 
 /// A base map found by a resolver.
 pub(crate) struct Resolved {
@@ -452,40 +453,44 @@ fn build(origin: &str, src: &str, resolve: &Resolver, chain: &mut Vec<String>) -
     Ok(patch.apply(base, &stem(origin)))
 }
 
-/// Syntax check, unknown-field scan (all of them), then typed parse.
+/// Typed parse; only when it fails, the unknown-field scan over the untyped value, so
+/// that every unknown field is reported, not only the first one serde stops at (a valid
+/// file is parsed once).
 fn parse_patch(origin: &str, src: &str) -> Result<MapPatch, MapError> {
     let opts = ron_options();
-    let value: ron::Value = opts.from_str(src).map_err(|e| MapError::one(spanned(origin, "", &e)))?;
-    if is_agent_file(&value) {
-        return Err(MapError::one(Diagnostic::new(
-            origin,
-            "",
-            "is an agent file, not a map (it has the `format_version` and `world_model` that `unforeseen train` writes)",
-            Some(
-                "give a map file (e.g. maps/jaywalk.ron) or an embedded map's name; an agent file goes after --agent"
-                    .into(),
-            ),
-        )));
-    }
-    let mut unknown = Vec::new();
-    walk(&value, Kind::Map, "", origin, &mut unknown);
-    if !unknown.is_empty() {
-        return Err(MapError::new(unknown));
-    }
-    let mut de =
-        ron::Deserializer::from_str_with_options(src, &opts).map_err(|e| MapError::one(spanned(origin, "", &e)))?;
-    let patch: MapPatch = match serde_path_to_error::deserialize(&mut de) {
-        Ok(p) => p,
-        Err(e) => {
+    let typed = || -> Result<MapPatch, Diagnostic> {
+        let mut de = ron::Deserializer::from_str_with_options(src, &opts).map_err(|e| spanned(origin, "", &e))?;
+        let patch: MapPatch = serde_path_to_error::deserialize(&mut de).map_err(|e| {
             let path = e.path().to_string();
             let path = if path == "." { String::new() } else { path };
             let err = de.span_error(e.into_inner());
-            return Err(MapError::one(spanned(origin, &path, &err)));
-        }
+            spanned(origin, &path, &err)
+        })?;
+        de.end().map_err(|e| spanned(origin, "", &de.span_error(e)))?;
+        Ok(patch)
     };
-    de.end()
-        .map_err(|e| MapError::one(spanned(origin, "", &de.span_error(e))))?;
-    Ok(patch)
+    typed().map_err(|first| {
+        let mut unknown = Vec::new();
+        if let Ok(value) = opts.from_str::<ron::Value>(src) {
+            if is_agent_file(&value) {
+                return MapError::one(Diagnostic::new(
+                    origin,
+                    "",
+                    "is an agent file, not a map (it has the `format_version` and `world_model` that `unforeseen train` writes)",
+                    Some(
+                        "give a map file (e.g. maps/jaywalk.ron) or an embedded map's name; an agent file goes after --agent"
+                            .into(),
+                    ),
+                ));
+            }
+            walk(&value, Kind::Map, "", origin, &mut unknown);
+        }
+        if unknown.is_empty() {
+            MapError::one(first)
+        } else {
+            MapError::new(unknown)
+        }
+    })
 }
 
 /// Whether `value`, a file's top level, is an agent file (its `format_version` and

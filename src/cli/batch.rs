@@ -9,9 +9,8 @@ use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::ProtocolChoice;
-use unforeseen_harness::reports::tables;
+use unforeseen_harness::runs::batch::table as tables;
 use unforeseen_harness::runs::batch::{AgentChoice, BatchRequest, ScenarioKind, Shard, SummaryRow, stream_learning};
-use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `batch`.
 #[derive(Debug, Clone, Args)]
@@ -26,10 +25,10 @@ pub struct BatchArgs {
     #[arg(long, value_name = "FILE", conflicts_with = "maps")]
     pub stream: Option<PathBuf>,
     /// Episodes per (scenario, method, parameter set, protocol, training seed).
-    #[arg(long, default_value_t = 100, value_parser = super::episodes)]
+    #[arg(long, default_value_t = BatchRequest::default().episodes, value_parser = super::episodes)]
     pub episodes: u64,
     /// Evaluation seed (and, without --agent or --train-seeds, the training seed).
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = BatchRequest::default().seed)]
     pub seed: u64,
     /// Methods to run (repeatable); default: q-learning, bayes-rl, scaled and the
     /// scripted references brake-on-pedestrian and never-brake (so every map reports
@@ -39,14 +38,14 @@ pub struct BatchArgs {
     /// Evaluation protocol: zero-shot (every episode starts from the trained agent),
     /// continual (learning carries over between episodes, in order) or both. A method
     /// that does not learn across episodes runs once; its line covers both.
-    #[arg(long, default_value = "both", value_parser = super::protocol_choice_parser())]
+    #[arg(long, default_value_t = BatchRequest::default().protocol, value_parser = super::protocol_choice_parser())]
     pub protocol: ProtocolChoice,
     /// Worker threads (results do not depend on it); default: every core.
     #[arg(long, value_parser = jobs)]
     pub jobs: Option<usize>,
     /// Results file (JSON Lines), one line per unit as soon as it finishes; the summary
     /// over training seeds goes beside it (`results.summary.json`).
-    #[arg(long, value_name = "FILE", default_value = "results.jsonl")]
+    #[arg(long, value_name = "FILE", default_value_os_t = BatchRequest::default().out)]
     pub out: PathBuf,
     /// Keep the complete lines already in --out and run only the missing units. The file
     /// must have been written by the same run (same program, agents, maps, methods,
@@ -65,14 +64,14 @@ pub struct BatchArgs {
     #[arg(long = "set", value_name = "KEY=V1,V2")]
     pub sweep: Vec<String>,
     /// Training episodes when no --agent is given.
-    #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
+    #[arg(long, default_value_t = BatchRequest::default().train_episodes, value_parser = super::episodes)]
     pub train_episodes: u64,
     /// Agent file from `unforeseen train` (default: train on --train-map).
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
     /// Training map (file or embedded name) when no --agent is given: the agent (or, with
     /// --train-seeds, each agent) is trained there.
-    #[arg(long, value_name = "MAP", default_value = DEFAULT_TRAIN_MAP, conflicts_with = "agent")]
+    #[arg(long, value_name = "MAP", default_value_t = BatchRequest::default().train_map, conflicts_with = "agent")]
     pub train_map: String,
     /// Training seeds and the agent cache.
     #[command(flatten)]

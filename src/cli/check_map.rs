@@ -19,7 +19,7 @@ pub struct CheckMapArgs {
     #[arg(long, value_name = "N", default_value_t = survivability::DEFAULT_EPISODES, value_parser = super::episodes_or_none)]
     pub survivability_episodes: u64,
     /// Run seed of the witnesses' episodes (the same episodes as `eval`/`batch --seed`).
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = unforeseen_env::seeds::DEFAULT_SEED)]
     pub seed: u64,
 }
 

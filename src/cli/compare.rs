@@ -9,25 +9,24 @@ use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::protocol::ProtocolChoice;
-use unforeseen_harness::reports::tables;
 use unforeseen_harness::runs::batch::AgentChoice;
+use unforeseen_harness::runs::compare::table as tables;
 use unforeseen_harness::runs::compare::{COMPARE_FILES, CompareRequest};
-use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
 
 /// Arguments of `compare`.
 #[derive(Debug, Clone, Args)]
 pub struct CompareArgs {
     /// Training map (file or embedded name).
-    #[arg(long, default_value = DEFAULT_TRAIN_MAP)]
+    #[arg(long, default_value_t = CompareRequest::default().train_map)]
     pub train_map: String,
     /// Test map with the unforeseen scenario (file or embedded name).
-    #[arg(long, default_value = "jaywalk")]
+    #[arg(long, default_value_t = CompareRequest::default().test_map)]
     pub test_map: String,
     /// Training episodes when no --agent is given.
-    #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
+    #[arg(long, default_value_t = CompareRequest::default().train_episodes, value_parser = super::episodes)]
     pub train_episodes: u64,
     /// Evaluation episodes per method, map and agent.
-    #[arg(long, default_value_t = 100, value_parser = super::episodes)]
+    #[arg(long, default_value_t = CompareRequest::default().episodes, value_parser = super::episodes)]
     pub episodes: u64,
     /// Also run the ablations (bayes-rl-factored, scaled-always, scaled-no-learning).
     #[arg(long)]
@@ -35,11 +34,11 @@ pub struct CompareArgs {
     /// Evaluation protocol: zero-shot (every test episode starts from the trained agent,
     /// the paper's table), continual (learning carries over between test episodes, in
     /// order) or both (zero-shot table first).
-    #[arg(long, default_value = "both", value_parser = super::protocol_choice_parser())]
+    #[arg(long, default_value_t = CompareRequest::default().protocol, value_parser = super::protocol_choice_parser())]
     pub protocol: ProtocolChoice,
     /// Output folder for compare.json, compare.csv, compare_seeds.csv and compare.svg
     /// (files from an earlier run there are replaced, with a warning).
-    #[arg(long, value_name = "DIR", default_value = "out/compare")]
+    #[arg(long, value_name = "DIR", default_value_os_t = CompareRequest::default().out.unwrap_or_default())]
     pub out: PathBuf,
     /// Training seeds and the agent cache.
     #[command(flatten)]
@@ -50,28 +49,15 @@ pub struct CompareArgs {
 }
 
 impl Default for CompareArgs {
+    /// The flags' defaults: `unforeseen compare` with no arguments (what `cargo run`
+    /// runs), so that no default is spelled twice.
     fn default() -> Self {
-        Self {
-            train_map: DEFAULT_TRAIN_MAP.into(),
-            test_map: "jaywalk".into(),
-            train_episodes: DEFAULT_TRAIN_EPISODES,
-            episodes: 100,
-            ablations: false,
-            protocol: ProtocolChoice::Both,
-            out: PathBuf::from("out/compare"),
-            seeds: TrainSeedArgs {
-                train_seeds: None,
-                cache: unforeseen_harness::training::seed_agents::DEFAULT_CACHE.into(),
-                no_cache: false,
-                timeout_as: unforeseen_harness::training::TimeoutAs::Truncation,
-            },
-            agent: AgentArgs {
-                agent: None,
-                set: Vec::new(),
-                seed: 7,
-                quiet: false,
-            },
+        #[derive(clap::Parser)]
+        struct Flags {
+            #[command(flatten)]
+            args: CompareArgs,
         }
+        <Flags as clap::Parser>::parse_from(["unforeseen"]).args
     }
 }
 

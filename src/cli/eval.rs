@@ -14,23 +14,23 @@ use unforeseen_harness::runs::evaluate::{EVAL_FILE, EvalRequest, EvalScene};
 #[derive(Debug, Clone, Args)]
 pub struct EvalArgs {
     /// Map to evaluate on (file or embedded name).
-    #[arg(long, default_value = "jaywalk")]
+    #[arg(long, default_value_t = EvalRequest::default().map)]
     pub map: String,
     /// Method to evaluate (the scripted `brake-on-pedestrian` and `never-brake` need
     /// no agent: `--agent` is then ignored and nothing is trained).
-    #[arg(long, default_value_t = Method::Scaled, value_parser = super::method_parser())]
+    #[arg(long, default_value_t = EvalRequest::default().method, value_parser = super::method_parser())]
     pub method: Method,
     /// Episodes.
-    #[arg(long, default_value_t = 100, value_parser = super::episodes)]
+    #[arg(long, default_value_t = EvalRequest::default().episodes, value_parser = super::episodes)]
     pub episodes: u64,
     /// Evaluation protocol: zero-shot (default; every episode starts from the trained
     /// agent, as in the paper's table) or continual (learning carries over between
     /// episodes, in order).
-    #[arg(long, default_value_t = Protocol::ZeroShot, value_parser = super::protocol_parser())]
+    #[arg(long, default_value_t = EvalRequest::default().protocol, value_parser = super::protocol_parser())]
     pub protocol: Protocol,
     /// Output folder for eval.json (an eval.json from an earlier run there is replaced,
     /// with a warning).
-    #[arg(long, value_name = "DIR", default_value = "out/eval")]
+    #[arg(long, value_name = "DIR", default_value_os_t = EvalRequest::default().out.unwrap_or_default())]
     pub out: PathBuf,
     /// A deployment stream (a RON file listing maps with weights or a sequence; see
     /// `harness/src/runs/stream.rs` and `maps/streams/`): run the episodes over its maps instead of

@@ -11,7 +11,7 @@ use unforeseen_agent::inspect::InspectModel;
 
 use super::AgentArgs;
 use unforeseen_harness::error::Error;
-use unforeseen_harness::reports::files::write_json;
+use unforeseen_harness::files::write_json;
 
 /// Arguments of `export-model`.
 #[derive(Debug, Clone, Args)]

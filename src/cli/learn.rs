@@ -14,14 +14,14 @@ use unforeseen_harness::runs::learn::{LEARN_FILES, LearnReport, LearnRequest, Ma
 #[derive(Debug, Clone, Args)]
 pub struct LearnArgs {
     /// Map with the unforeseen scenario (file or embedded name).
-    #[arg(long, default_value = "jaywalk")]
+    #[arg(long, default_value_t = LearnRequest::default().map)]
     pub map: String,
     /// Episodes of test-time learning.
-    #[arg(long, default_value_t = 50, value_parser = super::episodes)]
+    #[arg(long, default_value_t = LearnRequest::default().episodes, value_parser = super::episodes)]
     pub episodes: u64,
     /// Output folder for learn.csv, learn.json and learn.svg (files from an earlier run
     /// there are replaced, with a warning).
-    #[arg(long, value_name = "DIR", default_value = "out/learn")]
+    #[arg(long, value_name = "DIR", default_value_os_t = LearnRequest::default().out.unwrap_or_default())]
     pub out: PathBuf,
     /// A deployment stream (a RON file listing maps with weights or a sequence; see
     /// `harness/src/runs/stream.rs` and `maps/streams/`): learn across its maps instead of `--map`;

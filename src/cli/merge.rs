@@ -5,7 +5,7 @@ use clap::Args;
 use std::path::PathBuf;
 
 use super::batch::print_summary;
-use unforeseen_harness::reports::tables;
+use unforeseen_harness::runs::batch::table as tables;
 use unforeseen_harness::runs::merge::{merge, write_merged};
 use unforeseen_harness::runs::outputs::Outputs;
 

@@ -169,13 +169,9 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
 
 /// The exit code for an error (a library error, or an [`anyhow::Error`] as `&*err`): 2
 /// when it or anything in its chain of causes is input the user can fix
-/// ([`unforeseen_harness::user_input::in_chain`]), 1 otherwise.
+/// ([`unforeseen_harness::error::in_chain`]), 1 otherwise.
 pub fn exit_code(err: &(dyn std::error::Error + 'static)) -> i32 {
-    if unforeseen_harness::user_input::in_chain(err) {
-        2
-    } else {
-        1
-    }
+    if unforeseen_harness::error::in_chain(err) { 2 } else { 1 }
 }
 
 /// A failed command's message: the error and its causes (`outer: inner: ...`), with a
@@ -259,7 +255,7 @@ pub struct AgentArgs {
     #[arg(long = "set", value_name = "KEY=VALUE", help = unforeseen_harness::overrides::help())]
     pub set: Vec<String>,
     /// Run seed: the evaluation episodes and, without `--agent`, the training run derive from it.
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = unforeseen_env::seeds::DEFAULT_SEED)]
     pub seed: u64,
     /// No progress bars.
     #[arg(long, short)]
@@ -377,5 +373,41 @@ pub fn warn_replacing(dir: &std::path::Path, names: &[&str]) {
             existing.join(", "),
             dir.display()
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use unforeseen_harness::runs::compare::CompareRequest;
+    use unforeseen_harness::runs::evaluate::EvalRequest;
+    use unforeseen_harness::runs::learn::LearnRequest;
+    use unforeseen_harness::runs::trace::TraceRequest;
+
+    fn command(args: &[&str]) -> Command {
+        Cli::parse_from(args).command.expect("a command")
+    }
+
+    /// The flags' defaults are the requests' (batch and search check theirs beside their
+    /// arguments), and `cargo run` with no command runs compare's defaults.
+    #[test]
+    fn the_flags_defaults_are_the_requests() {
+        let Command::Compare(compare) = command(&["unforeseen", "compare"]) else {
+            panic!("not compare")
+        };
+        assert_eq!(compare.request(), CompareRequest::default());
+        assert_eq!(compare::CompareArgs::default().request(), CompareRequest::default());
+        let Command::Eval(eval) = command(&["unforeseen", "eval"]) else {
+            panic!("not eval")
+        };
+        assert_eq!(eval.request(), EvalRequest::default());
+        let Command::Learn(learn) = command(&["unforeseen", "learn"]) else {
+            panic!("not learn")
+        };
+        assert_eq!(learn.request(), LearnRequest::default());
+        let Command::Trace(trace) = command(&["unforeseen", "trace"]) else {
+            panic!("not trace")
+        };
+        assert_eq!(trace.request(), TraceRequest::default());
     }
 }

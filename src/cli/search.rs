@@ -9,41 +9,41 @@ use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::runs::batch::Shard;
-use unforeseen_harness::runs::search::{self, SearchRequest, Summary};
-use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, DEFAULT_TRAIN_MAP};
+use unforeseen_harness::runs::search::{SearchRequest, Summary};
+use unforeseen_harness::training::DEFAULT_TRAIN_MAP;
 
 /// Arguments of `search`.
 #[derive(Debug, Clone, Args)]
 pub struct SearchArgs {
     /// Base map (file or embedded name) that the space varies.
-    #[arg(long, value_name = "MAP", default_value = "jaywalk")]
+    #[arg(long, value_name = "MAP", default_value_t = SearchRequest::default().map)]
     pub map: String,
     /// Space file (RON; maps/README.md, "Space files"), e.g. maps/spaces/jaywalk.ron.
     #[arg(long, value_name = "FILE")]
     pub space: PathBuf,
     /// The method searched for failures.
-    #[arg(long, default_value = "scaled", value_parser = super::method_parser())]
+    #[arg(long, default_value_t = SearchRequest::default().method, value_parser = super::method_parser())]
     pub method: Method,
     /// The method's evaluation protocol on each candidate.
-    #[arg(long, default_value = "zero-shot", value_parser = super::protocol_parser())]
+    #[arg(long, default_value_t = SearchRequest::default().protocol, value_parser = super::protocol_parser())]
     pub protocol: Protocol,
     /// Candidates of the Sobol and adaptive stages (minimisation tries come on top).
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = SearchRequest::default().budget)]
     pub budget: usize,
     /// Episodes per candidate, for each witness and for the method (per training seed).
-    #[arg(long, default_value_t = 20, value_parser = super::episodes)]
+    #[arg(long, default_value_t = SearchRequest::default().episodes, value_parser = super::episodes)]
     pub episodes: u64,
     /// Run seed: Sobol scrambling, adaptive draws and every episode derive from it.
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = SearchRequest::default().seed)]
     pub seed: u64,
     /// Share of the budget for the Sobol stage (the unbiased estimate), in (0, 1].
-    #[arg(long, default_value_t = search::DEFAULT_SOBOL_SHARE)]
+    #[arg(long, default_value_t = SearchRequest::default().sobol_share)]
     pub sobol_share: f64,
     /// Rounds of the adaptive (cross-entropy) stage.
-    #[arg(long, default_value_t = search::DEFAULT_ROUNDS)]
+    #[arg(long, default_value_t = SearchRequest::default().rounds)]
     pub rounds: usize,
     /// Failures minimised and written as maps.
-    #[arg(long, default_value_t = search::DEFAULT_MAX_FAILURES)]
+    #[arg(long, default_value_t = SearchRequest::default().max_failures)]
     pub max_failures: usize,
     /// Worker threads (results do not depend on it); default: every core.
     #[arg(long)]
@@ -58,14 +58,14 @@ pub struct SearchArgs {
     pub resume: bool,
     /// Output folder: candidates.jsonl, summary.json, search.svg and failures/*.ron.
     /// No input may be inside it.
-    #[arg(long, value_name = "DIR", default_value = "out/search")]
+    #[arg(long, value_name = "DIR", default_value_os_t = SearchRequest::default().out)]
     pub out: PathBuf,
     /// Replace files in --out that a search did not write (a failure map edited by hand,
     /// a file of another program); without it they are refused.
     #[arg(long)]
     pub force: bool,
     /// Training episodes when no --agent is given.
-    #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
+    #[arg(long, default_value_t = SearchRequest::default().train_episodes, value_parser = super::episodes)]
     pub train_episodes: u64,
     /// Agent file from `unforeseen train` (default: train on the embedded intersection map).
     #[arg(long, value_name = "FILE")]

@@ -9,21 +9,21 @@ use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::reports::files::num;
+use unforeseen_harness::files::num;
 use unforeseen_harness::runs::trace::{TRACE_FILES, TraceReport, TraceRequest, mode, surprise_bits};
 
 /// Arguments of `trace`.
 #[derive(Debug, Clone, Args)]
 pub struct TraceArgs {
     /// Map (file or embedded name).
-    #[arg(long, default_value = "jaywalk")]
+    #[arg(long, default_value_t = TraceRequest::default().map)]
     pub map: String,
     /// Method to trace.
-    #[arg(long, default_value_t = Method::Scaled, value_parser = super::method_parser())]
+    #[arg(long, default_value_t = TraceRequest::default().method, value_parser = super::method_parser())]
     pub method: Method,
     /// Output folder for trace.csv, theta.svg and filmstrip.svg (files from an earlier
     /// run there are replaced, with a warning).
-    #[arg(long, value_name = "DIR", default_value = "out/trace")]
+    #[arg(long, value_name = "DIR", default_value_os_t = TraceRequest::default().out.unwrap_or_default())]
     pub out: PathBuf,
     /// Also write the episode as one self-contained HTML page (no network) that plays
     /// the car, the pedestrians and the light beside theta and the actions, with a
@@ -32,11 +32,11 @@ pub struct TraceArgs {
     pub html: Option<PathBuf>,
     /// Evaluation episode to trace (0 = the first). Under `--protocol continual` the agent
     /// first runs and learns from episodes 0..N, as a continual evaluation does.
-    #[arg(long, default_value_t = 0, value_parser = super::episode_index)]
+    #[arg(long, default_value_t = TraceRequest::default().episode, value_parser = super::episode_index)]
     pub episode: u64,
     /// Evaluation protocol of the traced episode: zero-shot (from the trained state) or
     /// continual (after learning from the episodes before it).
-    #[arg(long, default_value_t = Protocol::ZeroShot, value_parser = super::protocol_parser())]
+    #[arg(long, default_value_t = TraceRequest::default().protocol, value_parser = super::protocol_parser())]
     pub protocol: Protocol,
     /// Trained agent, parameter overrides, seed and progress.
     #[command(flatten)]

@@ -20,7 +20,7 @@ pub struct TrainArgs {
     #[arg(long, default_value_t = DEFAULT_TRAIN_EPISODES, value_parser = super::episodes)]
     pub episodes: u64,
     /// Run seed.
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = unforeseen_env::seeds::DEFAULT_SEED)]
     pub seed: u64,
     /// Agent file to write (RON).
     #[arg(long, value_name = "FILE", default_value = "agent.ron")]

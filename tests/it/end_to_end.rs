@@ -6,10 +6,12 @@ use crate::common;
 
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_harness::episodes::experiments::{evaluate, learn, trace};
+use unforeseen_harness::episodes::evaluation::evaluate;
+use unforeseen_harness::episodes::learning_curves::learn;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::metrics::Aggregate;
 use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::trace::trace;
 use unforeseen_harness::progress::NoProgress;
 
 #[test]
@@ -63,7 +65,7 @@ fn test_time_learning_makes_the_jaywalk_familiar_without_a_crash() {
     let points = learn(bundle, &ScaledParams::default(), &jaywalk, 30, 3, &NoProgress).unwrap();
     let (first, last) = (&points[0], points.last().unwrap());
     assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
-    let surprise = |p: &unforeseen_harness::episodes::experiments::LearnPoint| p.event_surprise_bits.unwrap();
+    let surprise = |p: &unforeseen_harness::episodes::learning_curves::LearnPoint| p.event_surprise_bits.unwrap();
     assert!(surprise(last) < 0.5 * surprise(first), "surprise {first:?} -> {last:?}");
     assert!(last.p_pedestrian_green_d2.unwrap() > first.p_pedestrian_green_d2.unwrap() + 0.3);
     assert!(last.p_slow_down > first.p_slow_down, "habit {first:?} -> {last:?}");
@@ -119,7 +121,7 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
     let reasoning = |params: &ScaledParams| {
         let points = learn(bundle, params, &map, 30, 3, &NoProgress).unwrap();
         assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
-        let ticks = |ps: &[unforeseen_harness::episodes::experiments::LearnPoint]| {
+        let ticks = |ps: &[unforeseen_harness::episodes::learning_curves::LearnPoint]| {
             ps.iter().map(|p| p.reasoning_ticks).sum::<u32>()
         };
         (ticks(&points[..5]), ticks(&points[25..]))

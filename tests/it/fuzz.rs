@@ -234,7 +234,7 @@ fn mutated_agent_files_are_refused_or_drive_the_car() {
             }
         };
         accepted += 1;
-        if unforeseen_harness::training::agent_file::check_compatible(&bundle, &map).is_err() {
+        if unforeseen_harness::episodes::methods::check_compatible(&bundle, &map).is_err() {
             continue;
         }
         for method in [

@@ -12,11 +12,11 @@ use crate::common;
 use std::fmt::Write;
 use unforeseen_agent::params::{ActionSelection, CompetenceCheck, CrashPlanning, ScaledParams, TieBreak};
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_harness::episodes::experiments::trace;
+use unforeseen_env::seeds::content_hash;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::episodes::runner::{EpisodeResult, Tick};
-use unforeseen_harness::seeds::content_hash;
+use unforeseen_harness::episodes::trace::trace;
 use unforeseen_harness::training::{TimeoutAs, train};
 
 fn bits(x: f64) -> String {

@@ -4,7 +4,8 @@
 
 use crate::common::{TINY_MAP, assert_exit, run_cli, tiny_agent_text};
 use std::path::{Path, PathBuf};
-use unforeseen_harness::runs::batch::{ResultLine, read_lines, summary_path};
+use unforeseen_harness::runs::batch::{ResultLine, read_lines};
+use unforeseen_harness::runs::outputs::summary_path;
 
 struct Setup {
     dir: tempfile::TempDir,

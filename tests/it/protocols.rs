@@ -5,7 +5,7 @@
 use crate::common;
 
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_harness::episodes::experiments::{evaluate, evaluate_under};
+use unforeseen_harness::episodes::evaluation::{evaluate, evaluate_under};
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::episodes::runner::EpisodeResult;

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_harness::episodes::experiments::evaluate;
+use unforeseen_harness::episodes::evaluation::evaluate;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::metrics::Aggregate;
 use unforeseen_harness::episodes::survivability::witness;
@@ -197,7 +197,7 @@ fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
 /// same map, `red_light: 0`) the witness ignores the light, as before.
 #[test]
 fn brake_on_pedestrian_stops_for_red_where_the_map_has_the_rule() {
-    use unforeseen_harness::episodes::experiments::evaluate_scripted;
+    use unforeseen_harness::episodes::evaluation::evaluate_scripted;
     let mut map = unforeseen_harness::maps::load(&shipped("red_light/red_on_approach.ron")).unwrap();
     assert_eq!(map.reward.red_light, -100.0);
     let run = |map: &unforeseen_sim::Map, method| {

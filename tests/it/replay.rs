@@ -102,7 +102,7 @@ fn trace_html_is_self_contained_and_carries_every_tick() {
 #[test]
 fn names_in_the_page_cannot_end_its_script() {
     let map = unforeseen_harness::maps::load("jaywalk").unwrap();
-    let (_, ticks) = unforeseen_harness::episodes::experiments::trace(
+    let (_, ticks) = unforeseen_harness::episodes::trace::trace(
         common::bundle(),
         &Default::default(),
         unforeseen_harness::episodes::methods::Method::QLearning,

@@ -18,7 +18,7 @@ use std::sync::OnceLock;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_env::{Env, EnvConfig};
-use unforeseen_harness::episodes::experiments::{eval_seeds, evaluate_under};
+use unforeseen_harness::episodes::evaluation::{eval_seeds, evaluate_under};
 use unforeseen_harness::episodes::methods::{Method, scaled_agent};
 use unforeseen_harness::episodes::protocol::Protocol;
 use unforeseen_harness::episodes::runner::{EpisodeResult, run_episode};

@@ -5,6 +5,7 @@ use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::{GateLearning, GateMode, ReasoningMode, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::scaled_agent::ScaledAgent;
+use unforeseen_discretizer::Discretizer;
 use unforeseen_sim::Map;
 
 use crate::episodes::metrics::efe_prefix_tree;
@@ -306,4 +307,24 @@ pub struct PaperFigures {
     pub success_rate: f64,
     /// Inference rate relative to Bayesian RL (which reasons on every tick).
     pub inference_rate: f64,
+}
+
+/// Checks that `bundle` can drive `map`: the world model's factor sizes are the ones the
+/// map's bins give (the same joint state space, factor by factor).
+pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> Result<(), Error> {
+    let disc = Discretizer::new(map)?;
+    let agent = bundle.world_model.structure().sizes();
+    let map_sizes = disc.factor_sizes();
+    if agent != map_sizes {
+        return Err(Error::Agent {
+            problem: format!(
+                "the agent was trained on factor sizes {agent:?} (d, v, L, p: {} discrete states) but map '{}' gives {map_sizes:?} ({} states)",
+                agent.iter().product::<usize>(),
+                map.name,
+                disc.n_states()
+            ),
+            fix: "its bins differ from the training map's: train an agent on a map with the same bins".into(),
+        });
+    }
+    Ok(())
 }

@@ -1,9 +1,10 @@
 //! One episode and the methods that drive it: the runner, the compared methods and the
 //! scripted references, the evaluation protocols, the metrics of the paper's table, the
-//! per-state preferences, the survivability check, the experiments built on them, and
-//! the recording of reasoning ticks.
+//! per-state preferences, the survivability check, the evaluation of a method on a map,
+//! one traced episode, the test-time learning curves and the recording of reasoning ticks.
 
-pub mod experiments;
+pub mod evaluation;
+pub mod learning_curves;
 pub mod methods;
 pub mod metrics;
 pub mod protocol;
@@ -12,3 +13,4 @@ pub mod rewards;
 pub mod runner;
 pub mod survivability;
 pub mod tick_recording;
+pub mod trace;

@@ -85,6 +85,12 @@ impl std::fmt::Display for Protocol {
     }
 }
 
+impl std::fmt::Display for ProtocolChoice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// A protocol name that is neither of [`Protocol::ALL`].
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("'{given}' is not a protocol; expected one of {}", Protocol::ALL.map(Protocol::name).join(", "))]

@@ -5,8 +5,10 @@
 use std::time::Instant;
 use unforeseen_agent::controller::{Controller, Ending};
 use unforeseen_discretizer::State;
-use unforeseen_env::{Env, EnvError};
+use unforeseen_env::Env;
 use unforeseen_sim::{Action, Snapshot};
+
+use crate::error::EpisodeError;
 
 /// One decision tick of an episode, as shown by `trace`.
 #[derive(Debug, Clone)]
@@ -72,18 +74,6 @@ pub struct EpisodeSeeds {
     pub world: u64,
     /// Seeds the controller's own sampling, if any.
     pub controller: u64,
-}
-
-/// Why an episode could not run: the controller chose an action that is not one of the
-/// three (a bug in the controller, or a policy given from outside).
-#[derive(Debug, thiserror::Error)]
-#[error("{controller}: {source}")]
-pub struct EpisodeError {
-    /// The controller's name.
-    pub controller: String,
-    /// What the env refused.
-    #[source]
-    pub source: EnvError,
 }
 
 /// Runs one episode of `controller` in `env` (a loop over [`Env::reset`] and

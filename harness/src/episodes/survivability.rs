@@ -21,14 +21,15 @@
 //! every cruise in that bin is one it may hold. A map is survivable when care alone
 //! suffices.
 //!
-//! `check-map` measures both on every map with pedestrian rules; `batch` checks its
-//! brake-on-pedestrian and never-brake units. Both report the same warnings (returned
-//! here; the command line prints them on stderr) and neither changes the exit code. Episodes use [`crate::episodes::experiments::eval_seeds`], so `check-map
+//! `check-map` measures both on every map with pedestrian rules; `batch` on the maps where
+//! it ran brake-on-pedestrian and never-brake, with the careful cruises at its own
+//! episodes and seed. Both report the same warnings (returned
+//! here; the command line prints them on stderr) and neither changes the exit code. Episodes use [`crate::episodes::evaluation::eval_seeds`], so `check-map
 //! --seed S` and `batch --seed S` meet the same pedestrians and report the same figures.
 
 use unforeseen_sim::Map;
 
-use crate::episodes::experiments::evaluate_scripted;
+use crate::episodes::evaluation::evaluate_scripted;
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::error::Error;
@@ -114,7 +115,7 @@ impl Witness {
 }
 
 /// Runs `episodes` episodes of a scripted `method` on `map` (in parallel; seeded by
-/// [`crate::episodes::experiments::eval_seeds`], so the result does not depend on the number of threads).
+/// [`crate::episodes::evaluation::eval_seeds`], so the result does not depend on the number of threads).
 pub fn witness(map: &Map, method: Method, episodes: u64, seed: u64) -> Result<Witness, Error> {
     let results = evaluate_scripted(map, method, episodes, seed, &NoProgress)?;
     Ok(Witness::of(&Aggregate::of(&results)))

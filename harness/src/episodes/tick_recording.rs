@@ -24,7 +24,7 @@ use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::Map;
 
-use crate::episodes::experiments::eval_seeds;
+use crate::episodes::evaluation::eval_seeds;
 use crate::episodes::methods::Method;
 use crate::episodes::runner::run_episode;
 use crate::error::Error;

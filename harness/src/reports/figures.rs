@@ -13,7 +13,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 use crate::error::Error;
-use crate::reports::files::write_atomic;
+use crate::files::write_atomic;
 
 /// What the drawing functions return.
 type Result<T> = std::result::Result<T, Error>;

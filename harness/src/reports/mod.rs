@@ -3,6 +3,5 @@
 //! printed tables of `compare`, `eval` and `batch` as text, Markdown or HTML ([`tables`]).
 
 pub mod figures;
-pub mod files;
 pub mod replay_page;
 pub mod tables;

@@ -1,22 +1,16 @@
-//! The printed tables of the reports: what `compare`, `eval` and `batch` print, built
-//! here once from their report types and rendered as plain text (what the command line
-//! prints and Python's `str(result)` gives), Markdown or HTML (a notebook's rich
-//! display). The library renders to strings and never prints.
+//! Printed tables: a [`Document`] is a sequence of headings, lines and grids; a [`Grid`]
+//! is rows of cells whose first column is left-aligned and the others right-aligned. A
+//! document renders as plain text (what the command line prints and Python's
+//! `str(result)` gives), Markdown or HTML (a notebook's rich display). The library renders
+//! to strings and never prints.
 //!
-//! A [`Document`] is a sequence of headings, lines and grids; a [`Grid`] is rows of cells
-//! whose first column is left-aligned and the others right-aligned. Each report builds
-//! its document in one function: [`compare`], [`eval`], [`eval_stream`] and
-//! [`batch_summary`].
+//! Each job builds its report's document in one function beside the report type:
+//! `compare`'s in `runs::compare::table`, `eval`'s in `runs::evaluate`, `batch`'s in
+//! `runs::batch::table`.
 
 use std::fmt::{self, Display, Write as _};
 
-use crate::episodes::experiments::EvalReport;
-use crate::episodes::methods::{Method, PaperFigures};
-use crate::episodes::protocol::Protocol;
-use crate::reports::files::num;
-use crate::runs::batch::{SummaryRow, stream_learning};
-use crate::runs::compare::{CompareReport, MethodSummary, ProtocolTable};
-use crate::runs::stream::StreamEvalReport;
+use crate::files::num;
 use crate::stats::Stat;
 
 /// A summarized figure as a cell: `mean` with one value, `mean ± half-width` of the 95%
@@ -114,15 +108,18 @@ pub struct Document {
 }
 
 impl Document {
-    fn heading(&mut self, text: impl Into<String>) {
+    /// Appends a heading.
+    pub fn heading(&mut self, text: impl Into<String>) {
         self.blocks.push(Block::Heading(text.into()));
     }
 
-    fn line(&mut self, text: impl Into<String>) {
+    /// Appends a line of text.
+    pub fn line(&mut self, text: impl Into<String>) {
         self.blocks.push(Block::Line(text.into()));
     }
 
-    fn grid(&mut self, grid: Grid) {
+    /// Appends a grid.
+    pub fn grid(&mut self, grid: Grid) {
         self.blocks.push(Block::Grid(grid));
     }
 
@@ -249,346 +246,6 @@ fn html_escape(s: &str) -> String {
             '>' => out.push_str("&gt;"),
             '"' => out.push_str("&quot;"),
             _ => out.push(ch),
-        }
-    }
-    out
-}
-
-/// The paper's figures for a method by name, if it reports them.
-fn paper_of(method: &str) -> Option<PaperFigures> {
-    method.parse::<Method>().ok().and_then(Method::paper)
-}
-
-/// Who the agents are, in words.
-fn agents_line(m: &MethodSummary) -> String {
-    let n = m.train_seeds.len();
-    let episodes = m.train_episodes.map_or("?".into(), |e| e.to_string());
-    let seeds: Vec<String> = m.train_seeds.iter().map(|&s| seed_text(s)).collect();
-    let agents = if n == 1 {
-        "1 agent".into()
-    } else {
-        format!("{n} agents")
-    };
-    format!(
-        "{agents} (training seed{} {}, {episodes} training episodes each), {} evaluation episodes per method, map and agent, evaluation seed {}",
-        if n == 1 { "" } else { "s" },
-        seeds.join(","),
-        m.episodes,
-        m.seed
-    )
-}
-
-/// `compare`'s tables (§VI, Fig. 8), one per protocol: the figures (the paper's in
-/// parentheses under zero-shot), then, over several agents, their range and the worst
-/// seed. A second header line names the map each column was measured on.
-pub fn compare(report: &CompareReport) -> Document {
-    let mut doc = Document::default();
-    for table in &report.tables {
-        protocol_table(&mut doc, report, table);
-    }
-    doc
-}
-
-/// One protocol's table of [`compare`].
-fn protocol_table(doc: &mut Document, report: &CompareReport, table: &ProtocolTable) {
-    let Some(first) = table.methods.first() else { return };
-    let (train_map, test_map) = (&report.train_map, &report.test_map);
-    let n = first.train_seeds.len();
-    doc.heading(format!("{} protocol: {}", table.protocol, table.meaning));
-    doc.line(agents_line(first));
-    doc.line(format!(
-        "train reward: on the training map '{train_map}'; every other column: on the test map '{test_map}'"
-    ));
-    let (train_reward, test_reward) = &report.reward_described;
-    if train_reward == test_reward {
-        doc.line(format!("reward on both maps: {train_reward}"));
-    } else {
-        doc.line(format!("reward: training map {train_reward}; test map {test_reward}"));
-    }
-    if n > 1 {
-        doc.line(format!(
-            "each figure: mean ± half-width of the 95% interval over the {n} agents (Student t, {} df)",
-            n - 1
-        ));
-    }
-    let mut grid = compare_header("µs/tick", train_map, test_map, &format!("({test_map})"));
-    let with_paper = |ours: String, paper: Option<String>| match paper {
-        Some(p) if table.protocol == Protocol::ZeroShot => format!("{ours} ({p})"),
-        _ => ours,
-    };
-    let rate_digits = if n > 1 { 1 } else { 0 };
-    for m in &table.methods {
-        let p = paper_of(&m.method);
-        let mark = if m.computed_under != m.protocol { "*" } else { "" };
-        grid.rows.push(vec![
-            format!("{}{mark}", m.method),
-            with_paper(cell(&m.train_reward, 1, false), p.map(|p| num(p.train_reward, 1))),
-            with_paper(cell(&m.test_reward, 1, false), p.map(|p| num(p.test_reward, 1))),
-            with_paper(
-                cell(&m.success_rate, rate_digits, true),
-                p.map(|p| format!("{:.0}%", 100.0 * p.success_rate)),
-            ),
-            with_paper(cell(&m.collision_rate, rate_digits, true), p.map(|_| "n/a".to_string())),
-            cell(&m.red_light_rate, rate_digits, true),
-            cell(&m.inference_rate, 1, true),
-            cell(&m.reasoning_us_per_tick, 2, false),
-        ]);
-    }
-    doc.grid(grid);
-    if table.protocol == Protocol::ZeroShot {
-        doc.line(
-            "(paper's values in parentheses, §VI; n/a: the paper gives no collision rate; red lights: episodes entering the crosswalk on red, not in the paper; its inference rate is relative, below)",
-        );
-    }
-    let copied: Vec<&str> = table
-        .methods
-        .iter()
-        .filter(|m| m.computed_under != m.protocol)
-        .map(|m| m.method.as_str())
-        .collect();
-    if !copied.is_empty() {
-        let verb = if copied.len() == 1 { "does" } else { "do" };
-        doc.line(format!(
-            "* {} {verb} not learn across episodes: identical under both protocols, run once ({}) and repeated here",
-            copied.join(", "),
-            Protocol::ZeroShot
-        ));
-    }
-    if let Some(rel) = &table.scaled_inference_relative_to_bayes_rl {
-        doc.line(format!(
-            "scaled reasons on {} of the ticks Bayesian RL does (paper: 63.3%)",
-            cell(rel, 1, true)
-        ));
-    }
-    if n > 1 {
-        doc.line("over the agents: min .. max, and the worst seed (lowest test success; its success and test reward)");
-        let mut grid = compare_header("worst seed", train_map, test_map, "");
-        for m in &table.methods {
-            let w = &m.worst_seed;
-            grid.rows.push(vec![
-                m.method.clone(),
-                range_cell(&m.train_reward, 1, false),
-                range_cell(&m.test_reward, 1, false),
-                range_cell(&m.success_rate, 0, true),
-                range_cell(&m.collision_rate, 0, true),
-                range_cell(&m.red_light_rate, 0, true),
-                range_cell(&m.inference_rate, 1, true),
-                format!(
-                    "{} ({:.0}%, {})",
-                    seed_text(w.train_seed),
-                    100.0 * w.success_rate,
-                    num(w.test_reward, 1)
-                ),
-            ]);
-        }
-        doc.grid(grid);
-    }
-}
-
-/// The two header rows of `compare`'s grids: the method, the table's figures, then
-/// `last`; below them the map each figure was measured on, then `last_map`.
-fn compare_header(last: &str, train_map: &str, test_map: &str, last_map: &str) -> Grid {
-    let figures = [
-        "train reward",
-        "test reward",
-        "success",
-        "collisions",
-        "red lights",
-        "inference rate",
-    ];
-    let names = std::iter::once("method")
-        .chain(figures)
-        .chain([last])
-        .map(String::from)
-        .collect();
-    let test = format!("({test_map})");
-    let maps = [
-        "",
-        &format!("({train_map})"),
-        &test,
-        &test,
-        &test,
-        &test,
-        &test,
-        last_map,
-    ]
-    .map(String::from)
-    .to_vec();
-    Grid {
-        header_rows: 2,
-        rows: vec![names, maps],
-    }
-}
-
-/// `eval`'s line: the method on the map under its protocol (noting a method that does
-/// not learn across episodes), and its figures over every episode.
-pub fn eval(report: &EvalReport) -> Document {
-    let agg = &report.aggregate;
-    let mut doc = Document::default();
-    doc.line(format!(
-        "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, red lights {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
-        report.method,
-        report.map,
-        protocol_note(report.method, report.protocol, report.learns_across_episodes),
-        agg.mean_reward,
-        100.0 * agg.success_rate,
-        100.0 * agg.collision_rate,
-        100.0 * agg.red_light_rate,
-        100.0 * agg.timeout_rate,
-        100.0 * agg.inference_rate,
-        agg.us_per_tick,
-        agg.episodes
-    ));
-    doc
-}
-
-/// `eval --stream`'s lines: the method on the stream under its protocol, then one line
-/// per map within the stream.
-pub fn eval_stream(report: &StreamEvalReport) -> Document {
-    let mut doc = Document::default();
-    doc.line(format!(
-        "{} on stream '{}' ({}), per map:",
-        report.method,
-        report.stream,
-        protocol_note(report.method, report.protocol, report.learns_across_episodes)
-    ));
-    for r in &report.per_map {
-        let a = &r.aggregate;
-        doc.line(format!(
-            "  {:<20} {:>4} episodes: success {:.1}%, collisions {:.1}%, reward {:.2}, inference rate {:.1}%",
-            r.map,
-            a.episodes,
-            100.0 * a.success_rate,
-            100.0 * a.collision_rate,
-            a.mean_reward,
-            100.0 * a.inference_rate
-        ));
-    }
-    doc
-}
-
-/// The protocol in words, noting a method that does not learn across episodes (so both
-/// protocols give its results).
-fn protocol_note(method: Method, protocol: Protocol, learns_across_episodes: bool) -> String {
-    if learns_across_episodes {
-        protocol.to_string()
-    } else {
-        format!("{protocol}; {method} does not learn across episodes, so both protocols give these results")
-    }
-}
-
-/// `batch`'s summary (and `merge`'s): one row per (scenario, method, parameters,
-/// protocol) over its training seeds (a stream's row followed by one per map within it,
-/// `STREAM/MAP`, with its episodes), then, for a stream run under both protocols, what
-/// learning does to each map within it.
-pub fn batch_summary(rows: &[SummaryRow]) -> Document {
-    let mut doc = Document::default();
-    let many = rows.iter().any(|r| r.train_seeds.len() > 1);
-    let streams = rows.iter().any(|r| r.stream.is_some());
-    let mut head = vec!["scenario", "method", "parameters", "protocol", "seeds"];
-    if streams {
-        head.push("episodes");
-    }
-    head.extend(["success", "collision", "red light", "reward", "inference", "worst seed"]);
-    let mut grid = Grid::new(head.into_iter().map(String::from).collect());
-    for r in rows {
-        let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
-        let w = &r.worst_seed;
-        let mut row = vec![
-            match &r.stream {
-                Some(stream) => format!("{stream}/{}", r.scenario),
-                None => r.scenario.clone(),
-            },
-            r.method.clone(),
-            r.param_set.clone(),
-            protocols.join("+"),
-            r.train_seeds.len().to_string(),
-        ];
-        if streams {
-            row.push(r.episodes.to_string());
-        }
-        row.extend([
-            cell(&r.success_rate, 1, true),
-            cell(&r.collision_rate, 1, true),
-            cell(&r.red_light_rate, 1, true),
-            cell(&r.mean_reward, 2, false),
-            cell(&r.inference_rate, 1, true),
-            format!("{} ({:.0}%)", seed_text(w.train_seed), 100.0 * w.success_rate),
-        ]);
-        grid.rows.push(row);
-    }
-    if many {
-        doc.line("each figure: mean ± half-width of the 95% interval over training seeds (Student t)");
-    }
-    doc.grid(grid);
-    let learning = stream_learning(rows);
-    if learning.is_empty() {
-        return doc;
-    }
-    doc.line(
-        "learning within the stream, per map: continual against zero-shot on the same episodes (means over training seeds)",
-    );
-    let mut grid = Grid::new(
-        [
-            "map",
-            "method",
-            "parameters",
-            "episodes",
-            "success zero-shot",
-            "continual",
-            "reward zero-shot",
-            "continual",
-            "",
-        ]
-        .map(String::from)
-        .to_vec(),
-    );
-    for l in &learning {
-        grid.rows.push(vec![
-            format!("{}/{}", l.stream, l.map),
-            l.method.clone(),
-            l.param_set.clone(),
-            l.episodes.to_string(),
-            format!("{:.1}%", 100.0 * l.zero_shot_success),
-            format!("{:.1}%", 100.0 * l.continual_success),
-            format!("{:.2}", l.zero_shot_reward),
-            format!("{:.2}", l.continual_reward),
-            if l.worse { "worse".into() } else { String::new() },
-        ]);
-    }
-    doc.grid(grid);
-    doc
-}
-
-/// One message per expectation of `batch`'s summary rows that fails on the mean, naming
-/// the worst seed (what `batch`, `merge` and the Ray driver report).
-pub fn expectation_failures(rows: &[SummaryRow]) -> Vec<String> {
-    let mut out = Vec::new();
-    for r in rows {
-        for c in r.checks.iter().filter(|c| !c.pass) {
-            let n = r.train_seeds.len();
-            let over = if n == 1 {
-                format!("training seed {}", seed_text(r.train_seeds[0]))
-            } else {
-                format!(
-                    "mean over {n} training seeds; worst seed {}: {:.4}",
-                    seed_text(c.worst_seed),
-                    c.worst_value
-                )
-            };
-            let protocols: Vec<&str> = r.covers.iter().map(|p| p.name()).collect();
-            out.push(format!(
-                "{} ({}): {} [{}] {} {} = {:.4} violates {} {} ({over})",
-                r.scenario,
-                r.source,
-                r.method,
-                r.param_set,
-                protocols.join("+"),
-                c.figure,
-                c.mean,
-                c.bound,
-                c.limit
-            ));
         }
     }
     out

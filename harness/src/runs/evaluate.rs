@@ -11,14 +11,14 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_sim::Map;
 
-use crate::episodes::experiments::{EvalReport, evaluate_map};
+use crate::episodes::evaluation::{EvalReport, evaluate_map};
 use crate::episodes::methods::Method;
 use crate::episodes::protocol::Protocol;
 use crate::error::Error;
+use crate::files::write_json;
 use crate::limits::check_episodes;
 use crate::progress::Progress;
-use crate::reports::files::write_json;
-use crate::reports::tables::{self, Document};
+use crate::reports::tables::Document;
 use crate::runs::batch::request::AgentFields;
 use crate::runs::batch::{AgentChoice, SCRIPTED_ONLY};
 use crate::runs::outputs::Outputs;
@@ -58,13 +58,13 @@ pub struct EvalRequest {
 impl Default for EvalRequest {
     fn default() -> Self {
         EvalRequest {
-            map: "jaywalk".to_string(),
+            map: crate::maps::DEFAULT_TEST_MAP.to_string(),
             stream: None,
             method: Method::Scaled,
-            episodes: 100,
+            episodes: crate::limits::DEFAULT_EPISODES,
             protocol: Protocol::ZeroShot,
             sets: Vec::new(),
-            seed: 7,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/eval")),
             agent: None,
         }
@@ -94,7 +94,7 @@ impl EvalScene {
     /// map given as `map`), with the agent file `agent` if any.
     pub fn inputs(&self, map: &str, agent: Option<&PathBuf>) -> Outputs {
         let guard = match self {
-            EvalScene::Stream(stream, file) => Outputs::new().stream("stream", file, stream),
+            EvalScene::Stream(stream, file) => Outputs::new().stream("stream", file, &stream.files),
             EvalScene::Map(_) => Outputs::new().input("map", map),
         };
         match agent {
@@ -135,11 +135,11 @@ impl EvalOutcome {
         }
     }
 
-    /// What the command line prints of it ([`tables::eval`], [`tables::eval_stream`]).
+    /// What the command line prints of it ([`eval_table`], [`eval_stream_table`]).
     pub fn table(&self) -> Document {
         match self {
-            EvalOutcome::Map(r) => tables::eval(r),
-            EvalOutcome::Stream(r) => tables::eval_stream(r),
+            EvalOutcome::Map(r) => eval_table(r),
+            EvalOutcome::Stream(r) => eval_stream_table(r),
         }
     }
 }
@@ -239,6 +239,63 @@ impl EvalJob {
         let path = dir.join(EVAL_FILE);
         write_json(&path, &outcome.document()?)?;
         Ok(Some(path))
+    }
+}
+
+/// `eval`'s line: the method on the map under its protocol (noting a method that does
+/// not learn across episodes), and its figures over every episode.
+pub fn eval_table(report: &EvalReport) -> Document {
+    let agg = &report.aggregate;
+    let mut doc = Document::default();
+    doc.line(format!(
+        "{} on '{}' ({}): reward {:.2}, success {:.1}%, collisions {:.1}%, red lights {:.1}%, timeouts {:.1}%, inference rate {:.1}%, {:.2} µs/tick over {} episodes",
+        report.method,
+        report.map,
+        protocol_note(report.method, report.protocol, report.learns_across_episodes),
+        agg.mean_reward,
+        100.0 * agg.success_rate,
+        100.0 * agg.collision_rate,
+        100.0 * agg.red_light_rate,
+        100.0 * agg.timeout_rate,
+        100.0 * agg.inference_rate,
+        agg.us_per_tick,
+        agg.episodes
+    ));
+    doc
+}
+
+/// `eval --stream`'s lines: the method on the stream under its protocol, then one line
+/// per map within the stream.
+pub fn eval_stream_table(report: &StreamEvalReport) -> Document {
+    let mut doc = Document::default();
+    doc.line(format!(
+        "{} on stream '{}' ({}), per map:",
+        report.method,
+        report.stream,
+        protocol_note(report.method, report.protocol, report.learns_across_episodes)
+    ));
+    for r in &report.per_map {
+        let a = &r.aggregate;
+        doc.line(format!(
+            "  {:<20} {:>4} episodes: success {:.1}%, collisions {:.1}%, reward {:.2}, inference rate {:.1}%",
+            r.map,
+            a.episodes,
+            100.0 * a.success_rate,
+            100.0 * a.collision_rate,
+            a.mean_reward,
+            100.0 * a.inference_rate
+        ));
+    }
+    doc
+}
+
+/// The protocol in words, noting a method that does not learn across episodes (so both
+/// protocols give its results).
+fn protocol_note(method: Method, protocol: Protocol, learns_across_episodes: bool) -> String {
+    if learns_across_episodes {
+        protocol.to_string()
+    } else {
+        format!("{protocol}; {method} does not learn across episodes, so both protocols give these results")
     }
 }
 

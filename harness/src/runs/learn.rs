@@ -13,12 +13,12 @@ use std::path::{Path, PathBuf};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 
-use crate::episodes::experiments::{LearnPoint, learn};
+use crate::episodes::learning_curves::{LearnPoint, learn};
 use crate::error::Error;
+use crate::files::{Csv, all_or_none, num, write_json};
 use crate::limits::check_episodes;
 use crate::progress::Progress;
 use crate::reports::figures::{Series, line_panels};
-use crate::reports::files::{Csv, all_or_none, num, write_json};
 use crate::runs::batch::AgentChoice;
 use crate::runs::batch::request::AgentFields;
 use crate::runs::evaluate::EvalScene;
@@ -54,11 +54,11 @@ pub struct LearnRequest {
 impl Default for LearnRequest {
     fn default() -> Self {
         LearnRequest {
-            map: "jaywalk".to_string(),
+            map: crate::maps::DEFAULT_TEST_MAP.to_string(),
             stream: None,
             episodes: 50,
             sets: Vec::new(),
-            seed: 7,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/learn")),
             agent: None,
         }

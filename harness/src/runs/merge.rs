@@ -20,8 +20,9 @@ use crate::error::Error;
 use crate::runs::batch::results_file::line_problem;
 use crate::runs::batch::{
     KeptLine, ParamSet, ResultLine, RunIdentity, SummaryRow, Unit, UnitKey, read_results, stream_learning, summarize,
-    summary_path, units,
+    units,
 };
+use crate::runs::outputs::summary_path;
 
 /// The merged results of one run.
 #[derive(Debug, Clone)]
@@ -339,9 +340,9 @@ pub fn write_merged(merged: &Merged, out: &Path) -> Result<MergeReport, Error> {
     let rows = summarize(&merged.results());
     let summary = summary_path(out);
     let doc = summary_document(out, None, &merged.identity, &rows);
-    crate::reports::files::all_or_none(|| {
-        crate::reports::files::write_atomic(out, text.as_bytes())?;
-        crate::reports::files::write_json(&summary, &doc)
+    crate::files::all_or_none(|| {
+        crate::files::write_atomic(out, text.as_bytes())?;
+        crate::files::write_json(&summary, &doc)
     })?;
     Ok(MergeReport {
         out: out.to_path_buf(),

@@ -2,8 +2,9 @@
 //! scenario suites and sweeps ([`batch`]), deployment streams
 //! ([`stream`]), the paper's comparison over agents and protocols ([`compare`]),
 //! test-time learning curves ([`learn`]), one episode step by step ([`trace`]), the
-//! merge of shard files ([`merge`]) and the search for fair failing scenarios
-//! ([`search`]); the guard all of them pass before any work ([`outputs`]: no output
+//! merge of shard files ([`merge`]), the search for fair failing scenarios
+//! ([`search`]) and the methods given from outside the library, a Python policy, reported
+//! as batch result lines ([`outside_methods`]); the guard all of them pass before any work ([`outputs`]: no output
 //! replaces an input or another program's file, one writer at a time). Jobs are asked
 //! for by typed requests ([`EvalRequest`](evaluate::EvalRequest),
 //! [`CompareRequest`](compare::CompareRequest), [`BatchRequest`](batch::BatchRequest),
@@ -17,6 +18,7 @@ pub mod evaluate;
 pub mod learn;
 pub mod merge;
 pub mod outputs;
+pub mod outside_methods;
 pub mod request;
 pub mod search;
 pub mod stream;

@@ -49,6 +49,11 @@ pub fn file_name(field: &str, name: &str) -> Result<(), String> {
     ))
 }
 
+/// Where the summary of results file `out` goes: `results.jsonl` -> `results.summary.json`.
+pub fn summary_path(out: &Path) -> PathBuf {
+    out.with_extension("summary.json")
+}
+
 /// What a run writes into an output, so that a file holding something else is refused
 /// (unless `force`) instead of being replaced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,7 +62,7 @@ pub enum Own {
     /// figure); only inputs and non-files are refused.
     Any,
     /// A batch results file (JSON Lines): its first line is a run identity
-    /// (`{"run": ...}`) or a result line (Python's `evaluate`).
+    /// (`{"run": ...}`) or a result line (`{"unit": ...}`, Python's `evaluate`).
     Results,
     /// A search's candidates file: its first line is `{"search": ...}`.
     Candidates,
@@ -107,7 +112,8 @@ impl Own {
             Own::Any => true,
             Own::Results => {
                 first.starts_with("{\"run\":")
-                    || serde_json::from_str::<crate::runs::batch::ResultLine>(first.trim_end()).is_ok()
+                    || (first.starts_with("{\"unit\":")
+                        && serde_json::from_str::<serde_json::Value>(first.trim_end()).is_ok_and(|v| v.is_object()))
             }
             Own::Candidates => first.starts_with("{\"search\":"),
             Own::Json => {
@@ -174,10 +180,11 @@ impl Outputs {
         self
     }
 
-    /// A stream file given as `flag` and every map file it lists.
-    pub fn stream(mut self, flag: &str, file: &Path, stream: &crate::runs::stream::Stream) -> Outputs {
+    /// A stream file given as `flag` and the map files it lists (`maps`, by position in
+    /// its `maps`; `None` for an embedded map).
+    pub fn stream(mut self, flag: &str, file: &Path, maps: &[Option<PathBuf>]) -> Outputs {
         self.inputs.push((flag.to_string(), file.to_path_buf()));
-        for (i, f) in stream.files.iter().enumerate() {
+        for (i, f) in maps.iter().enumerate() {
             if let Some(f) = f {
                 self.inputs
                     .push((format!("{flag} {} (its maps[{i}])", file.display()), f.clone()));
@@ -209,7 +216,7 @@ impl Outputs {
     pub fn results(flag: &str, out: &Path) -> Outputs {
         Outputs::new().file(flag, out, Own::Results).file_at_end(
             &format!("{flag} (its summary)"),
-            crate::runs::batch::summary_path(out),
+            summary_path(out),
             Own::Json,
         )
     }

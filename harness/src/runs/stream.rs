@@ -17,7 +17,7 @@
 //!
 //! A map is a file relative to the stream file, else an embedded map by name. Episode `k`
 //! of the stream runs on the map the order gives it, with the world seed of episode `k` of
-//! that map ([`crate::episodes::experiments::eval_seeds`]); the order draws from the evaluation seed
+//! that map ([`crate::episodes::evaluation::eval_seeds`]); the order draws from the evaluation seed
 //! alone, so every method, protocol and agent meets the same maps in the same order.
 //! Results are reported per map within the stream ([`per_map`]). Syntax errors name the
 //! file, line and column; semantic ones the file and field ([`StreamError`]).
@@ -38,14 +38,15 @@ use unforeseen_agent::persist::AgentBundle;
 use unforeseen_env::{Env, EnvConfig};
 use unforeseen_sim::Map;
 
-use crate::episodes::experiments::{LearnPoint, eval_seeds, learn_over};
+use crate::episodes::evaluation::eval_seeds;
+use crate::episodes::learning_curves::{LearnPoint, learn_over};
 use crate::episodes::methods::Method;
+use crate::episodes::methods::check_compatible;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::Protocol;
 use crate::episodes::runner::{EpisodeResult, run_episode};
 use crate::progress::Progress;
-use crate::seeds::episode_seed;
-use crate::training::agent_file::check_compatible;
+use unforeseen_env::seeds::episode_seed;
 
 /// Largest stream file read (bytes).
 const MAX_BYTES: u64 = 1 << 20;
@@ -423,7 +424,7 @@ pub fn per_map(stream: &Stream, episodes: &[StreamEpisode]) -> Vec<StreamRow> {
 }
 
 /// The test-time learning curves of the scaled agent over `episodes` episodes of the
-/// stream ([`crate::episodes::experiments::learn_over`] on the stream's schedule): one agent
+/// stream ([`crate::episodes::learning_curves::learn_over`] on the stream's schedule): one agent
 /// learning across the stream in order, each point naming its map.
 pub fn learn_stream(
     stream: &Stream,

@@ -12,15 +12,15 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_sim::Map;
 
-use crate::episodes::experiments::trace;
 use crate::episodes::methods::Method;
 use crate::episodes::protocol::Protocol;
 use crate::episodes::runner::{EpisodeResult, Tick};
+use crate::episodes::trace::trace;
 use crate::error::Error;
+use crate::files::{Csv, all_or_none, num, write_atomic};
 use crate::limits::MAX_EPISODES;
 use crate::progress::Progress;
 use crate::reports::figures::{filmstrip, theta_trace};
-use crate::reports::files::{Csv, all_or_none, num, write_atomic};
 use crate::reports::replay_page::replay_html;
 use crate::runs::batch::AgentChoice;
 use crate::runs::batch::request::AgentFields;
@@ -64,12 +64,12 @@ pub struct TraceRequest {
 impl Default for TraceRequest {
     fn default() -> Self {
         TraceRequest {
-            map: "jaywalk".to_string(),
+            map: crate::maps::DEFAULT_TEST_MAP.to_string(),
             method: Method::Scaled,
             episode: 0,
             protocol: Protocol::ZeroShot,
             sets: Vec::new(),
-            seed: 7,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/trace")),
             html: None,
             agent: None,

@@ -8,11 +8,10 @@ use std::io::Read;
 use std::path::Path;
 use unforeseen_agent::error::PersistError;
 use unforeseen_agent::persist::{AgentBundle, MAX_FILE_BYTES};
-use unforeseen_discretizer::Discretizer;
-use unforeseen_sim::{Action, Map};
+use unforeseen_sim::Action;
 
 use crate::error::Error;
-use crate::reports::files::write_atomic;
+use crate::files::write_atomic;
 
 /// Saves `bundle` to `path` (temporary file + rename).
 pub fn save(path: &Path, bundle: &AgentBundle) -> Result<(), Error> {
@@ -117,26 +116,6 @@ fn check_intersection(bundle: &AgentBundle) -> Result<(), (String, String)> {
                 "has factors {factors:?}; an agent of the intersection has d, v, L, p (in that order, L and p binary, d at least 2)"
             ),
         ));
-    }
-    Ok(())
-}
-
-/// Checks that `bundle` can drive `map`: the world model's factor sizes are the ones the
-/// map's bins give (the same joint state space, factor by factor).
-pub fn check_compatible(bundle: &AgentBundle, map: &Map) -> Result<(), Error> {
-    let disc = Discretizer::new(map)?;
-    let agent = bundle.world_model.structure().sizes();
-    let map_sizes = disc.factor_sizes();
-    if agent != map_sizes {
-        return Err(Error::Agent {
-            problem: format!(
-                "the agent was trained on factor sizes {agent:?} (d, v, L, p: {} discrete states) but map '{}' gives {map_sizes:?} ({} states)",
-                agent.iter().product::<usize>(),
-                map.name,
-                disc.n_states()
-            ),
-            fix: "its bins differ from the training map's: train an agent on a map with the same bins".into(),
-        });
     }
     Ok(())
 }

@@ -23,7 +23,7 @@ use unforeseen_sim::{Action, Map};
 use crate::episodes::rewards::{crash_model, red_light_cost, state_rewards, terminal_states};
 use crate::error::Error;
 use crate::progress::{NoProgress, Progress};
-use crate::seeds::episode_seed;
+use unforeseen_env::seeds::episode_seed;
 
 /// Everything training needs besides the map.
 #[derive(Debug, Clone)]

@@ -10,9 +10,9 @@ use std::time::Instant;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_sim::Map;
 
+use crate::episodes::methods::check_compatible;
 use crate::error::Error;
 use crate::progress::{Message, Progress};
-use crate::training::agent_file::check_compatible;
 use crate::training::{TrainConfig, train_with_progress};
 
 /// Most training seeds one run accepts (each agent takes seconds to train).
@@ -146,7 +146,7 @@ pub fn cache_key(map: &Map, cfg: &TrainConfig) -> Result<String, Error> {
         "code": env!("UNFORESEEN_TRAINING_FINGERPRINT"),
     });
     let text = serde_json::to_string(&parts)?;
-    Ok(format!("{:016x}", crate::seeds::episode_seed(0, &text, 0)))
+    Ok(format!("{:016x}", unforeseen_env::seeds::episode_seed(0, &text, 0)))
 }
 
 /// Where the cache keeps that agent: `DIR/<map>-seed<S>-<episodes>ep-<key>.ron`.

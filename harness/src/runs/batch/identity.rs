@@ -33,7 +33,7 @@ pub fn trained_agents_identity(
         "trained on {} for {} episodes, agents {}",
         train_map.name,
         config.episodes,
-        crate::seeds::content_hash(keys.join(",").as_bytes())
+        unforeseen_env::seeds::content_hash(keys.join(",").as_bytes())
     ))
 }
 
@@ -46,7 +46,7 @@ pub const SCRIPTED_ONLY: &str = "none (scripted methods only)";
 pub fn agent_file_identity(bundle: &AgentBundle) -> String {
     format!(
         "agent file with contents {}",
-        crate::seeds::content_hash(bundle.to_ron_string().as_bytes())
+        unforeseen_env::seeds::content_hash(bundle.to_ron_string().as_bytes())
     )
 }
 

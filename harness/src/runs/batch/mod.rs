@@ -43,6 +43,7 @@ pub mod run;
 pub mod scenario;
 pub mod summary;
 pub mod sweep;
+pub mod table;
 pub mod units;
 
 pub use expectations::{Check, check_expectations};
@@ -53,6 +54,6 @@ pub use result_line::{MapFigures, ResultLine, UnitKey, UnitLabel};
 pub use results_file::{KeptLine, MAX_FIGURE, ResultsFile, read_lines, read_results, resume_lines};
 pub use run::{run, run_plan, run_unit, run_unit_with};
 pub use scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};
-pub use summary::{StreamLearning, SummaryCheck, SummaryRow, WorstLine, stream_learning, summarize, summary_path};
+pub use summary::{StreamLearning, SummaryCheck, SummaryRow, WorstLine, stream_learning, summarize};
 pub use sweep::{MAX_PARAM_SETS, ParamSet, checked_sweep, sweep};
 pub use units::{DEFAULT_METHODS, Shard, Unit, units};

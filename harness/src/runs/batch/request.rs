@@ -16,11 +16,11 @@ use unforeseen_sim::Map;
 
 use crate::episodes::methods::Method;
 use crate::episodes::protocol::{Protocol, ProtocolChoice};
-use crate::episodes::survivability::{Witness, warnings};
+use crate::episodes::survivability::{Witness, careful_witness, warnings};
 use crate::error::Error;
+use crate::files::write_json;
 use crate::limits::{MAX_JOBS, check_episodes};
-use crate::progress::Progress;
-use crate::reports::files::write_json;
+use crate::progress::{CancelOnly, Progress};
 use crate::runs::merge::summary_document;
 use crate::runs::outputs::{Guarded, Outputs};
 use crate::training::seed_agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
@@ -31,9 +31,10 @@ use super::plan::{BatchConfig, Plan};
 use super::result_line::ResultLine;
 use super::run::run_plan;
 use super::scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};
-use super::summary::{SummaryRow, summarize, summary_path};
+use super::summary::{SummaryRow, summarize};
 use super::sweep::{ParamSet, checked_sweep};
 use super::units::{DEFAULT_METHODS, Shard};
+use crate::runs::outputs::summary_path;
 
 /// Every choice of a batch run, with its defaults ([`BatchRequest::default`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -95,8 +96,8 @@ impl Default for BatchRequest {
             methods: Vec::new(),
             protocol: ProtocolChoice::Both,
             sets: Vec::new(),
-            episodes: 100,
-            seed: 7,
+            episodes: crate::limits::DEFAULT_EPISODES,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             jobs: None,
             out: PathBuf::from("results.jsonl"),
             resume: false,
@@ -346,7 +347,7 @@ impl BatchRequest {
         }
         for s in &setup.scenarios {
             guard = match (&s.kind, &self.stream) {
-                (ScenarioKind::Stream(stream), Some(file)) => guard.stream("stream", file, stream),
+                (ScenarioKind::Stream(stream), Some(file)) => guard.stream("stream", file, &stream.files),
                 _ => guard.input("maps", &s.source),
             };
         }
@@ -415,10 +416,10 @@ pub struct BatchReport {
     pub summary: PathBuf,
     /// Expectations checked on the mean over training seeds.
     pub checked: usize,
-    /// One message per expectation failed ([`crate::reports::tables::expectation_failures`]).
+    /// One message per expectation failed ([`crate::runs::batch::table::expectation_failures`]).
     pub failures: Vec<String>,
-    /// The survivability warnings of the maps, from their scripted references' lines
-    /// ([`survivability_warnings`]).
+    /// The survivability warnings of the maps on which the scripted references ran, as
+    /// `check-map` gives them ([`survivability_warnings`]).
     pub survivability: Vec<String>,
 }
 
@@ -473,8 +474,8 @@ impl BatchJob {
         )?;
         Ok(BatchReport {
             checked: rows.iter().map(|r| r.checks.len()).sum(),
-            failures: crate::reports::tables::expectation_failures(&rows),
-            survivability: survivability_warnings(&self.setup.scenarios, &lines),
+            failures: crate::runs::batch::table::expectation_failures(&rows),
+            survivability: survivability_warnings(&self.setup.scenarios, &lines, progress)?,
             lines,
             rows,
             summary,
@@ -515,37 +516,47 @@ fn memory_bound_jobs(jobs: usize, states: usize, available: Option<u64>) -> Work
 }
 
 /// The survivability warnings of `check-map` for the map scenarios with pedestrian
-/// rules, from the brake-on-pedestrian and never-brake lines among `lines` (scripted
-/// methods ignore parameter sets, protocols and training seeds, so the first line of
-/// each is taken), each prefixed with the scenario's source.
-pub fn survivability_warnings(scenarios: &[Scenario], lines: &[ResultLine]) -> Vec<String> {
-    let witness = |scenario: &str, method: Method| {
+/// rules on which the batch ran the scripted references, each prefixed with the
+/// scenario's source: never-brake's from its line among `lines`, brake-on-pedestrian's
+/// from the careful cruises `check-map` drives ([`careful_witness`]), at the episodes
+/// and seed of its line (whose figures are the top-speed cruise's), so that batch and
+/// `check-map --seed S` give one verdict. Scripted methods ignore parameter sets,
+/// protocols and training seeds, so the first line of each is taken. Stops when
+/// `progress` asks ([`Error::Interrupted`]).
+pub fn survivability_warnings(
+    scenarios: &[Scenario],
+    lines: &[ResultLine],
+    progress: &dyn Progress,
+) -> Result<Vec<String>, Error> {
+    let line = |scenario: &str, method: Method| {
         lines
             .iter()
             .find(|l| l.scenario == scenario && l.method == method.name())
-            .map(|l| Witness {
-                episodes: l.episodes,
-                success_rate: l.success_rate,
-                collision_rate: l.collision_rate,
-                timeout_rate: l.timeout_rate,
-                cruise: 1.0,
-            })
     };
-    scenarios
-        .iter()
-        .filter_map(|s| s.map().map(|map| (s, map)))
-        .filter(|(_, map)| !map.pedestrians.is_empty())
-        .flat_map(|(s, map)| {
-            let name = &map.name;
-            warnings(
-                name,
-                witness(name, Method::BrakeOnPedestrian).as_ref(),
-                witness(name, Method::NeverBrake).as_ref(),
-            )
-            .into_iter()
-            .map(move |w| format!("{}: {w}", s.source))
-        })
-        .collect()
+    let mut out = Vec::new();
+    for (s, map) in scenarios.iter().filter_map(|s| s.map().map(|map| (s, map))) {
+        if map.pedestrians.is_empty() {
+            continue;
+        }
+        let name = &map.name;
+        let brake = match line(name, Method::BrakeOnPedestrian) {
+            Some(l) => Some(careful_witness(map, l.episodes, l.seed, &CancelOnly(progress))?.0),
+            None => None,
+        };
+        let never_brake = line(name, Method::NeverBrake).map(|l| Witness {
+            episodes: l.episodes,
+            success_rate: l.success_rate,
+            collision_rate: l.collision_rate,
+            timeout_rate: l.timeout_rate,
+            cruise: 1.0,
+        });
+        out.extend(
+            warnings(name, brake.as_ref(), never_brake.as_ref())
+                .into_iter()
+                .map(|w| format!("{}: {w}", s.source)),
+        );
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
 
-use crate::episodes::experiments::{evaluate_scripted, evaluate_under};
+use crate::episodes::evaluation::{evaluate_scripted, evaluate_under};
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::runner::EpisodeResult;
 use crate::error::Error;
@@ -129,7 +129,7 @@ pub fn run_plan(
     let head: String = std::iter::once(identity.to_line())
         .chain(plan.kept.iter().map(|l| l.raw.clone()))
         .collect();
-    crate::reports::files::write_atomic(out, head.as_bytes())?;
+    crate::files::write_atomic(out, head.as_bytes())?;
     let file = std::fs::OpenOptions::new()
         .append(true)
         .open(out)
@@ -161,6 +161,6 @@ pub fn run_plan(
     let text: String = std::iter::once(identity.to_line())
         .chain(lines.iter().map(|l| l.raw.clone()))
         .collect();
-    crate::reports::files::write_atomic(out, text.as_bytes())?;
+    crate::files::write_atomic(out, text.as_bytes())?;
     Ok(lines.into_iter().map(|l| l.parsed).collect())
 }

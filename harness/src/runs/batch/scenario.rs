@@ -2,7 +2,7 @@
 //! or embedded names, with their names checked unique.
 
 use std::path::{Path, PathBuf};
-use unforeseen_sim::Map;
+use unforeseen_sim::{EMBEDDED_PREFIX, Map};
 
 use crate::error::Error;
 use crate::runs::stream::Stream;
@@ -75,7 +75,7 @@ impl Scenario {
             ScenarioKind::Map(map) => serde_json::to_string(map),
             ScenarioKind::Stream(s) => serde_json::to_string(&("stream", &s.name, &s.maps, s.order)),
         };
-        crate::seeds::content_hash(text.unwrap_or_default().as_bytes())
+        unforeseen_env::seeds::content_hash(text.unwrap_or_default().as_bytes())
     }
 }
 
@@ -105,7 +105,7 @@ fn read_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
             .map(|n| {
                 Ok(Scenario::of_map(
                     unforeseen_sim::embedded::load(n)?,
-                    format!("embedded:{n}"),
+                    format!("{EMBEDDED_PREFIX}{n}"),
                 ))
             })
             .collect();
@@ -132,7 +132,7 @@ fn read_scenarios(paths: &[PathBuf]) -> Result<Vec<Scenario>, Error> {
             scenarios.push(Scenario::of_map(crate::maps::load_file(p)?, p.display().to_string()));
         } else {
             let map = crate::maps::load(&p.to_string_lossy())?;
-            let source = format!("embedded:{}", map.name);
+            let source = format!("{EMBEDDED_PREFIX}{}", map.name);
             scenarios.push(Scenario::of_map(map, source));
         }
     }

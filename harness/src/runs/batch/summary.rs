@@ -3,7 +3,6 @@
 //! map of a stream fares under the two protocols.
 
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
 
 use crate::episodes::protocol::Protocol;
 use crate::stats::Stat;
@@ -245,9 +244,4 @@ fn summary_check(group: &[&ResultLine], i: usize, c: &Check) -> SummaryCheck {
         worst_value,
         worst_seed_passes: holds(&c.bound, c.limit, worst_value),
     }
-}
-
-/// Where the summary of results file `out` goes: `results.jsonl` -> `results.summary.json`.
-pub fn summary_path(out: &Path) -> PathBuf {
-    out.with_extension("summary.json")
 }

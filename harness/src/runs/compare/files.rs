@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use crate::episodes::methods::{Method, PaperFigures};
 use crate::episodes::protocol::Protocol;
 use crate::error::Error;
+use crate::files::{Csv, all_or_none, num, write_json};
 use crate::reports::figures::{BarPanel, BarRow, bar_key, grouped_bars};
-use crate::reports::files::{Csv, all_or_none, num, write_json};
 use crate::reports::tables::seed_text;
 
 use super::{CompareReport, METRICS, ProtocolTable};

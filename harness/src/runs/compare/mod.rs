@@ -7,6 +7,7 @@
 
 pub mod files;
 pub mod request;
+pub mod table;
 
 pub use files::COMPARE_FILES;
 pub use request::{CompareJob, CompareRequest};
@@ -17,7 +18,7 @@ use std::collections::BTreeMap;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::{Map, Reward};
 
-use crate::episodes::experiments::{MethodRow, evaluate_under, method_row};
+use crate::episodes::evaluation::{MethodRow, evaluate_under, method_row};
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::Protocol;

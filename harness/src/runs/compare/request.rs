@@ -65,13 +65,13 @@ impl Default for CompareRequest {
     fn default() -> Self {
         CompareRequest {
             train_map: DEFAULT_TRAIN_MAP.to_string(),
-            test_map: "jaywalk".to_string(),
+            test_map: crate::maps::DEFAULT_TEST_MAP.to_string(),
             train_episodes: DEFAULT_TRAIN_EPISODES,
-            episodes: 100,
+            episodes: crate::limits::DEFAULT_EPISODES,
             ablations: false,
             protocol: ProtocolChoice::Both,
             sets: Vec::new(),
-            seed: 7,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             out: Some(PathBuf::from("out/compare")),
             agent: None,
             train_seeds: None,

@@ -26,7 +26,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::space::{Domain, Space};
-use crate::seeds::episode_seed;
+use unforeseen_env::seeds::episode_seed;
 
 /// Share of the scored candidates that form the elite.
 pub const ELITE_SHARE: f64 = 0.2;

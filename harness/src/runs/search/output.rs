@@ -318,7 +318,7 @@ pub(super) fn write_all(cfg: &SearchConfig<'_>, out: &Path, outcome: &Outcome) -
         failures,
         rejected,
     };
-    crate::reports::files::write_json(&out.join(SUMMARY), &summary)?;
+    crate::files::write_json(&out.join(SUMMARY), &summary)?;
     Ok(summary)
 }
 
@@ -459,7 +459,7 @@ fn write_failure(cfg: &SearchConfig<'_>, dir: &Path, m: &Minimised) -> Result<Fa
     })?;
     text.push_str(&body);
     text.push('\n');
-    crate::reports::files::write_atomic(&path, text.as_bytes())?;
+    crate::files::write_atomic(&path, text.as_bytes())?;
     Ok(FailureReport {
         name: map.name.clone(),
         file: path,
@@ -524,20 +524,22 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
     let names: Vec<String> = dims.iter().map(|&d| space.params[d].name.clone()).collect();
     // Position of a candidate on axis d: the value for a range, the cell (jittered by the
     // candidate's number, so points of one cell do not hide each other) otherwise.
-    let position = |e: &Evaluated, d: usize| -> f64 {
-        let p = &space.params[d];
-        match (&p.domain, &e.candidate.values[d]) {
-            (Domain::Range(..), Value::Num(x)) => *x,
-            _ => {
-                let cells = p.cells().unwrap_or(1) as f64;
-                let cell = (p.coordinate(&e.candidate.values[d]) * cells - 0.5).round();
-                let jitter = (crate::seeds::episode_seed(0, "search/jitter", (e.candidate.index * 2 + d) as u64) % 1000)
-                    as f64
-                    / 1000.0;
-                cell + 0.6 * (jitter - 0.5)
+    let position =
+        |e: &Evaluated, d: usize| -> f64 {
+            let p = &space.params[d];
+            match (&p.domain, &e.candidate.values[d]) {
+                (Domain::Range(..), Value::Num(x)) => *x,
+                _ => {
+                    let cells = p.cells().unwrap_or(1) as f64;
+                    let cell = (p.coordinate(&e.candidate.values[d]) * cells - 0.5).round();
+                    let jitter =
+                        (unforeseen_env::seeds::episode_seed(0, "search/jitter", (e.candidate.index * 2 + d) as u64)
+                            % 1000) as f64
+                            / 1000.0;
+                    cell + 0.6 * (jitter - 0.5)
+                }
             }
-        }
-    };
+        };
     let axis = |d: Option<usize>| -> (f64, f64) {
         match d.map(|d| &space.params[d].domain) {
             Some(Domain::Range(lo, hi)) => {

@@ -83,12 +83,12 @@ impl Default for SearchRequest {
     fn default() -> Self {
         SearchRequest {
             space: PathBuf::new(),
-            map: "jaywalk".into(),
+            map: crate::maps::DEFAULT_TEST_MAP.into(),
             method: Method::Scaled,
             protocol: Protocol::ZeroShot,
             budget: 100,
             episodes: 20,
-            seed: 7,
+            seed: unforeseen_env::seeds::DEFAULT_SEED,
             sobol_share: DEFAULT_SOBOL_SHARE,
             rounds: DEFAULT_ROUNDS,
             max_failures: DEFAULT_MAX_FAILURES,

@@ -6,7 +6,7 @@
 //! independent draws. The scramble seed derives from the run seed: the same seed gives
 //! the same points.
 
-use crate::seeds::episode_seed;
+use unforeseen_env::seeds::episode_seed;
 
 /// Most points one sequence gives (the crate's limit, 2^16).
 pub const MAX_POINTS: usize = 1 << 16;

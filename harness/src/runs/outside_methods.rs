@@ -6,7 +6,7 @@
 //!
 //! A method given from outside is known by its name alone: the name its lines carry, from
 //! which its episodes' controller seeds derive
-//! ([`eval_seeds_named`](crate::episodes::experiments::eval_seeds_named); the world seeds
+//! ([`eval_seeds_named`](crate::episodes::evaluation::eval_seeds_named); the world seeds
 //! depend on the map and the episode only, so every method meets the same pedestrians).
 //! A policy given under a built-in method's name, and acting as it does, gives that
 //! method's line (timing aside); its line carries no expectation checks (a map's
@@ -15,7 +15,7 @@
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_env::EnvConfig;
 
-use crate::episodes::experiments::{MakeControllerMut, evaluate_in_order};
+use crate::episodes::evaluation::{MakeControllerMut, evaluate_in_order};
 use crate::episodes::metrics::{Aggregate, efe_prefix_tree};
 use crate::episodes::protocol::Protocol;
 use crate::episodes::runner::EpisodeResult;
@@ -28,7 +28,7 @@ use crate::runs::batch::{ResultLine, Scenario, UnitLabel};
 pub struct ExternalMethod<'a> {
     /// Its name in the lines; its controller seeds derive from it ([`eval_seeds_named`]).
     ///
-    /// [`eval_seeds_named`]: crate::episodes::experiments::eval_seeds_named
+    /// [`eval_seeds_named`]: crate::episodes::evaluation::eval_seeds_named
     pub name: &'a str,
     /// How the env observes for it (the form its policy reads).
     pub config: EnvConfig,
@@ -137,7 +137,7 @@ pub fn evaluate_external(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::episodes::experiments::evaluate_scripted;
+    use crate::episodes::evaluation::evaluate_scripted;
     use crate::episodes::methods::Method;
     use crate::episodes::reference::NeverBrake;
     use crate::progress::NoProgress;

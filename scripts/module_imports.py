@@ -1,11 +1,33 @@
 #!/usr/bin/env python3
-# Usage: python3 scripts/module_cycles.py .   (exit status 1 if any crate has a cycle)
-"""Module-level dependency cycles inside each crate of the workspace: an edge a -> b
-when a's code (comments stripped) names `crate::b...` (also inside `use crate::{...}`
-groups) or `super::b...`. Reports strongly connected components with more than one file."""
+# Usage: python3 scripts/module_imports.py .   (exit status 1 on a cycle or an upward import)
+"""Module-level imports inside each crate of the workspace (and of the Python binding,
+python/src): an edge a -> b when a's code (comments stripped) names `crate::b...` (also
+inside `use crate::{...}` groups) or `super::b...`.
+
+Fails on:
+* a cycle: a strongly connected component with more than one file;
+* an import that runs up a floor of the harness (FLOORS, lowest first; docs/ARCHITECTURE.md
+  §1): a module may import its own floor and the floors below, never one above."""
 import os, re, sys
 root = sys.argv[1]
-crates = {'unforeseen': 'src', 'harness': 'harness/src', 'sim': 'sim/src', 'agent': 'agent/src', 'discretizer': 'discretizer/src', 'env': 'env/src'}
+crates = {'unforeseen': 'src', 'harness': 'harness/src', 'sim': 'sim/src', 'agent': 'agent/src', 'discretizer': 'discretizer/src', 'env': 'env/src', 'python': 'python/src'}
+# The harness's floors, lowest first: each entry is a module or a folder (every module
+# under it). The output guard sits below the jobs it guards.
+FLOORS = {'harness': [
+    ['error', 'files', 'progress', 'limits', 'stats'],
+    ['maps', 'overrides', 'episodes'],
+    ['training'],
+    ['reports'],
+    ['runs::outputs'],
+    ['runs'],
+]}
+def floor_of(floors, module):
+    best, depth = None, -1
+    for i, floor in enumerate(floors):
+        for prefix in floor:
+            if (module == prefix or module.startswith(prefix + '::')) and prefix.count('::') > depth:
+                best, depth = i, prefix.count('::')
+    return best
 for extra in sys.argv[2:]:
     crates[extra] = extra + '/src'
 def strip(text):
@@ -91,4 +113,20 @@ for name, src in crates.items():
         for a in c:
             print('   ', a, '->', sorted(e for e in edges[a] if e in c))
     total += len(sccs)
+    floors = FLOORS.get(name)
+    if floors:
+        upward = []
+        for a in sorted(mods):
+            fa = floor_of(floors, a)
+            if a and fa is None:
+                upward.append(f'{a}: on no floor (add it to FLOORS)')
+                continue
+            for b in sorted(edges[a]):
+                fb = floor_of(floors, b)
+                if fa is not None and fb is not None and fb > fa:
+                    upward.append(f'{a} (floor {fa}) -> {b} (floor {fb})')
+        print(f'{name}: {len(floors)} floors, upward imports: {upward or "none"}')
+        for u in upward:
+            print('   ', u)
+        total += len(upward)
 sys.exit(1 if total else 0)

@@ -1,5 +1,10 @@
 //! Per-episode seeds derived from the run seed and the episode's identity, never from
-//! thread or completion order, so results do not depend on `--jobs`.
+//! thread or completion order, so results do not depend on `--jobs`: what every
+//! episode's [`Env::reset`](crate::Env::reset) seed derives from, in the harness's jobs and
+//! in the Gymnasium env alike, and the content hash of files and settings.
+
+/// The run seed every job uses unless given one (`--seed`, Python's `seed`).
+pub const DEFAULT_SEED: u64 = 7;
 
 /// 64-bit FNV-1a over the parts, each followed by a separator byte.
 fn fnv1a(parts: &[&[u8]]) -> u64 {
