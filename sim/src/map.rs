@@ -604,6 +604,10 @@ pub struct Map {
     pub episode: Episode,
     /// Expected batch results (replaces the base's list when set). Default [].
     pub expect: Vec<Expectation>,
+    /// The base whose `expect` list this map inherited (its file sets none), if any: said
+    /// by `check-map`, since those checks decide batch's exit code for this map too.
+    #[serde(skip)]
+    pub expect_inherited_from: Option<String>,
 }
 
 /// Partial map as read from a file, before it is laid over its base.
@@ -666,8 +670,13 @@ impl MapPatch {
         if let Some(p) = self.episode {
             p.apply(&mut base.episode);
         }
-        if let Some(p) = self.expect {
-            base.expect = p;
+        match self.expect {
+            Some(p) => {
+                base.expect = p;
+                base.expect_inherited_from = None;
+            }
+            None if !base.expect.is_empty() => base.expect_inherited_from = base.base.clone(),
+            None => {}
         }
         base
     }
@@ -806,6 +815,13 @@ impl Map {
             e.substeps(),
             e.max_steps
         );
+        if let Some(from) = &self.expect_inherited_from {
+            let _ = writeln!(
+                s,
+                "expectations: {}, inherited from {from} (they decide batch's exit code here too; set `expect: []` for none)",
+                self.expect.len()
+            );
+        }
         for x in &self.expect {
             let mut parts = Vec::new();
             for (label, val) in [

@@ -89,10 +89,10 @@ fn a_run_without_training_seeds_shows_no_question_mark_for_its_worst_seed() {
 
 #[test]
 fn a_map_given_as_the_agent_is_named_a_map_and_no_hint_points_at_it() {
-    let out = unforeseen(&["eval", "--agent", "maps/near_stop.ron", "--episodes", "1"]);
-    assert_exit(&out, 2, &["maps/near_stop.ron", "is a map file, not an agent file"]);
+    let out = unforeseen(&["eval", "--agent", "maps/near_kerb.ron", "--episodes", "1"]);
+    assert_exit(&out, 2, &["maps/near_kerb.ron", "is a map file, not an agent file"]);
     let all = text(&out);
-    assert!(!all.contains("--out maps/near_stop.ron"), "{all}");
+    assert!(!all.contains("--out maps/near_kerb.ron"), "{all}");
 }
 
 #[test]
