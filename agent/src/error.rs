@@ -25,12 +25,27 @@ impl ParamError {
     }
 }
 
+/// What to say of the unknown parameter `key`: the nearest of `known` when it is a typo
+/// away (two edits at most, as the map loader suggests a field), then every key.
+fn suggestion(key: &str, known: &[&'static str]) -> String {
+    let near = known
+        .iter()
+        .map(|k| (strsim::levenshtein(key, k), *k))
+        .min_by_key(|(d, _)| *d)
+        .filter(|(d, _)| *d <= 2);
+    let all = format!("known: {}", known.join(", "));
+    match near {
+        Some((_, k)) => format!("did you mean `{k}`? ({all})"),
+        None => all,
+    }
+}
+
 /// A parameter of [`crate::params::ScaledParams`] set by name
 /// ([`crate::param_table`]) with an unknown key or a value it does not admit.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum SetError {
     /// No parameter has this key.
-    #[error("unknown parameter `{key}`; known: {}", known.join(", "))]
+    #[error("unknown parameter `{key}`; {}", suggestion(key, known))]
     UnknownKey {
         /// The key as given.
         key: String,

@@ -14,9 +14,10 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::methods::Method;
 use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::limits::check_episodes;
 use unforeseen_harness::runs::evaluate::EvalRequest;
+use unforeseen_harness::training::seed_agents::TrainSeeds;
 
+use crate::convert;
 use crate::errors;
 use crate::reports::EvalResult;
 
@@ -146,13 +147,20 @@ impl PyAgent {
     }
 }
 
-/// Trains an agent on `map` for `episodes` episodes from `seed` (as `unforeseen train`),
-/// with the GIL released.
+/// Trains an agent on `map` (a map file or an embedded name) for `episodes` episodes
+/// from `seed` (as `unforeseen train`), with the GIL released; Ctrl-C raises
+/// `KeyboardInterrupt`. The arguments as [`crate::convert`] reads them.
 #[pyfunction]
-#[pyo3(signature = (map = "intersection", episodes = 6000, seed = 7))]
-fn train(py: Python<'_>, map: &str, episodes: u64, seed: u64) -> PyResult<PyAgent> {
-    check_episodes("episodes", episodes).map_err(errors::to_py)?;
-    let map = crate::maps::load(map, None)?;
+fn train(
+    py: Python<'_>,
+    map: &Bound<'_, PyAny>,
+    episodes: &Bound<'_, PyAny>,
+    seed: &Bound<'_, PyAny>,
+) -> PyResult<PyAgent> {
+    let map = convert::path("map", map)?;
+    let episodes = convert::episodes("episodes", episodes)?;
+    let seed = convert::seed("seed", seed)?;
+    let map = crate::maps::load(&map.to_string_lossy(), None)?;
     let cfg = unforeseen_harness::training::TrainConfig::new(episodes, seed);
     let (bundle, log) = crate::interrupt::interruptible(py, |progress| {
         unforeseen_harness::training::train_with_progress(&map, &cfg, progress)
@@ -165,34 +173,35 @@ fn train(py: Python<'_>, map: &str, episodes: u64, seed: u64) -> PyResult<PyAgen
 
 /// Trains one agent per seed of `seeds` on `map`, in parallel (rayon, the GIL released),
 /// loading and saving them in the agent cache `cache` (`None`: no cache) as
-/// `--train-seeds` does, so a notebook and the command line share agents.
+/// `--train-seeds` does, so a notebook and the command line share agents. The seeds
+/// are bounded as `--train-seeds` bounds them ([`TrainSeeds::new`]: at least one, at
+/// most 1,000, each once); the cache folder is checked before any training.
 #[pyfunction]
-#[pyo3(signature = (seeds, map = "intersection", episodes = 6000, cache = Some(PathBuf::from(unforeseen_harness::training::seed_agents::DEFAULT_CACHE)), timeout_as = "truncation"))]
 fn train_agents(
     py: Python<'_>,
-    seeds: Vec<u64>,
-    map: &str,
-    episodes: u64,
-    cache: Option<PathBuf>,
-    timeout_as: &str,
+    seeds: &Bound<'_, PyAny>,
+    map: &Bound<'_, PyAny>,
+    episodes: &Bound<'_, PyAny>,
+    cache: Option<&Bound<'_, PyAny>>,
+    timeout_as: &Bound<'_, PyAny>,
 ) -> PyResult<Vec<PyAgent>> {
-    check_episodes("episodes", episodes).map_err(errors::to_py)?;
-    if seeds.is_empty() {
-        return Err(errors::value("seeds: give at least one training seed"));
-    }
-    let timeout_as = timeout_as
+    let seeds = TrainSeeds::new(convert::seeds("seeds", seeds)?).map_err(|e| errors::value(format!("seeds: {e}")))?;
+    let map = convert::path("map", map)?;
+    let episodes = convert::episodes("episodes", episodes)?;
+    let cache = cache.map(|c| convert::path("cache", c)).transpose()?;
+    let timeout_as = convert::text("timeout_as", timeout_as)?
         .parse()
         .map_err(|e: String| errors::value(format!("timeout_as: {e}")))?;
     if let Some(dir) = &cache {
         unforeseen_harness::runs::outputs::check_cache(dir).map_err(errors::to_py)?;
     }
-    let map = crate::maps::load(map, None)?;
+    let map = crate::maps::load(&map.to_string_lossy(), None)?;
     let cfg = unforeseen_harness::training::TrainConfig {
         timeout_as,
         ..unforeseen_harness::training::TrainConfig::new(episodes, 0)
     };
     let agents = crate::interrupt::interruptible(py, |progress| {
-        unforeseen_harness::training::seed_agents::train_agents(&map, &seeds, &cfg, cache.as_deref(), progress)
+        unforeseen_harness::training::seed_agents::train_agents(&map, &seeds.0, &cfg, cache.as_deref(), progress)
     })?;
     Ok(agents
         .into_iter()
@@ -370,24 +379,30 @@ impl PyController {
 /// policy's under the name its lines carry
 /// ([`unforeseen_harness::episodes::evaluation::eval_seeds_named`]).
 #[pyfunction]
-fn eval_seeds(seed: u64, map: &str, method: &str, episode: u64) -> PyResult<(u64, u64)> {
-    if method.is_empty() {
-        return Err(errors::value("method: give a method's name, e.g. 'scaled'"));
-    }
-    let map = crate::maps::load(map, None)?;
-    let s = unforeseen_harness::episodes::evaluation::eval_seeds_named(seed, &map, method, episode);
+fn eval_seeds(
+    seed: &Bound<'_, PyAny>,
+    map: &Bound<'_, PyAny>,
+    method: &Bound<'_, PyAny>,
+    episode: &Bound<'_, PyAny>,
+) -> PyResult<(u64, u64)> {
+    let seed = convert::seed("seed", seed)?;
+    let map = convert::path("map", map)?;
+    let method = convert::text("method", method)?;
+    let episode = convert::whole("episode", episode, convert::SEEDS)?;
+    let map = crate::maps::load(&map.to_string_lossy(), None)?;
+    let s = unforeseen_harness::episodes::evaluation::eval_seeds_named(seed, &map, &method, episode);
     Ok((s.world, s.controller))
 }
 
-/// `unforeseen eval`: the eval `request` (JSON text of its fields, the library's
-/// `EvalRequest`) planned, its agent trained or loaded and its episodes run by the
+/// `unforeseen eval`: the eval `request` (its fields as keyword arguments, read by
+/// [`convert::request`] into the library's `EvalRequest`) planned, its agent trained or loaded and its episodes run by the
 /// library with the GIL released, as the command line runs it, writing the same
 /// eval.json into `out` (when the request has one); `agent` is an agent given loaded
 /// instead of the request's agent file. Returns its report ([`EvalResult`]).
 #[pyfunction]
 #[pyo3(signature = (request, agent = None))]
-fn evaluate(py: Python<'_>, request: &str, agent: Option<&PyAgent>) -> PyResult<EvalResult> {
-    let request: EvalRequest = crate::requests::request(request)?;
+fn evaluate(py: Python<'_>, request: &Bound<'_, PyDict>, agent: Option<&PyAgent>) -> PyResult<EvalResult> {
+    let request: EvalRequest = convert::request(request)?;
     let given = agent.map(|a| a.bundle.clone());
     let outcome = crate::interrupt::interruptible(py, |progress| {
         let job = request.plan(given)?;

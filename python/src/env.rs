@@ -15,13 +15,22 @@ use pyo3::types::{PyDict, PyTuple};
 use unforeseen_env::{Env, EnvConfig, Info, Observation, ObservationForm, kinematic};
 use unforeseen_sim::Map;
 
+use crate::convert;
 use crate::errors;
 use crate::render;
 
 /// World seed of episode `episode` of the stream keyed `key`.
-#[pyfunction]
 pub fn stream_seed(key: u64, episode: u64) -> u64 {
     unforeseen_env::seeds::episode_seed(key, "gymnasium", episode)
+}
+
+/// [`stream_seed`] for Python: `key` and `episode` any whole numbers of `u64`.
+#[pyfunction(name = "stream_seed")]
+fn py_stream_seed(key: &Bound<'_, PyAny>, episode: &Bound<'_, PyAny>) -> PyResult<u64> {
+    Ok(stream_seed(
+        convert::seed("key", key)?,
+        convert::whole("episode", episode, convert::SEEDS)?,
+    ))
 }
 
 /// Parses an observation form name.
@@ -178,20 +187,33 @@ pub struct PyEnv {
     episode: u64,
 }
 
+impl PyEnv {
+    /// Starts an episode with world seed `seed`: `(observation, info)`.
+    fn reset_with<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyTuple>> {
+        let (obs, info) = self.env.reset(seed);
+        (observation(py, &obs), info_dict(py, &self.env, &self.states, &info)?).into_pyobject(py)
+    }
+}
+
 #[pymethods]
 impl PyEnv {
     /// An env of `map` (file or embedded name) with map `overrides` (dict).
     #[new]
-    #[pyo3(signature = (map, observation = "discrete", pedestrian_slots = 4, overrides = None))]
+    #[pyo3(signature = (map, observation = "discrete", pedestrian_slots = None, overrides = None))]
     fn new(
         py: Python<'_>,
-        map: &str,
+        map: &Bound<'_, PyAny>,
         observation: &str,
-        pedestrian_slots: usize,
+        pedestrian_slots: Option<&Bound<'_, PyAny>>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        let map = convert::path("map", map)?;
+        let pedestrian_slots = pedestrian_slots
+            .map(|n| convert::size("pedestrian_slots", n, 1..=kinematic::MAX_SLOTS))
+            .transpose()?
+            .unwrap_or(EnvConfig::default().pedestrian_slots);
         let form = observation_form(observation)?;
-        let map = crate::maps::load(map, overrides)?;
+        let map = crate::maps::load(&map.to_string_lossy(), overrides)?;
         let env = new_env(&map, form, pedestrian_slots)?;
         Ok(PyEnv {
             states: state_tuples(py, &env)?,
@@ -252,23 +274,26 @@ impl PyEnv {
         self.env.map().episode.max_steps
     }
 
-    /// Starts an episode with world seed `seed` exactly: `(observation, info)`.
-    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyTuple>> {
-        let (obs, info) = self.env.reset(seed);
-        (observation(py, &obs), info_dict(py, &self.env, &self.states, &info)?).into_pyobject(py)
+    /// Starts an episode with world seed `seed` exactly (named `world_seed` in errors,
+    /// as `reset(options={"world_seed": ...})` gives it): `(observation, info)`.
+    fn reset<'py>(&mut self, py: Python<'py>, seed: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyTuple>> {
+        let seed = convert::seed("world_seed", seed)?;
+        self.reset_with(py, seed)
     }
 
     /// Keys the episode stream (see the module docs); the next `reset_next` is episode 0.
-    fn set_stream(&mut self, key: u64) {
+    fn set_stream(&mut self, key: &Bound<'_, PyAny>) -> PyResult<()> {
+        let key = convert::seed("key", key)?;
         self.key = key;
         self.episode = 0;
+        Ok(())
     }
 
     /// Starts the stream's next episode: `(observation, info)`.
     fn reset_next<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let seed = stream_seed(self.key, self.episode);
         self.episode += 1;
-        self.reset(py, seed)
+        self.reset_with(py, seed)
     }
 
     /// The world seed the last `reset_next` used, if any.
@@ -329,34 +354,44 @@ impl PyEnv {
     }
 }
 
+/// Ticks [`rust_loop`] runs between two looks at Ctrl-C (well under a millisecond).
+const TICKS_PER_LOOK: u64 = 1024;
+
 /// Steps `steps` decision ticks of `map` in Rust alone, with the actions of `actions`
 /// in turn, starting a new episode (world seeds `stream_seed(seed, k)`) whenever one ends;
-/// the GIL is released; `overrides` as for `Env`. Returns `(ticks, seconds, episodes)`: the Rust loop's own speed,
-/// for the benches.
+/// the GIL is released and Ctrl-C raises `KeyboardInterrupt` within about 50 ms
+/// ([`crate::interrupt`]); `overrides` as for `Env`. Returns `(ticks, seconds,
+/// episodes)`: the Rust loop's own speed, for the benches.
 #[pyfunction]
-#[pyo3(signature = (map, actions, steps, seed = 0, observation = "discrete", overrides = None))]
+#[pyo3(signature = (map, actions, steps, seed = None, observation = "discrete", overrides = None))]
 pub fn rust_loop(
     py: Python<'_>,
-    map: &str,
+    map: &Bound<'_, PyAny>,
     actions: Vec<i64>,
-    steps: u64,
-    seed: u64,
+    steps: &Bound<'_, PyAny>,
+    seed: Option<&Bound<'_, PyAny>>,
     observation: &str,
     overrides: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<(u64, f64, u64)> {
+    let map = convert::path("map", map)?;
+    let steps = convert::whole("steps", steps, convert::SEEDS)?;
+    let seed = seed.map(|s| convert::seed("seed", s)).transpose()?.unwrap_or(0);
     let form = observation_form(observation)?;
-    let map = crate::maps::load(map, overrides)?;
+    let map = crate::maps::load(&map.to_string_lossy(), overrides)?;
     let mut env = new_env(&map, form, 4)?;
     let actions = actions.into_iter().map(action_index).collect::<PyResult<Vec<_>>>()?;
     if actions.is_empty() {
         return Err(errors::value("actions: give at least one action"));
     }
-    py.detach(|| {
+    crate::interrupt::interruptible(py, |progress| {
         let started = std::time::Instant::now();
         let mut episodes = 0;
         env.reset(stream_seed(seed, 0));
         for t in 0..steps {
-            let step = env.step(actions[t as usize % actions.len()]).map_err(errors::to_py)?;
+            if t % TICKS_PER_LOOK == 0 && progress.cancelled() {
+                return Err(unforeseen_harness::error::Error::Interrupted);
+            }
+            let step = env.step(actions[t as usize % actions.len()])?;
             std::hint::black_box(&step);
             if step.terminated || step.truncated {
                 episodes += 1;
@@ -370,7 +405,7 @@ pub fn rust_loop(
 /// Registers the env class and functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyEnv>()?;
-    m.add_function(wrap_pyfunction!(stream_seed, m)?)?;
+    m.add_function(wrap_pyfunction!(py_stream_seed, m)?)?;
     m.add_function(wrap_pyfunction!(rust_loop, m)?)?;
     Ok(())
 }

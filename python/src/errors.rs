@@ -30,7 +30,7 @@ fn is_user_error(err: &DynError) -> bool {
 }
 
 /// The message the command line prints: the error and its causes, joined by `: `.
-fn message(err: &DynError) -> String {
+pub fn message(err: &DynError) -> String {
     let mut text = err.to_string();
     let mut cause = err.source();
     while let Some(e) = cause {

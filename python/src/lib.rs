@@ -5,6 +5,8 @@
 //! The Python package `unforeseen` (python/unforeseen/) wraps these classes into
 //! Gymnasium environments; `_unforeseen.pyi` is the interface, class by class.
 //!
+//! * [`convert`]: Python arguments (counts, seeds, sizes, paths, a job's keyword
+//!   arguments) to the library's values, every refusal naming its argument;
 //! * [`maps`]: a map by file or embedded name, with keyword overrides as a RON patch
 //!   validated by the map loader;
 //! * [`env`]: one episode API ([`unforeseen_env::Env`]) per Python object;
@@ -22,6 +24,7 @@
 //! * [`errors`]: Rust errors as Python exceptions (`ValueError` for what the user can fix).
 
 mod agent;
+mod convert;
 mod env;
 mod errors;
 mod interrupt;
@@ -53,8 +56,13 @@ fn version() -> &'static str {
 /// The extension module.
 #[pymodule]
 fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // NumPy's C API, fetched now, at import: the numpy crate fetches it on first use and
+    // reports a failure as a panic, which a Ctrl-C pending at that moment made (a
+    // `PanicException` instead of `KeyboardInterrupt` while stepping a vector env).
+    numpy::PyArray1::<f32>::zeros(m.py(), [0], false);
     m.add_function(wrap_pyfunction!(embedded_maps, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
+    convert::register(m)?;
     env::register(m)?;
     vector::register(m)?;
     agent::register(m)?;

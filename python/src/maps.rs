@@ -22,14 +22,12 @@ pub fn load(arg: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Map> {
             let mut fields = Vec::new();
             for (k, v) in o.iter() {
                 let key: String = k.extract()?;
-                let (section, field) = locate(&key, &sections)?;
-                if v.is_instance_of::<PyFloat>() && is_whole_number(&section, &field) {
-                    return Err(errors::value(format!(
-                        "map override {key}: {v} is not an integer; {section}.{field} is a whole number: give an int (e.g. {key}={})",
-                        v.extract::<f64>()?.round().max(0.0)
-                    )));
-                }
-                let value = ron_value(&key, &v, 0)?;
+                let (section, field, whole) = locate(&key, &sections)?;
+                let value = if whole {
+                    whole_value(&key, &section, &field, &v)?
+                } else {
+                    ron_value(&key, &v, 0)?
+                };
                 fields.push((section, field, value));
             }
             patch(&map, arg, &fields)
@@ -38,43 +36,69 @@ pub fn load(arg: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Map> {
     }
 }
 
+/// A section of a map: its name and its fields, each with whether it is a whole number.
+type Section = (String, Vec<(String, bool)>);
+
 /// The sections of a map and their fields, from the map's own serialization (so new
-/// fields need no change here).
-fn sections() -> Vec<(String, Vec<String>)> {
+/// fields need no change here); a field whose default serializes as an integer is a
+/// whole number, so an override of another type is refused by name rather than parsed.
+fn sections() -> Vec<Section> {
     let value = serde_json::to_value(Map::default()).unwrap_or_default();
     let mut out = Vec::new();
     if let Some(top) = value.as_object() {
         for (section, v) in top {
             if let Some(fields) = v.as_object() {
-                out.push((section.clone(), fields.keys().cloned().collect()));
+                let fields = fields
+                    .iter()
+                    .map(|(f, d)| (f.clone(), d.as_number().is_some_and(|n| n.is_u64() || n.is_i64())))
+                    .collect();
+                out.push((section.clone(), fields));
             }
         }
     }
     out
 }
 
-/// Whether `section.field` of a map is a whole number (its default serializes as an
-/// integer), so a float override is refused by name instead of failing in the RON parser.
-fn is_whole_number(section: &str, field: &str) -> bool {
-    let value = serde_json::to_value(Map::default()).unwrap_or_default();
-    value[section][field]
-        .as_number()
-        .is_some_and(|n| n.is_u64() || n.is_i64())
+/// The override `v` of the whole-number field `section.field` (given as `key`) as RON
+/// text: a Python or NumPy integer; a bool, a float (NaN and inf too) or text is refused.
+fn whole_value(key: &str, section: &str, field: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
+    let refuse = |shown: String| {
+        errors::value(format!(
+            "map override {key}: {shown} is not a whole number; {section}.{field} is a whole number: give an int (e.g. {key}=60)"
+        ))
+    };
+    if v.is_instance_of::<PyBool>() || v.is_instance_of::<PyFloat>() || v.is_instance_of::<PyString>() {
+        return Err(refuse(v.repr()?.to_string()));
+    }
+    if !v.is_instance_of::<PyInt>() && !v.hasattr("__index__")? {
+        return Err(refuse(v.repr()?.to_string()));
+    }
+    Ok(v.extract::<i128>()
+        .map_err(|_| refuse(v.repr().map(|r| r.to_string()).unwrap_or_default()))?
+        .to_string())
 }
 
 /// `key` as `(section, field)`: `section__field`, or a field name that only one
 /// section has.
-fn locate(key: &str, sections: &[(String, Vec<String>)]) -> PyResult<(String, String)> {
+fn locate(key: &str, sections: &[Section]) -> PyResult<(String, String, bool)> {
     let known = || {
         sections
             .iter()
-            .flat_map(|(s, fs)| fs.iter().map(move |f| format!("{s}__{f}")))
+            .flat_map(|(s, fs)| fs.iter().map(move |(f, _)| format!("{s}__{f}")))
             .collect::<Vec<_>>()
             .join(", ")
     };
+    let whole = |s: &str, f: &str| {
+        sections
+            .iter()
+            .filter(|(sec, _)| sec == s)
+            .flat_map(|(_, fs)| fs.iter())
+            .find(|(x, _)| x == f)
+            .map(|(_, whole)| *whole)
+    };
     if let Some((s, f)) = key.split_once("__") {
-        if sections.iter().any(|(sec, fs)| sec == s && fs.iter().any(|x| x == f)) {
-            return Ok((s.to_string(), f.to_string()));
+        if let Some(w) = whole(s, f) {
+            return Ok((s.to_string(), f.to_string(), w));
         }
         return Err(errors::value(format!(
             "map override {key}: no such field; known: {}",
@@ -83,11 +107,11 @@ fn locate(key: &str, sections: &[(String, Vec<String>)]) -> PyResult<(String, St
     }
     let owners: Vec<&String> = sections
         .iter()
-        .filter(|(_, fs)| fs.iter().any(|x| x == key))
+        .filter(|(_, fs)| fs.iter().any(|(x, _)| x == key))
         .map(|(s, _)| s)
         .collect();
     match owners[..] {
-        [s] => Ok((s.clone(), key.to_string())),
+        [s] => Ok((s.clone(), key.to_string(), whole(s, key).unwrap_or(false))),
         [] => Err(errors::value(format!(
             "map override {key}: no such field; known: {}",
             known()

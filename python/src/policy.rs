@@ -17,7 +17,6 @@
 //! signal) stops the run at once (the controller answers with an action the env refuses,
 //! which ends the episode) and is raised as it was.
 
-use std::path::PathBuf;
 use std::sync::Mutex;
 
 use pyo3::prelude::*;
@@ -27,11 +26,11 @@ use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_discretizer::Discretizer;
 use unforeseen_env::{EnvConfig, Observation, ObservationForm};
 use unforeseen_harness::error::Error;
-use unforeseen_harness::limits::check_episodes;
 use unforeseen_harness::progress::{Message, Progress};
 use unforeseen_harness::runs::batch::load_scenarios;
 use unforeseen_harness::runs::outside_methods::{ExternalMethod, ExternalRun, LinePlace, evaluate_external};
 
+use crate::convert;
 use crate::errors;
 use crate::wrapper::{Habit, PyScaledHabitAgent, Wrapped};
 
@@ -298,27 +297,29 @@ enum Evaluated<'a> {
 /// from the map and the episode, controller seeds from the name too). A Python exception
 /// raised by the policy (or `KeyboardInterrupt`) is raised as it was.
 #[pyfunction]
-#[pyo3(signature = (policy, map, method, protocols, episodes = 100, seed = 7, train_seed = None, train_episodes = None, first_unit = 0, observation = "discrete"))]
+#[pyo3(signature = (policy, map, method, protocols, episodes, seed, train_seed = None, train_episodes = None, first_unit = 0, observation = "discrete"))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate_policy(
     py: Python<'_>,
     policy: &Bound<'_, PyAny>,
-    map: PathBuf,
-    method: &str,
+    map: &Bound<'_, PyAny>,
+    method: &Bound<'_, PyAny>,
     protocols: Vec<String>,
-    episodes: u64,
-    seed: u64,
-    train_seed: Option<u64>,
-    train_episodes: Option<u64>,
+    episodes: &Bound<'_, PyAny>,
+    seed: &Bound<'_, PyAny>,
+    train_seed: Option<&Bound<'_, PyAny>>,
+    train_episodes: Option<&Bound<'_, PyAny>>,
     first_unit: usize,
     observation: &str,
 ) -> PyResult<Vec<PolicyRun>> {
-    check_episodes("episodes", episodes).map_err(errors::to_py)?;
-    if method.is_empty() {
-        return Err(errors::value(
-            "method: name the method its lines carry, e.g. 'my-policy'",
-        ));
-    }
+    let map = convert::path("map", map)?;
+    let method = &convert::text("method", method)?;
+    let episodes = convert::episodes("episodes", episodes)?;
+    let seed = convert::seed("seed", seed)?;
+    let train_seed = train_seed.map(|s| convert::seed("train_seed", s)).transpose()?;
+    let train_episodes = train_episodes
+        .map(|n| convert::episodes("train_episodes", n))
+        .transpose()?;
     let protocols = protocols
         .iter()
         .map(|p| crate::agent::protocol(p))
@@ -474,9 +475,23 @@ fn env_config(form: ObservationForm) -> EnvConfig {
     }
 }
 
+/// `(name, source)` of the scenario of each of `maps` (embedded names or map files), as
+/// the batch's result lines carry them (`"jaywalk"`, `"embedded:jaywalk"`), by the
+/// batch's own lookup ([`load_scenarios`]), which refuses a map listed twice.
+#[pyfunction]
+fn scenario_sources(maps: &Bound<'_, PyAny>) -> PyResult<Vec<(String, String)>> {
+    let maps = convert::paths("maps", maps)?;
+    let scenarios = load_scenarios(&maps).map_err(|e| errors::value(format!("maps: {}", errors::message(&e))))?;
+    Ok(scenarios
+        .iter()
+        .map(|s| (s.name().to_string(), s.source.clone()))
+        .collect())
+}
+
 /// Registers the class and the function.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PolicyRun>()?;
     m.add_function(wrap_pyfunction!(evaluate_policy, m)?)?;
+    m.add_function(wrap_pyfunction!(scenario_sources, m)?)?;
     Ok(())
 }

@@ -6,6 +6,7 @@
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use unforeseen_harness::runs::batch::{BatchRequest, ResultLine};
 use unforeseen_harness::runs::compare::CompareRequest;
 use unforeseen_harness::runs::outputs::{Guarded, Outputs, Own};
@@ -29,16 +30,16 @@ fn agents_of(agents: &Bound<'_, PyAny>) -> PyResult<Vec<Agent>> {
     Ok(list.iter().map(|a| Agent::from_bundle(a.bundle.clone())).collect())
 }
 
-/// `unforeseen compare`: the compare `request` (JSON text of its fields, the library's
-/// `CompareRequest`) planned, its agents trained or loaded and the study run by the
+/// `unforeseen compare`: the compare `request` (its fields as keyword arguments, read by
+/// [`crate::convert::request`] into the library's `CompareRequest`) planned, its agents trained or loaded and the study run by the
 /// library, as the command line runs it, writing the same files into `out` (when the
 /// request has one); `agents` are agents given loaded (an `Agent` or a list) instead of
 /// the request's agent file or training seeds. Returns its report ([`CompareResult`]).
 /// Ctrl-C raises `KeyboardInterrupt` at the next episode.
 #[pyfunction]
 #[pyo3(signature = (request, agents = None))]
-fn compare(py: Python<'_>, request: &str, agents: Option<&Bound<'_, PyAny>>) -> PyResult<CompareResult> {
-    let request: CompareRequest = crate::requests::request(request)?;
+fn compare(py: Python<'_>, request: &Bound<'_, PyDict>, agents: Option<&Bound<'_, PyAny>>) -> PyResult<CompareResult> {
+    let request: CompareRequest = crate::convert::request(request)?;
     let given = match agents {
         Some(a) => agents_of(a)?,
         None => Vec::new(),
@@ -53,16 +54,16 @@ fn compare(py: Python<'_>, request: &str, agents: Option<&Bound<'_, PyAny>>) -> 
     CompareResult::new(&report)
 }
 
-/// `unforeseen batch`: the batch `request` (JSON text of its fields, the library's
-/// `BatchRequest`) planned, its agents trained or loaded and its units run by the
+/// `unforeseen batch`: the batch `request` (its fields as keyword arguments, read by
+/// [`crate::convert::request`] into the library's `BatchRequest`) planned, its agents trained or loaded and its units run by the
 /// library, as the command line runs it, writing the same results file and summary
 /// (`out`); `agent` is an agent given loaded instead of the request's agent file.
 /// Returns its report ([`BatchResult`]): the result lines (after the file's `run` line)
 /// and the summary's rows. Ctrl-C raises `KeyboardInterrupt` at the next episode.
 #[pyfunction]
 #[pyo3(signature = (request, agent = None))]
-fn batch(py: Python<'_>, request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<BatchResult> {
-    let request: BatchRequest = crate::requests::request(request)?;
+fn batch(py: Python<'_>, request: &Bound<'_, PyDict>, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<BatchResult> {
+    let request: BatchRequest = crate::convert::request(request)?;
     let given = agent.map(|a| a.bundle.clone());
     let report = crate::interrupt::interruptible(py, |progress| {
         let job = request.plan(given)?;
@@ -113,11 +114,22 @@ impl ResultsGuard {
     }
 }
 
+/// Writes `text` to `path` as every job of the library writes its files
+/// ([`unforeseen_harness::files::write_atomic`]: a temporary file beside it,
+/// renamed over it), so a reader never sees half of it.
+#[pyfunction]
+fn write_atomic(py: Python<'_>, path: &Bound<'_, PyAny>, text: &str) -> PyResult<()> {
+    let path = crate::convert::path("path", path)?;
+    py.detach(|| unforeseen_harness::files::write_atomic(&path, text.as_bytes()))
+        .map_err(errors::to_py)
+}
+
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ResultsGuard>()?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch_result, m)?)?;
+    m.add_function(wrap_pyfunction!(write_atomic, m)?)?;
     Ok(())
 }

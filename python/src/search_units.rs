@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use rayon::prelude::*;
 use serde_json::json;
 use unforeseen_agent::persist::AgentBundle;
@@ -91,8 +92,8 @@ impl Built {
 /// when one is given, else null).
 #[pyfunction]
 #[pyo3(signature = (request, agent = None))]
-fn plan_search(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
-    let request: SearchRequest = self::request(request)?;
+fn plan_search(request: &Bound<'_, PyDict>, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
+    let request: SearchRequest = crate::convert::request(request)?;
     let setup = request.setup(agent.map(|a| a.bundle.clone())).map_err(errors::to_py)?;
     let agent_text = match &setup.agents {
         AgentChoice::Given(agent) => Some(agent.bundle.to_ron_string()),
@@ -120,8 +121,13 @@ fn plan_search(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<Str
 /// `KeyboardInterrupt` at the next episode.
 #[pyfunction]
 #[pyo3(signature = (request, agent = None, command = String::new()))]
-fn search(py: Python<'_>, request: &str, agent: Option<PyRef<'_, PyAgent>>, command: String) -> PyResult<String> {
-    let request: SearchRequest = self::request(request)?;
+fn search(
+    py: Python<'_>,
+    request: &Bound<'_, PyDict>,
+    agent: Option<PyRef<'_, PyAgent>>,
+    command: String,
+) -> PyResult<String> {
+    let request: SearchRequest = crate::convert::request(request)?;
     let given = agent.map(|a| a.bundle.clone());
     interruptible(py, |progress| {
         let job = request.plan(given)?;

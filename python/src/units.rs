@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyDict};
 use serde_json::{Value, json};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::episodes::methods::Method;
@@ -31,7 +31,6 @@ use unforeseen_harness::training::{TimeoutAs, TrainConfig};
 use crate::agent::PyAgent;
 use crate::errors;
 use crate::reports::BatchResult;
-use crate::requests::request;
 
 pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
     unforeseen_harness::limits::check_episodes(what, n).map_err(errors::to_py)?;
@@ -42,7 +41,7 @@ pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
 /// map): an embedded map's name, or the map file's absolute path (a node's working
 /// folder is not the driver's).
 fn locate(source: &str) -> String {
-    match source.strip_prefix("embedded:") {
+    match source.strip_prefix(unforeseen_sim::EMBEDDED_PREFIX) {
         Some(name) => name.to_string(),
         None if !Path::new(source).exists() => source.to_string(),
         None => std::fs::canonicalize(source)
@@ -63,8 +62,8 @@ fn locate(source: &str) -> String {
 /// one is given, else null).
 #[pyfunction]
 #[pyo3(signature = (request, agent = None))]
-fn plan_batch(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
-    let request: BatchRequest = self::request(request)?;
+fn plan_batch(request: &Bound<'_, PyDict>, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
+    let request: BatchRequest = crate::convert::request(request)?;
     let job = request.plan(agent.map(|a| a.bundle.clone())).map_err(errors::to_py)?;
     let setup = &job.setup;
     let plan = &job.plan;
@@ -103,6 +102,17 @@ fn plan_batch(request: &str, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<Stri
         "agent": agent_text,
     })
     .to_string())
+}
+
+/// Checks the batch `request` as [`plan_batch`] does, without taking the output guard
+/// (which removes an earlier run's summary): for a driver to refuse bad input before
+/// anything else can fail (Ray's import).
+#[pyfunction]
+#[pyo3(signature = (request, agent = None))]
+fn check_batch(request: &Bound<'_, PyDict>, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<()> {
+    let request: BatchRequest = crate::convert::request(request)?;
+    request.setup(agent.map(|a| a.bundle.clone())).map_err(errors::to_py)?;
+    Ok(())
 }
 
 /// Trains the agent of training seed `seed` on `train_map` (a file or an embedded name)
@@ -191,7 +201,7 @@ fn run_units(
     let located: Vec<(String, String)> = from(&spec, "scenarios")?;
     let mut scenarios = Vec::new();
     for (source, place) in &located {
-        let map = if source.starts_with("embedded:") {
+        let map = if source.starts_with(unforeseen_sim::EMBEDDED_PREFIX) {
             unforeseen_harness::maps::load(place).map_err(errors::to_py)?
         } else {
             unforeseen_harness::maps::load_file(Path::new(place)).map_err(errors::to_py)?
@@ -283,6 +293,7 @@ fn finish_batch(py: Python<'_>, out: PathBuf) -> PyResult<BatchResult> {
 
 /// Registers the functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(check_batch, m)?)?;
     m.add_function(wrap_pyfunction!(plan_batch, m)?)?;
     m.add_function(wrap_pyfunction!(train_agent, m)?)?;
     m.add_function(wrap_pyfunction!(run_units, m)?)?;

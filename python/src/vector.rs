@@ -14,10 +14,17 @@ use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
-use unforeseen_env::{Env, Info, Observation, ObservationForm, kinematic};
+use unforeseen_env::{Env, EnvConfig, Info, Observation, ObservationForm, kinematic};
 
+use crate::convert;
 use crate::env::{action_index, frame_array, light_code, new_env, observation, observation_form, stream_seed};
 use crate::errors;
+
+/// Most envs of one vector env.
+const MAX_ENVS: usize = 1 << 16;
+
+/// Most threads of one vector env's own pool.
+const MAX_THREADS: usize = 1024;
 
 /// One env of the vector and its episode stream.
 struct Slot {
@@ -88,16 +95,25 @@ impl PyVectorEnv {
     /// `num_envs` envs of `map` with map `overrides`; `num_threads` threads (default:
     /// rayon's global pool, one per core); `autoreset` "next_step" or "same_step".
     #[new]
-    #[pyo3(signature = (map, num_envs, observation = "discrete", pedestrian_slots = 4, overrides = None, num_threads = None, autoreset = "next_step"))]
+    #[pyo3(signature = (map, num_envs, observation = "discrete", pedestrian_slots = None, overrides = None, num_threads = None, autoreset = "next_step"))]
     fn new(
-        map: &str,
-        num_envs: usize,
+        map: &Bound<'_, PyAny>,
+        num_envs: &Bound<'_, PyAny>,
         observation: &str,
-        pedestrian_slots: usize,
+        pedestrian_slots: Option<&Bound<'_, PyAny>>,
         overrides: Option<&Bound<'_, PyDict>>,
-        num_threads: Option<usize>,
+        num_threads: Option<&Bound<'_, PyAny>>,
         autoreset: &str,
     ) -> PyResult<Self> {
+        let map = convert::path("map", map)?;
+        let num_envs = convert::size("num_envs", num_envs, 1..=MAX_ENVS)?;
+        let pedestrian_slots = pedestrian_slots
+            .map(|n| convert::size("pedestrian_slots", n, 1..=kinematic::MAX_SLOTS))
+            .transpose()?
+            .unwrap_or(EnvConfig::default().pedestrian_slots);
+        let num_threads = num_threads
+            .map(|n| convert::size("num_threads", n, 1..=MAX_THREADS))
+            .transpose()?;
         let same_step = match autoreset {
             "next_step" => false,
             "same_step" => true,
@@ -107,24 +123,20 @@ impl PyVectorEnv {
                 )));
             }
         };
-        if num_envs == 0 || num_envs > 1 << 16 {
-            return Err(errors::value(format!("num_envs {num_envs}: expected 1..=65536")));
-        }
         let form = observation_form(observation)?;
-        let map = crate::maps::load(map, overrides)?;
+        let map = crate::maps::load(&map.to_string_lossy(), overrides)?;
         let obs_len = match form {
             ObservationForm::Discrete => 4,
             ObservationForm::Kinematic => kinematic::len(pedestrian_slots),
         };
         let pool = match num_threads {
             None => None,
-            Some(n) if (1..=1024).contains(&n) => Some(
+            Some(n) => Some(
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(n)
                     .build()
                     .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?,
             ),
-            Some(n) => return Err(errors::value(format!("num_threads {n}: expected 1..=1024"))),
         };
         let slots = (0..num_envs)
             .map(|_| {

@@ -501,3 +501,20 @@ def test_a_batch_of_scripted_methods_trains_no_agent_and_equals_the_command_line
                     "--protocol", "zero-shot", "--episodes", "2", "--seed", "5", "-q", "--out", str(cli_out)],
                    check=True, capture_output=True, timeout=120)
     assert _lines_without_timing(tmp_path / "py.jsonl") == _lines_without_timing(cli_out)
+
+
+def test_without_ray_a_run_changes_no_file(tmp_path: Path):
+    """A missing Ray is refused before the output guard removes an earlier summary."""
+    import importlib.util
+
+    if importlib.util.find_spec("ray") is not None:
+        pytest.skip("Ray is installed")
+    import unforeseen
+    from unforeseen.distributed import run_batch
+
+    out = tmp_path / "res.jsonl"
+    unforeseen.batch("jaywalk", methods=["never-brake"], episodes=1, out=out)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    with pytest.raises(ImportError, match="needs Ray"):
+        run_batch("jaywalk", methods=["never-brake"], episodes=1, out=out)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before

@@ -87,7 +87,7 @@ def test_bad_agent_file(tmp_path):
         (lambda: unforeseen.make_env("jaywalk", lane_width=float("nan")), "road.lane_width: must be a finite number"),
         (lambda: unforeseen.make_env("jaywalk", distance_edges=[60, 30]), "strictly increasing"),
         (lambda: unforeseen.make_env("jaywalk", cycle=[]), "light.cycle"),
-        (lambda: unforeseen.make_env("jaywalk", pedestrian_slots=0), "pedestrian_slots: must be in 1..=100"),
+        (lambda: unforeseen.make_env("jaywalk", pedestrian_slots=0), "pedestrian_slots 0: expected a whole number in 1..=100"),
         (lambda: unforeseen.make_env("/dev/null"), "not a regular file"),
         (lambda: unforeseen.VectorEnv("jaywalk", 2, num_threads=0), "num_threads 0"),
         (lambda: unforeseen.train(episodes=0), "episodes 0"),

@@ -4,7 +4,6 @@ plot-sweep` read beside the built-in methods."""
 
 from __future__ import annotations
 
-import json
 import subprocess
 
 import pytest
@@ -27,11 +26,11 @@ def test_lines_are_read_by_the_batch_summary_beside_builtin_methods(agent, tmp_p
     out = tmp_path / "results.jsonl"
     builtin = unforeseen.batch("jaywalk", agent=agent, episodes=4, seed=7, methods=["q-learning"],
                                protocol="zero-shot", out=tmp_path / "builtin.jsonl")
-    with open(out, "w") as f:
-        for line in builtin["lines"]:
-            f.write(json.dumps(line) + "\n")
+    # The batch's own file, its lines beside which the policy's go.
+    out.write_bytes((tmp_path / "builtin.jsonl").read_bytes())
+    assert len(builtin["lines"]) == 1
     lines = unforeseen.evaluate({3: AlwaysFast(), 4: AlwaysFast()}, ["jaywalk", "intersection"], [3, 4],
-                                episodes=5, protocol=["zero-shot", "continual"], out=out)
+                                episodes=5, protocol=["zero-shot", "continual"], out=out, append=True)
     assert [(l["scenario"], l["train_seed"]) for l in lines] == [("jaywalk", 3), ("jaywalk", 4),
                                                                  ("intersection", 3), ("intersection", 4)]
     # A policy that does not learn runs once and covers both protocols, as the batch does.

@@ -49,17 +49,24 @@ def test_evaluate_refuses_a_file_that_is_not_results_unless_forced(tmp_path):
     assert json.loads(agent_file.read_text().splitlines()[0])["method"] == "always-fast"
 
 
-def test_evaluate_twice_into_one_file_is_refused(tmp_path):
+def test_evaluate_again_replaces_its_file_with_a_notice_and_appends_only_when_asked(tmp_path, capsys):
     out = tmp_path / "r.jsonl"
     unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out)
+    # A cell run again: the file is replaced, and the notice names it and its lines.
+    unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out)
+    assert f"replacing {out} (1 line) from an earlier run" in capsys.readouterr().err
+    first = out.read_bytes()
+    assert len(first.splitlines()) == 1
     with pytest.raises(ValueError, match="counted twice"):
-        unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out)
-    assert len(out.read_text().splitlines()) == 1
+        unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out,
+                            append=True)
+    assert out.read_bytes() == first
     assert [r["train_seeds"] for r in unforeseen.summarize(out)] == [[None]]
     # The lock was released: another method goes beside it.
     unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out,
-                        method="other")
+                        method="other", append=True)
     assert len(out.read_text().splitlines()) == 2
+    assert "replacing" not in capsys.readouterr().err
 
 
 def test_summarize_a_missing_file_is_an_error(tmp_path):
@@ -133,9 +140,9 @@ def test_the_search_drivers_threads_are_capped(tmp_path):
 
 def test_a_float_for_a_whole_number_override_names_the_key():
     # It used to fail in the RON parser: "episode.?: Expected comma".
-    with pytest.raises(ValueError, match=r"max_steps: 1\.5 is not an integer.*give an int"):
+    with pytest.raises(ValueError, match=r"max_steps: 1\.5 is not a whole number.*give an int"):
         unforeseen.make_env("jaywalk", max_steps=1.5)
-    with pytest.raises(ValueError, match="episode__max_steps: 60.0 is not an integer"):
+    with pytest.raises(ValueError, match="episode__max_steps: 60.0 is not a whole number"):
         gym.make("unforeseen/Jaywalk-v0", episode__max_steps=60.0)
     assert unforeseen.make_env("jaywalk", max_steps=60)._env.max_steps == 60
 
@@ -158,6 +165,7 @@ calls = {
                                       out=os.path.join(os.environ["TMPDIR"], "r.jsonl")),
     "compare": lambda: unforeseen.compare(agents=agent, episodes=1_000_000),
     "evaluate_builtin": lambda: unforeseen.evaluate_builtin("jaywalk", "never-brake", episodes=1_000_000),
+    "rust_loop": lambda: unforeseen._unforeseen.rust_loop("jaywalk", [0], 10**12),
 }
 threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
 start = time.monotonic()
@@ -169,7 +177,7 @@ except KeyboardInterrupt:
 """
 
 
-@pytest.mark.parametrize("which", ["train", "train_agents", "batch", "compare", "evaluate_builtin"])
+@pytest.mark.parametrize("which", ["train", "train_agents", "batch", "compare", "evaluate_builtin", "rust_loop"])
 def test_long_calls_stop_on_ctrl_c(which, tmp_path):
     import os
     import subprocess

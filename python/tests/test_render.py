@@ -82,6 +82,23 @@ def test_human_mode_draws_a_window(monkeypatch):
     assert not pygame.display.get_init()
 
 
+def test_a_headless_check_of_human_mode_is_quiet():
+    # pygame.init() opened the audio device too: 8 ALSA lines on a machine without sound.
+    pytest.importorskip("pygame", reason="the render extra (pygame) is not installed")
+    import subprocess
+
+    code = (
+        "import gymnasium as gym, unforeseen\n"
+        "from gymnasium.utils.env_checker import check_env\n"
+        "check_env(gym.make('unforeseen/Jaywalk-v0', render_mode='human').unwrapped)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("XDG_RUNTIME_DIR", "SDL_AUDIODRIVER")}
+    env["SDL_VIDEODRIVER"] = "dummy"
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert "ALSA" not in run.stderr and "XDG_RUNTIME_DIR" not in run.stderr, run.stderr
+
+
 @pytest.mark.filterwarnings("ignore::DeprecationWarning")
 @pytest.mark.filterwarnings("ignore::UserWarning")
 def test_record_video_writes_an_episode_to_mp4(tmp_path):

@@ -31,11 +31,9 @@ from ._unforeseen import (
     load_agent,
     scripted_controller,
     stream_seed,
-    train_agents,
 )
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
 from .evaluate import EvaluateResult, evaluate, evaluate_policy, summarize
-from .requests import request_json
 from .search import search
 from .vector import VectorEnv
 from .wrapper import ScaledWrapper, q_table_habit
@@ -107,9 +105,27 @@ def make_env(
     return UnforeseenEnv(map, observation, render_mode, **map_overrides)
 
 
-def train(map: str = "intersection", episodes: int = 6000, seed: int = 7) -> Agent:
-    """Trains Q-learning, the world model and Bayesian RL on ``map`` (``unforeseen train``)."""
+def train(map: str | os.PathLike[str] = "intersection", episodes: int = 6000, seed: int = 7) -> Agent:
+    """Trains Q-learning, the world model and Bayesian RL on ``map`` (an embedded name or
+    a map file) for ``episodes`` episodes from ``seed`` (``unforeseen train``); Ctrl-C
+    raises ``KeyboardInterrupt``."""
     return _unforeseen.train(map, episodes, seed)
+
+
+def train_agents(
+    seeds: Iterable[int],
+    map: str | os.PathLike[str] = "intersection",
+    episodes: int = 6000,
+    cache: str | os.PathLike[str] | None = None,
+    timeout_as: str = "truncation",
+) -> list[Agent]:
+    """Trains one agent per seed of ``seeds`` (at most 1,000, each once, as
+    ``--train-seeds`` takes them) on ``map`` for ``episodes`` episodes, in parallel, as
+    ``unforeseen compare --train-seeds`` does. With ``cache`` (a folder, e.g.
+    ``"out/agents"``, the command line's) agents are loaded from it when there and saved
+    into it, so a notebook and the command line share them; without it (the default)
+    nothing is written. Ctrl-C raises ``KeyboardInterrupt``."""
+    return _unforeseen.train_agents(seeds, map, episodes, cache, timeout_as)
 
 
 def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int]:
@@ -147,7 +163,7 @@ def evaluate_builtin(
     (or ``to_dict()``) eval.json's data, and ``to_pandas()`` one row per episode."""
     fields = dict(locals())
     given = fields.pop("agent") if isinstance(agent, Agent) else None
-    return _unforeseen.evaluate(request_json(fields), given)
+    return _unforeseen.evaluate(fields, given)
 
 
 def rollout(
@@ -185,7 +201,7 @@ def compare(
     agent: str | os.PathLike[str] | None = None,
     train_seeds: Iterable[int] | str | None = None,
     timeout_as: str = "truncation",
-    cache: str | os.PathLike[str] | None = "out/agents",
+    cache: str | os.PathLike[str] | None = None,
     force: bool = False,
 ) -> CompareResult:
     """``unforeseen compare`` in this process: the paper's table (§VI), the same request
@@ -194,8 +210,8 @@ def compare(
     (None: no files). The agents: ``agents`` (an :class:`Agent`, or several from
     :func:`train_agents`, summarized over them), ``agent`` (an agent file),
     ``train_seeds`` (one agent per seed, ``range(1, 5)`` or ``"1..4"``, trained on
-    ``train_map`` for ``train_episodes`` and kept in the agent cache ``cache``, None for
-    none), or none of them (one agent trained with ``seed``). They are tested on
+    ``train_map`` for ``train_episodes``, and kept in the agent cache ``cache`` when one
+    is given: e.g. ``"out/agents"``, the command line's), or none of them (one agent trained with ``seed``). They are tested on
     ``test_map`` for ``episodes`` episodes per method under ``protocol``
     (``"zero-shot"``, ``"continual"`` or ``"both"``), with the ablations when
     ``ablations``, and the scaled agent's overrides ``sets`` (``"KEY=VALUE"`` each). A
@@ -206,7 +222,7 @@ def compare(
     method)."""
     fields = dict(locals())
     given = fields.pop("agents")
-    return _unforeseen.compare(request_json(fields), given)
+    return _unforeseen.compare(fields, given)
 
 
 def batch(
@@ -228,7 +244,7 @@ def batch(
     train_map: str = "intersection",
     train_episodes: int = 6000,
     timeout_as: str = "truncation",
-    cache: str | os.PathLike[str] | None = "out/agents",
+    cache: str | os.PathLike[str] | None = None,
 ) -> BatchResult:
     """``unforeseen batch`` in this process: the same request, planned, trained and run by
     the library as the command line runs it, writing the same results file ``out`` and
@@ -244,7 +260,8 @@ def batch(
     * ``sets``: the sweep, one ``"KEY=V1,V2"`` per parameter (the cross product);
     * the agents: ``agent`` (an agent file, or an :class:`Agent`), ``train_seeds`` (one
       agent per seed, ``range(1, 5)`` or ``"1..4"``, trained on ``train_map`` for
-      ``train_episodes`` and kept in the agent cache ``cache``, None for none), or
+      ``train_episodes``, and kept in the agent cache ``cache`` when one is given: e.g.
+      ``"out/agents"``, the command line's), or
       neither (one agent trained with ``seed``; scripted methods alone need none);
     * ``episodes`` per unit, the evaluation ``seed``, ``jobs`` threads (None: every
       core), ``resume`` (keep the lines of the same run in ``out``), ``force`` (replace an
@@ -256,4 +273,4 @@ def batch(
     summary's rows, and ``to_pandas()`` one row per summary row."""
     fields = dict(locals())
     given = fields.pop("agent") if isinstance(agent, Agent) else None
-    return _unforeseen.batch(request_json(fields), given)
+    return _unforeseen.batch(fields, given)

@@ -7,7 +7,7 @@ an agent file, a parameter, an action), with the message the command line prints
 """
 
 import os
-from typing import Any, Callable, Sequence, final
+from typing import Any, Callable, Iterable, Sequence, final
 
 import numpy as np
 import numpy.typing as npt
@@ -50,15 +50,25 @@ def embedded_maps() -> list[str]:
 def stream_seed(key: int, episode: int) -> int:
     """World seed of episode ``episode`` of the episode stream keyed ``key``."""
 
+def argument(field: str, kind: str, value: Any) -> Any:
+    """``value`` converted as the argument ``field`` of ``kind`` (``"seed"``,
+    ``"episodes"``, ``"seeds"``, ``"path"`` or ``"text"``) is everywhere in the extension:
+    the converted value, or the ``ValueError`` naming ``field`` (and a number's range)."""
+
+def write_atomic(path: str | os.PathLike[str], text: str) -> None:
+    """Writes ``text`` to ``path`` as the library writes its files: a temporary file
+    beside it renamed over it."""
+
 def rust_loop(
-    map: str,
+    map: str | os.PathLike[str],
     actions: Sequence[int],
     steps: int,
-    seed: int = 0,
+    seed: int | None = None,
     observation: str = "discrete",
     overrides: dict[str, Any] | None = None,
 ) -> tuple[int, float, int]:
-    """Steps ``map`` ``steps`` ticks in Rust alone with ``actions`` in turn (GIL released):
+    """Steps ``map`` ``steps`` ticks in Rust alone with ``actions`` in turn (GIL released;
+    Ctrl-C raises ``KeyboardInterrupt``) from stream key ``seed`` (None: 0):
     ``(ticks, seconds, episodes)``."""
 
 @final
@@ -167,26 +177,26 @@ class Controller:
     def end_episode(self) -> None:
         """Ends the episode; the scaled agent's test-time learning runs here."""
 
-def train(map: str = "intersection", episodes: int = 6000, seed: int = 7) -> Agent: ...
+def train(map: str | os.PathLike[str], episodes: int, seed: int) -> Agent: ...
 def load_agent(path: str) -> Agent: ...
 def train_agents(
-    seeds: list[int],
-    map: str = "intersection",
-    episodes: int = 6000,
-    cache: str | None = "out/agents",
-    timeout_as: str = "truncation",
+    seeds: Iterable[int],
+    map: str | os.PathLike[str],
+    episodes: int,
+    cache: str | os.PathLike[str] | None,
+    timeout_as: str,
 ) -> list[Agent]: ...
 def scripted_controller(method: str, map: str = "jaywalk") -> Controller: ...
-def eval_seeds(seed: int, map: str, method: str, episode: int) -> tuple[int, int]:
+def eval_seeds(seed: int, map: str | os.PathLike[str], method: str, episode: int) -> tuple[int, int]:
     """``(world, controller)`` seeds of evaluation episode ``episode`` of the method named
     ``method`` (a built-in method's name, or the name a Python policy's lines carry)."""
 def evaluate_policy(
     policy: Any,
-    map: str,
+    map: str | os.PathLike[str],
     method: str,
     protocols: Sequence[str],
-    episodes: int = 100,
-    seed: int = 7,
+    episodes: int,
+    seed: int,
     train_seed: int | None = None,
     train_episodes: int | None = None,
     first_unit: int = 0,
@@ -199,6 +209,10 @@ def evaluate_policy(
     per run, one per protocol for a wrapper that learns, else one covering them all;
     lines numbered from ``first_unit``, episodes of the method named ``method``. The
     policy's exceptions (and ``KeyboardInterrupt``) propagate."""
+
+def scenario_sources(maps: Sequence[str | os.PathLike[str]]) -> list[tuple[str, str]]:
+    """``(name, source)`` of each map's scenario as the batch's lines carry them
+    (``("jaywalk", "embedded:jaywalk")``); a map listed twice is a ``ValueError``."""
 
 @final
 class PolicyRun:
@@ -213,20 +227,20 @@ class PolicyRun:
     @property
     def episodes(self) -> list[dict[str, Any]]:
         """Every episode, in order, as eval.json holds them."""
-def evaluate(request: str, agent: Agent | None = None) -> EvalResult:
-    """``unforeseen eval`` in this process: the eval request (JSON text of its fields;
-    :func:`unforeseen.evaluate_builtin` writes it) planned and run by the library as the
+def evaluate(request: dict[str, Any], agent: Agent | None = None) -> EvalResult:
+    """``unforeseen eval`` in this process: the eval request (its fields, as
+    :func:`unforeseen.evaluate_builtin` takes them) planned and run by the library as the
     command line runs it, writing eval.json into its ``out``; ``agent`` is an agent
     given loaded instead of the request's agent file. A bad field raises ``ValueError``
     naming it."""
-def compare(request: str, agents: Agent | Sequence[Agent] | None = None) -> CompareResult:
-    """``unforeseen compare`` in this process: the compare request (JSON text of its
-    fields; :func:`unforeseen.compare` writes it) planned, trained and run by the library
+def compare(request: dict[str, Any], agents: Agent | Sequence[Agent] | None = None) -> CompareResult:
+    """``unforeseen compare`` in this process: the compare request (its fields, as
+    :func:`unforeseen.compare` takes them) planned, trained and run by the library
     as the command line runs it, writing its four files into its ``out``; ``agents`` are
     agents given loaded. A bad field raises ``ValueError`` naming it."""
-def batch(request: str, agent: Agent | None = None) -> BatchResult:
-    """``unforeseen batch`` in this process: the batch request (JSON text of its fields;
-    :func:`unforeseen.batch` writes it), planned, trained and run by the library as the
+def batch(request: dict[str, Any], agent: Agent | None = None) -> BatchResult:
+    """``unforeseen batch`` in this process: the batch request (its fields, as
+    :func:`unforeseen.batch` takes them), planned, trained and run by the library as the
     command line runs it, writing its results file and summary; ``agent`` is an agent
     given loaded instead of the request's agent file. A bad field raises ``ValueError``
     naming it."""
@@ -384,8 +398,10 @@ class ResultsGuard:
 
 def summarize_json(path: str) -> str:
     """The batch summary over training seeds of a results file, as JSON text."""
-def plan_batch(request: str, agent: Agent | None = None) -> str:
-    """The batch request (JSON text of its fields) planned as ``unforeseen batch`` plans it
+def check_batch(request: dict[str, Any], agent: Agent | None = None) -> None:
+    """The batch request checked as :func:`plan_batch` checks it, without its output guard."""
+def plan_batch(request: dict[str, Any], agent: Agent | None = None) -> str:
+    """The batch request (its fields) planned as ``unforeseen batch`` plans it
     (JSON text: spec, head, total, kept, todo, todo_seeds, train_seeds_to_run, train,
     agent); passes the output guard, runs and trains nothing."""
 def train_agent(seed: int, episodes: int, train_map: str = "intersection", timeout_as: str = "truncation") -> bytes:
@@ -395,14 +411,13 @@ def run_units(spec: str, agents: Sequence[tuple[int | None, bytes]], units: Sequ
 def finish_batch(out: str) -> BatchResult:
     """Rewrites a driver's results file in canonical order with its summary; its report,
     as :func:`unforeseen.batch` returns it."""
-def plan_search(request: str, agent: Agent | None = None) -> str:
-    """The search request (JSON text of its fields) checked as ``unforeseen search`` checks
+def plan_search(request: dict[str, Any], agent: Agent | None = None) -> str:
+    """The search request (its fields) checked as ``unforeseen search`` checks
     it (arguments, base map, space file), before any task; JSON text of ``spec`` (the
     request), ``train`` (training seeds to train), ``train_episodes``, ``timeout_as`` and
     ``agent`` (the given agent's text, or null)."""
-def search(request: str, agent: Agent | None = None, command: str = "") -> str:
-    """``unforeseen search`` in this process: the search request (JSON text of its
-    fields) planned, trained and run by the library as the command line runs it, writing
+def search(request: dict[str, Any], agent: Agent | None = None, command: str = "") -> str:
+    """``unforeseen search`` in this process: the search request (its fields) planned, trained and run by the library as the command line runs it, writing
     its folder of outputs; ``summary.json``'s contents (JSON text). A bad field raises
     ``ValueError`` naming it; Ctrl-C raises KeyboardInterrupt at the next episode."""
 def evaluate_search_candidates(

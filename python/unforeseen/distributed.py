@@ -63,7 +63,6 @@ event the evaluator checks between waits; pending tasks are cancelled) and raise
 from __future__ import annotations
 
 import argparse
-import fcntl
 import json
 import math
 import os
@@ -75,7 +74,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _unforeseen
-from .requests import BATCH_DEFAULTS, SEARCH_DEFAULTS, flag, flag_message, request_json
+from .requests import BATCH_DEFAULTS, SEARCH_DEFAULTS, flag, flag_message
 
 __all__ = ["DEFAULT_MAX_RETRIES", "main", "run_batch", "run_search"]
 
@@ -208,31 +207,6 @@ def _drive(
             ray.cancel(ref, force=True)
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-
-
-def _lock(out: Path) -> Any:
-    """The advisory lock ``batch`` takes on ``OUT.lock``: one run per results file."""
-    path = Path(str(out) + ".lock")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    f = open(path, "a")  # noqa: SIM115 - held for the run
-    try:
-        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        f.close()
-        raise ValueError(
-            f"out {out}: another batch is writing this results file now (it holds {path}); "
-            "wait for it to finish, or give another out"
-        ) from None
-    return f
-
-
 def _task_request(job: str, fields: dict[str, Any], per_task_name: str, per_task: int | None, max_retries: int,
                   shards_instead: str) -> tuple[int, _unforeseen.Agent | None]:
     """The request of ``job`` as the driver takes it (``fields``, changed in place): the shard
@@ -277,7 +251,7 @@ def run_batch(
     train_map: str = "intersection",
     train_episodes: int = 6000,
     timeout_as: str = "truncation",
-    cache: str | os.PathLike[str] | None = "out/agents",
+    cache: str | os.PathLike[str] | None = None,
     units_per_task: int | None = None,
     address: str | None = "auto",
     max_retries: int = DEFAULT_MAX_RETRIES,
@@ -303,14 +277,17 @@ def run_batch(
     threads, given = _task_request("batch", fields, "units_per_task", units_per_task, max_retries,
                                    "`unforeseen merge` the parts")
     out = Path(out)
-    plan = json.loads(_unforeseen.plan_batch(request_json(fields), given))
+    # Bad input, then a missing Ray, refused before the plan's guard removes an earlier summary.
+    _unforeseen.check_batch(fields, given)
     ray = _ray()
-    lock = _lock(out)
+    plan = json.loads(_unforeseen.plan_batch(fields, given))
+    # The lock and the writer of `unforeseen batch` (OUT.lock; a temporary file renamed).
+    lock = _unforeseen.ResultsGuard(os.fspath(out), [], force=True)
     try:
         # Every check has passed (the plan's, Ray's import): the earlier run's summary
         # goes, so it never describes this run's lines.
         Path(plan["summary"]).unlink(missing_ok=True)
-        _write_atomic(out, plan["head"])
+        _unforeseen.write_atomic(os.fspath(out), plan["head"])
         _connect(ray, address)
         options = _task_options(max_retries)
         # One agent per training seed the remaining units need, in the object store.
@@ -347,7 +324,7 @@ def run_batch(
                 progress.finish()
         return _unforeseen.finish_batch(str(out))
     finally:
-        lock.close()
+        lock.release()
 
 
 def run_search(
@@ -371,7 +348,7 @@ def run_search(
     train_seeds: Iterable[int] | str | None = None,
     train_episodes: int = 6000,
     timeout_as: str = "truncation",
-    cache: str | os.PathLike[str] | None = "out/agents",
+    cache: str | os.PathLike[str] | None = None,
     command: str | None = None,
     candidates_per_task: int | None = None,
     address: str | None = "auto",
@@ -397,7 +374,7 @@ def run_search(
     threads, given = _task_request("search", fields, "candidates_per_task", candidates_per_task, max_retries,
                                    "finish with --resume")
     # The request, maps and space checked before any task runs.
-    plan = json.loads(_unforeseen.plan_search(request_json(fields), given))
+    plan = json.loads(_unforeseen.plan_search(fields, given))
     spec = plan["spec"]
     from_file = plan["agent"] is not None
     ray = _ray()

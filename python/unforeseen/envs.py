@@ -162,7 +162,7 @@ class UnforeseenEnv(gym.Env):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         if options and "world_seed" in options:
-            out = self._env.reset(int(options["world_seed"]))
+            out = self._env.reset(options["world_seed"])
         else:
             if seed is not None or not self._keyed:
                 self._env.set_stream(episode_key(self.np_random))
@@ -214,7 +214,9 @@ class _Window:
         pg = self._pygame
         h, w, _ = frame.shape
         if self._screen is None:
-            pg.init()
+            # The display alone: pygame.init() would open the audio device too, which a
+            # headless machine reports line by line on stderr (ALSA), and the env has no sound.
+            pg.display.init()
             pg.display.set_caption("unforeseen")
             self._screen = pg.display.set_mode((w, h))
         pg.event.pump()

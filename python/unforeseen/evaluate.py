@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from typing import Any, Iterable, Mapping
 
 from . import _unforeseen
@@ -47,15 +48,6 @@ from .wrapper import ScaledWrapper
 __all__ = ["EvaluateResult", "evaluate", "evaluate_policy", "summarize", "PROTOCOLS"]
 
 PROTOCOLS = ("zero-shot", "continual")
-
-
-def _source(map: str) -> tuple[str, str]:
-    """``(scenario name, source)`` as the batch writes them."""
-    env = _unforeseen.Env(map)
-    name = env.map_name
-    if os.path.exists(map):
-        return name, str(map)
-    return name, f"embedded:{map}"
 
 
 def _runs(
@@ -129,7 +121,7 @@ class EvaluateResult(list):
 
 def evaluate(
     policy: Any,
-    maps: Iterable[str],
+    maps: Iterable[str | os.PathLike[str]],
     seeds: Iterable[int | None],
     episodes: int = 100,
     protocol: str | Iterable[str] = ("zero-shot", "continual"),
@@ -138,34 +130,55 @@ def evaluate(
     seed: int = 7,
     train_episodes: int | None = None,
     force: bool = False,
+    append: bool = False,
 ) -> EvaluateResult:
     """Evaluates a policy per training seed on every map under every protocol and
     returns the batch result lines (dicts, in an :class:`EvaluateResult`: ``print()`` it
-    for the summary table ``unforeseen batch`` prints); with ``out``, appends them to that JSON Lines
-    file (one line per unit as it finishes), beside the lines of other methods. ``out``
-    is checked first as ``unforeseen batch --out`` is: a ``ValueError`` if it is one of
-    the map files, if it holds something other than result lines (a batch run's file,
-    whose first line names its run, included; unless ``force``: then it is replaced), if it already holds a line of the same map, method, protocol
-    and training seed (a second call would count it twice), or if another run is writing
-    it.
+    for the summary table ``unforeseen batch`` prints).
+
+    With ``out``, the lines are written to that JSON Lines file once every unit has run
+    (atomically: an interrupted call leaves the file as it was). An earlier results file
+    there is replaced, as ``unforeseen batch`` replaces its own, with a notice on stderr
+    naming it and its line count, so a notebook cell can be run again; with ``append``,
+    the lines are added after the file's lines instead (beside the lines of other
+    methods), and a line of the same map, method and training seed already there is
+    refused (the summary would count it twice). ``out`` is checked first as ``unforeseen
+    batch --out`` is: a ``ValueError`` if it is one of the map files, if it holds
+    something other than result lines (a batch run's file, whose first line names its run,
+    included; unless ``force``: then it is replaced), or if
+    another run is writing it.
 
     ``policy``: a policy (the module's protocol) or a :class:`~unforeseen.ScaledWrapper`,
     a mapping ``train_seed -> policy`` or a callable ``train_seed -> policy`` (the policy
-    trained with that seed). ``seeds``: the training seeds (``None`` for a policy without
-    one). ``protocol``: ``"zero-shot"``, ``"continual"`` or both; a plain policy runs once
-    and its line covers every protocol asked (as the batch does for methods that do not
+    trained with that seed). ``maps``: embedded names or map files, each once.
+    ``seeds``: the training seeds, each once (``None`` for a policy without one).
+    ``protocol``: ``"zero-shot"``, ``"continual"`` or both; a plain policy runs once and
+    its line covers every protocol asked (as the batch does for methods that do not
     learn), a wrapper that learns runs once per protocol. ``method``: the name in the
     lines, from which the episodes' controller seeds derive (default: the policy's
     ``method`` attribute). ``seed``: the evaluation seed (the batch's ``--seed``).
-    ``train_episodes``: what the lines record as the policy's training episodes."""
+    ``train_episodes``: what the lines record as the policy's training episodes. A bad
+    argument raises ``ValueError`` naming it before any episode runs."""
     protocols = [protocol] if isinstance(protocol, str) else list(protocol)
     for p in protocols:
         if p not in PROTOCOLS:
             raise ValueError(f"protocol {p!r}: expected one of {PROTOCOLS}")
-    maps = list(maps)
+    maps = [maps] if isinstance(maps, (str, os.PathLike)) else list(maps)
     seeds = list(seeds)
     if not maps or not seeds or not protocols:
         raise ValueError("evaluate: give at least one map, one training seed and one protocol")
+    arg = _unforeseen.argument
+    seeds = [None if s is None else arg(f"seeds[{i}]", "seed", s) for i, s in enumerate(seeds)]
+    for i, s in enumerate(seeds):
+        if s in seeds[:i]:
+            raise ValueError(f"seeds: {s} is listed twice; give each training seed once")
+    episodes = arg("episodes", "episodes", episodes)
+    seed = arg("seed", "seed", seed)
+    if train_episodes is not None:
+        train_episodes = arg("train_episodes", "episodes", train_episodes)
+    if method is not None:
+        method = arg("method", "text", method)
+    names = [name for name, _ in _unforeseen.scenario_sources(maps)]
 
     def policy_of(s: int | None) -> Any:
         if isinstance(policy, Mapping):
@@ -174,22 +187,21 @@ def evaluate(
             return policy(s)
         return policy
 
-    lines = []
-    unit = 0
     guard = None
+    kept = ""
     if out is not None:
-        # Every check before the file is touched: the maps load, the guard passes, no
-        # line would be counted twice; only then does force=True empty it.
-        for m in maps:
-            _source(m)
-        files = [m for m in maps if os.path.exists(m)]
-        guard = _unforeseen.ResultsGuard(os.fspath(out), files, force=force)
-        if force:
-            open(out, "w").close()
-        else:
-            _refuse_repeats(out, maps, seeds, method or getattr(policy, "method", None), guard)
-    fh = open(out, "a", encoding="utf-8") if out is not None else None
+        out = arg("out", "path", out)
+        files = [os.fspath(m) for m in maps if os.path.exists(m)]
+        guard = _unforeseen.ResultsGuard(out, files, force=force)
     try:
+        if out is not None and os.path.isfile(out):
+            if append:
+                kept = _kept(out, names, seeds, method or getattr(policy, "method", None))
+            else:
+                _say_replacing(out)
+        lines = []
+        texts = []
+        unit = 0
         for m in maps:
             for s in seeds:
                 pol = policy_of(s)
@@ -199,34 +211,45 @@ def evaluate(
                 for run in _runs(pol, m, name, protocols, episodes, seed, s, train_episodes, unit):
                     unit += 1
                     lines.append(run.line)
-                    if fh is not None:
-                        fh.write(run.line_text + "\n")
-                        fh.flush()
+                    texts.append(run.line_text + "\n")
+        if out is not None:
+            _unforeseen.write_atomic(out, kept + "".join(texts))
     finally:
-        if fh is not None:
-            fh.close()
         if guard is not None:
             guard.release()
     return EvaluateResult(lines)
 
 
-def _refuse_repeats(out: Any, maps: list[str], seeds: list[int | None], method: str | None, guard: Any) -> None:
-    """Refuses an ``out`` that already holds a line of one of these (map, method,
-    training seed): the summary would count it twice."""
-    if not method or not os.path.isfile(out):
-        return
-    names = {_source(m)[0] for m in maps}
+def _say_replacing(out: str) -> None:
+    """The notice of a results file replaced (``unforeseen batch``'s, on stderr)."""
+    with open(out, encoding="utf-8", errors="replace") as f:
+        count = sum(1 for text in f if text.strip())
+    print(
+        f"unforeseen.evaluate: replacing {out} ({_lines(count)}) from an earlier run; append=True adds to it instead",
+        file=sys.stderr,
+    )
+
+
+def _lines(n: int) -> str:
+    return f"{n} line" if n == 1 else f"{n} lines"
+
+
+def _kept(out: str, names: list[str], seeds: list[int | None], method: str | None) -> str:
+    """The text of ``out`` to keep before the new lines (ending in a newline), refusing a
+    line of one of these (map, method, training seed): the summary would count it twice."""
     with open(out, encoding="utf-8") as f:
-        for number, text in enumerate(f, 1):
-            if text.startswith('{"run":') or not text.strip():
+        text = f.read()
+    if method:
+        for number, line_text in enumerate(text.splitlines(), 1):
+            if line_text.startswith('{"run":') or not line_text.strip():
                 continue
-            line = json.loads(text)
+            line = json.loads(line_text)
             if line.get("method") == method and line.get("scenario") in names and line.get("train_seed") in seeds:
-                guard.release()
                 raise ValueError(
-                    f"{os.fspath(out)}: line {number} is already {method} on {line['scenario']} (training seed "
+                    f"{out}: line {number} is already {method} on {line['scenario']} (training seed "
                     f"{line['train_seed']}); a second line would be counted twice: give another out, or remove it"
                 )
+    return text if not text or text.endswith("\n") else text + "\n"
 
 
 def summarize(path: str | os.PathLike[str]) -> list[dict[str, Any]]:

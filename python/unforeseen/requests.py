@@ -1,8 +1,10 @@
 """The requests of jobs (``batch``, ``search``, ``compare``, ``eval``) as the extension
-reads them: keyword arguments to the JSON text of the library's request
-(``BatchRequest``, ``SearchRequest``, ``CompareRequest``, ``EvalRequest``), whose
-defaults, checks, agent choice and run identity are the command line's. A bad field raises ``ValueError`` naming the field (``train_seeds:
-...``); ``python -m unforeseen.distributed`` spells it as its flag (:func:`flag_message`).
+reads them: the keyword arguments, as given, become the library's request
+(``BatchRequest``, ``SearchRequest``, ``CompareRequest``, ``EvalRequest``) in the
+extension's conversion layer, whose defaults, checks, agent choice and run identity are
+the command line's. A bad field raises ``ValueError`` naming the field (``train_seeds:
+...``, ``episodes -5: expected a whole number in 1..=1000000``); ``python -m
+unforeseen.distributed`` spells it as its flag (:func:`flag_message`).
 
 :data:`BATCH_DEFAULTS`, :data:`SEARCH_DEFAULTS`, :data:`COMPARE_DEFAULTS` and
 :data:`EVAL_DEFAULTS` are the requests' fields with their defaults, read from the
@@ -10,13 +12,13 @@ library: :func:`unforeseen.batch`, :func:`unforeseen.distributed.run_batch`,
 :func:`unforeseen.search`, :func:`unforeseen.distributed.run_search`,
 :func:`unforeseen.compare` and :func:`unforeseen.evaluate_builtin` take these fields with
 these defaults (a test checks their signatures against them), and the Ray driver's
-command line derives its options from them.
+command line derives its options from them, except the fields of
+:data:`PYTHON_DEFAULTS`.
 """
 
 from __future__ import annotations
 
 import json
-import os
 from collections.abc import Mapping
 from typing import Any
 
@@ -33,6 +35,11 @@ COMPARE_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("comp
 
 #: The eval request's fields and their defaults (``unforeseen eval``'s).
 EVAL_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("eval"))
+
+#: The defaults the Python functions take where the command line's differ: no agent
+#: cache unless one is given (``cache="out/agents"`` shares the command line's), so that a
+#: call writes nothing it was not asked to write (``out=None`` writes no file at all).
+PYTHON_DEFAULTS: dict[str, Any] = {"cache": None}
 
 #: Fields whose flag is not ``--`` and the field with ``-`` for ``_``.
 _FLAGS = {"maps": "MAP", "methods": "--method", "sets": "--set"}
@@ -51,26 +58,3 @@ def flag_message(message: str, fields: Mapping[str, Any]) -> str:
     if head in fields:
         return flag(head) + message[len(head):]
     return message
-
-
-def _plain(value: Any) -> Any:
-    """A keyword argument's value as JSON: paths as text, sequences and ranges as lists."""
-    if isinstance(value, os.PathLike):
-        return os.fspath(value)
-    if isinstance(value, (str, bytes, bool, int, float)) or value is None:
-        return value
-    if isinstance(value, Mapping):
-        return {k: _plain(v) for k, v in value.items()}
-    try:
-        return [_plain(v) for v in value]
-    except TypeError:
-        return value
-
-
-def request_json(fields: Mapping[str, Any]) -> str:
-    """The JSON text of a request with ``fields`` (the others at their defaults). A single
-    map (text or path) given as ``maps`` is a list of one."""
-    plain = {k: _plain(v) for k, v in fields.items()}
-    if isinstance(plain.get("maps"), str):
-        plain["maps"] = [plain["maps"]]
-    return json.dumps(plain)

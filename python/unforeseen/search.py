@@ -14,7 +14,6 @@ from collections.abc import Iterable
 from typing import Any
 
 from . import _unforeseen
-from .requests import request_json
 
 
 def search(
@@ -38,7 +37,7 @@ def search(
     train_seeds: Iterable[int] | str | None = None,
     train_episodes: int = 6000,
     timeout_as: str = "truncation",
-    cache: str | os.PathLike[str] | None = "out/agents",
+    cache: str | os.PathLike[str] | None = None,
     command: str | None = None,
 ) -> dict[str, Any]:
     """Searches ``space`` (a space file over the base ``map``) for the fair scenarios where
@@ -47,8 +46,8 @@ def search(
     adaptive rounds), ``episodes`` each, then up to ``max_failures`` failures minimised
     toward the base. Agents: ``agent`` (an agent file, or an :class:`unforeseen.Agent`),
     one per training seed (``train_seeds``, ``range(1, 4)`` or ``"1..3"``, trained on the
-    intersection for ``train_episodes`` and kept in the agent cache ``cache``, None for
-    none), or, with neither, one trained with ``seed``. ``jobs`` threads (None: every
+    intersection for ``train_episodes``, and kept in the agent cache ``cache`` when one is
+    given: e.g. ``"out/agents"``, the command line's), or, with neither, one trained with ``seed``. ``jobs`` threads (None: every
     core); ``shard`` (``"I/N"``) evaluates one slice of the Sobol stage; ``resume`` keeps
     the finished candidates in ``out``; ``force`` replaces files there a search did not
     write; ``command`` goes in the failure maps' comments.
@@ -62,4 +61,4 @@ def search(
     if space is None:
         fields.pop("space")
     said = command if command is not None else f"unforeseen.search(space={str(space)!r}, ...)"
-    return json.loads(_unforeseen.search(request_json(fields), given, said))
+    return json.loads(_unforeseen.search(fields, given, said))

@@ -88,7 +88,7 @@ class VectorEnv(_GymVectorEnv):
         )
         single = UnforeseenEnv(map, observation, render_mode, pedestrian_slots, render_scale, **map_overrides)
         self._single = single
-        self.num_envs = num_envs
+        self.num_envs = num_envs = self._env.num_envs
         self.render_mode = render_mode
         self._scale = float(render_scale)
         self.single_observation_space = single.observation_space
@@ -103,15 +103,26 @@ class VectorEnv(_GymVectorEnv):
     def reset(
         self, *, seed: int | Sequence[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed if isinstance(seed, int) else None)
         n = self.num_envs
+        seeds: list[int] | None = None
         if seed is None:
+            super().reset(seed=None)
+        elif isinstance(seed, (str, bytes)) or not hasattr(seed, "__iter__"):
+            try:
+                one = _unforeseen.argument("seed", "seed", seed)
+            except ValueError:
+                raise ValueError(f"seed {seed!r}: expected an int, a sequence of {n} ints or None") from None
+            super().reset(seed=one)
+            seeds = [one + i for i in range(n)]
+        else:
+            seeds = [_unforeseen.argument(f"seed[{i}]", "seed", s) for i, s in enumerate(seed)]
+            if len(seeds) != n:
+                raise ValueError(f"seed: {len(seeds)} seeds for {n} envs; give one per env, or one int")
+            super().reset(seed=None)
+        if seeds is None:
             keys = [int(k) for k in self.np_random.integers(0, 2**64, size=n, dtype=np.uint64)]
         else:
-            seeds = [seed + i for i in range(n)] if isinstance(seed, int) else list(seed)
-            if len(seeds) != n:
-                raise ValueError(f"{len(seeds)} seeds for {n} envs")
-            keys = [episode_key(seeding.np_random(int(s))[0]) for s in seeds]
+            keys = [episode_key(seeding.np_random(s)[0]) for s in seeds]
         obs, info = self._env.reset(keys)
         return obs, self._info(info)
 

@@ -17,6 +17,7 @@ reasoning kept choosing another action, the habit follows it.
 
 from __future__ import annotations
 
+import difflib
 import os
 from typing import Any, Callable
 
@@ -25,6 +26,9 @@ import numpy as np
 from . import _unforeseen
 
 __all__ = ["ScaledWrapper", "q_table_habit"]
+
+#: The keyword arguments of :class:`ScaledWrapper` that are not the agent's parameters.
+_OWN_KEYWORDS = ("habit", "agent", "observation", "method")
 
 
 def q_table_habit(agent: Any, **params: Any) -> np.ndarray:
@@ -71,6 +75,13 @@ class ScaledWrapper:
         method: str | None = None,
         **params: Any,
     ) -> None:
+        for key in params:
+            near = difflib.get_close_matches(key, _OWN_KEYWORDS, n=1)
+            if near:
+                raise TypeError(
+                    f"ScaledWrapper() got an unexpected keyword argument {key!r}; did you mean {near[0]!r}? "
+                    "(the other keywords are the scaled agent's parameters, the keys of --set)"
+                )
         if agent is None:
             raise TypeError("ScaledWrapper needs agent=: an Agent or an agent file")
         self._agent = _agent(agent)

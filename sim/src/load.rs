@@ -476,6 +476,17 @@ fn parse_patch(origin: &str, src: &str) -> Result<MapPatch, MapError> {
     typed().map_err(|first| {
         let mut unknown = Vec::new();
         if let Ok(value) = opts.from_str::<ron::Value>(src) {
+            if is_agent_file(&value) {
+                return MapError::one(Diagnostic::new(
+                    origin,
+                    "",
+                    "is an agent file, not a map (it has the `format_version` and `world_model` that `unforeseen train` writes)",
+                    Some(
+                        "give a map file (e.g. maps/jaywalk.ron) or an embedded map's name; an agent file goes after --agent"
+                            .into(),
+                    ),
+                ));
+            }
             walk(&value, Kind::Map, "", origin, &mut unknown);
         }
         if unknown.is_empty() {
@@ -484,6 +495,17 @@ fn parse_patch(origin: &str, src: &str) -> Result<MapPatch, MapError> {
             MapError::new(unknown)
         }
     })
+}
+
+/// Whether `value`, a file's top level, is an agent file (its `format_version` and
+/// `world_model`) rather than a map: said as such, not as a map's unknown fields.
+fn is_agent_file(value: &ron::Value) -> bool {
+    let ron::Value::Map(fields) = value else {
+        return false;
+    };
+    ["format_version", "world_model"]
+        .iter()
+        .all(|k| fields.get(&ron::Value::String((*k).to_string())).is_some())
 }
 
 // ---------------------------------------------------------------------------

@@ -663,6 +663,22 @@ pub struct Map {
     pub episode: Episode,
     /// Expected batch results (replaces the base's list when set). Default [].
     pub expect: Vec<Expectation>,
+    /// The base whose `expect` list this map inherited (its file sets none), if any: said
+    /// by `check-map`, since those checks decide batch's exit code for this map too.
+    #[serde(skip)]
+    pub expect_inherited_from: Provenance,
+}
+
+/// Where a map's value came from (a base's name), for diagnostics only: not part of
+/// the map's content, so two maps that differ only in it are equal (a map written out
+/// and read back states every value itself).
+#[derive(Debug, Clone, Default)]
+pub struct Provenance(pub Option<String>);
+
+impl PartialEq for Provenance {
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
 }
 
 /// Partial map as read from a file, before it is laid over its base.
@@ -725,8 +741,13 @@ impl MapPatch {
         if let Some(p) = self.episode {
             p.apply(&mut base.episode);
         }
-        if let Some(p) = self.expect {
-            base.expect = p;
+        match self.expect {
+            Some(p) => {
+                base.expect = p;
+                base.expect_inherited_from = Provenance(None);
+            }
+            None if !base.expect.is_empty() => base.expect_inherited_from = Provenance(base.base.clone()),
+            None => {}
         }
         base
     }
@@ -887,6 +908,13 @@ impl Map {
             e.substeps(),
             e.max_steps
         );
+        if let Some(from) = &self.expect_inherited_from.0 {
+            let _ = writeln!(
+                s,
+                "expectations: {}, inherited from {from} (they decide batch's exit code here too; set `expect: []` for none)",
+                self.expect.len()
+            );
+        }
         for x in &self.expect {
             let mut parts = Vec::new();
             for (label, val) in [

@@ -123,9 +123,20 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     let out = &args.out;
     // The folder the run creates for --out, if any, said once the guard has passed.
     let creates = super::outputs::to_create(out.parent().unwrap_or(Path::new("")));
+    // An earlier file the run replaces (not one --resume completes), said once the guard passed.
+    let replaced = (!args.resume).then(|| super::outputs::line_count(out)).flatten();
     // One run at a time per results file: the job holds the lock until it is dropped.
     let job = args.request().plan(None)?;
     super::outputs::creating("--out", creates);
+    if let Some(n) = replaced
+        && !quiet
+    {
+        errln!(
+            "note: replacing {} ({}) from an earlier run (--resume completes a run instead; --out FILE writes elsewhere)",
+            out.display(),
+            super::outputs::lines(n)
+        );
+    }
     let setup = &job.setup;
     let to_train = job.to_train();
     if let AgentChoice::Trained { map, .. } = &setup.agents
@@ -192,9 +203,9 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
         errln!("{warning}");
     }
     outln!(
-        "wrote {} ({} lines) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
+        "wrote {} ({}) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
         out.display(),
-        report.lines.len(),
+        super::outputs::lines(report.lines.len()),
         report.summary.display(),
         report.checked,
         report.failures.len()

@@ -39,10 +39,10 @@ pub fn run(args: MergeArgs) -> anyhow::Result<()> {
     let report = write_merged(&merged, &args.out)?;
     print_summary(&report.rows);
     outln!(
-        "merged {} part(s) into {} ({} lines) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
+        "merged {} part(s) into {} ({}) and {}; {} expectation(s) checked on the mean over training seeds, {} failed",
         args.parts.len(),
         report.out.display(),
-        merged.lines.len(),
+        super::outputs::lines(merged.lines.len()),
         report.summary.display(),
         report.checked,
         report.failed

@@ -103,32 +103,45 @@ pub struct Cli {
     pub command: Option<Command>,
 }
 
-/// The commands.
+/// The commands. Each takes a negative number as the value of a flag (`--episodes -5`
+/// reaches the flag's own check and its message, not clap's tip).
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Train on a map and compare Q-learning, Bayesian RL and the scaled agent on a test map (the paper's table).
+    #[command(allow_negative_numbers = true)]
     Compare(compare::CompareArgs),
     /// Train Q-learning, the world model and Bayesian RL on a map; write an agent file.
+    #[command(allow_negative_numbers = true)]
     Train(train::TrainArgs),
     /// Evaluate one method of a trained agent on a map.
+    #[command(allow_negative_numbers = true)]
     Eval(eval::EvalArgs),
     /// Run one episode step by step: table, CSV, surprise plot and filmstrip.
+    #[command(allow_negative_numbers = true)]
     Trace(trace::TraceArgs),
     /// Test-time learning curves over repeated episodes (paper Fig. 9).
+    #[command(allow_negative_numbers = true)]
     Learn(learn::LearnArgs),
     /// Validate map files and print a readable summary.
+    #[command(allow_negative_numbers = true)]
     CheckMap(check_map::CheckMapArgs),
     /// Run scenario suites headless: every map x method x parameter set, in parallel, as JSON Lines, with expectations.
+    #[command(allow_negative_numbers = true)]
     Batch(batch::BatchArgs),
     /// Merge the shard files of one batch run (from Slurm, Kubernetes, GNU parallel, Ray) into one results file and summary.
+    #[command(allow_negative_numbers = true)]
     Merge(merge::MergeArgs),
     /// Plot a sweep's results (success and reward against reasoning compute) as SVG.
+    #[command(allow_negative_numbers = true)]
     PlotSweep(plot_sweep::PlotSweepArgs),
     /// Cross-check the agent's math on a single-factor model given as JSON (pymdp layout).
+    #[command(allow_negative_numbers = true)]
     Inspect(inspect::InspectArgs),
     /// Search a space of map variations for the fair scenarios where a method fails.
+    #[command(allow_negative_numbers = true)]
     Search(search::SearchArgs),
     /// Write a trained agent's planning model in the `inspect` JSON layout (for pymdp).
+    #[command(allow_negative_numbers = true)]
     ExportModel(export_model::ExportModelArgs),
 }
 
@@ -283,8 +296,8 @@ impl AgentArgs {
 }
 
 /// Parses an episode count that may be 0 (`check-map --survivability-episodes`, where 0
-/// turns the check off), or an episode's number counted from 0 (`trace --episode`): a
-/// whole number in 0..=MAX_EPISODES, digits only (`+5` is refused).
+/// turns the check off): a whole number in 0..=MAX_EPISODES, digits only (`+5` is
+/// refused).
 pub fn episodes_or_none(s: &str) -> Result<u64, String> {
     if s == "0" { Ok(0) } else { episodes(s) }
 }
@@ -326,6 +339,17 @@ pub fn episodes(s: &str) -> Result<u64, String> {
             "at most {MAX_EPISODES} per run (split larger runs with --shard or several --seed values)"
         )),
         Err(_) => Err(format!("'{s}' is not a whole number of episodes")),
+    }
+}
+
+/// Parses an episode index (`trace --episode`): digits only (no sign, no `+5`), at most
+/// MAX_EPISODES.
+pub fn episode_index(s: &str) -> Result<u64, String> {
+    match s.parse::<u64>() {
+        Ok(n) if s.bytes().all(|b| b.is_ascii_digit()) && n <= MAX_EPISODES => Ok(n),
+        _ => Err(format!(
+            "'{s}' is not an episode number: digits only, 0 (the first) to {MAX_EPISODES}"
+        )),
     }
 }
 

@@ -39,3 +39,18 @@ pub fn file(out_flag: &str, out: &Path, own: Own, force: bool, guard: Outputs) -
     note_created(out_flag, out.parent().unwrap_or(Path::new("")));
     Ok(())
 }
+
+/// `n` lines, in words: `1 line`, `3 lines`.
+pub fn lines(n: usize) -> String {
+    if n == 1 { "1 line".into() } else { format!("{n} lines") }
+}
+
+/// How many lines the regular file `path` holds (None: no such file, or not a regular
+/// file): what a notice of its replacement says.
+pub fn line_count(path: &Path) -> Option<usize> {
+    use std::io::BufRead;
+    let file = std::fs::File::open(path)
+        .ok()
+        .filter(|f| f.metadata().is_ok_and(|m| m.is_file()))?;
+    Some(std::io::BufReader::new(file).split(b'\n').count())
+}

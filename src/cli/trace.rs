@@ -32,7 +32,7 @@ pub struct TraceArgs {
     pub html: Option<PathBuf>,
     /// Evaluation episode to trace (0 = the first). Under `--protocol continual` the agent
     /// first runs and learns from episodes 0..N, as a continual evaluation does.
-    #[arg(long, default_value_t = TraceRequest::default().episode, value_parser = super::episodes_or_none)]
+    #[arg(long, default_value_t = TraceRequest::default().episode, value_parser = super::episode_index)]
     pub episode: u64,
     /// Evaluation protocol of the traced episode: zero-shot (from the trained state) or
     /// continual (after learning from the episodes before it).

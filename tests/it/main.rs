@@ -12,6 +12,7 @@ mod corrupt_agent_files;
 mod doc_paths;
 mod guard;
 mod merge;
+mod newcomer;
 mod outputs;
 mod overrides;
 mod readme;

@@ -65,10 +65,29 @@ pub fn parse(path: &Path, text: &str) -> Result<AgentBundle, Error> {
             f.message,
             format!("the file is damaged or was edited: restore it, or {}", retrain(path)),
         ),
-        other => bad(path, None, clipped(&other.to_string()), retrain(path)),
+        other => match other_kind(path, text) {
+            // Never suggest writing an agent over a file of another kind.
+            Some(kind) => bad(
+                path,
+                None,
+                format!("is {kind}, not an agent file"),
+                "give the agent file `unforeseen train --out FILE` wrote (e.g. agent.ron)".into(),
+            ),
+            None => bad(path, None, clipped(&other.to_string()), retrain(path)),
+        },
     })?;
     check_intersection(&bundle).map_err(|(field, problem)| bad(path, Some(field), problem, retrain(path)))?;
     Ok(bundle)
+}
+
+/// What the file at `path` (text `text`) is when it is not an agent file but a file of
+/// another kind a user may give in its place: a map (it loads as one), or JSON (a results
+/// file, a summary, a model).
+fn other_kind(path: &Path, text: &str) -> Option<&'static str> {
+    if text.trim_start().starts_with('{') {
+        return Some("a JSON file (results, a summary or a model)");
+    }
+    (path.is_file() && unforeseen_sim::Map::load(path).is_ok()).then_some("a map file")
 }
 
 /// Longest parser message kept in an error (bytes): a parser may quote the text it met,

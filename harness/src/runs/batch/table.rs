@@ -39,7 +39,11 @@ pub fn batch_summary(rows: &[SummaryRow]) -> Document {
             cell(&r.red_light_rate, 1, true),
             cell(&r.mean_reward, 2, false),
             cell(&r.inference_rate, 1, true),
-            format!("{} ({:.0}%)", seed_text(w.train_seed), 100.0 * w.success_rate),
+            // A run without training seeds has no worst seed to name.
+            match w.train_seed {
+                Some(seed) => format!("{seed} ({:.0}%)", 100.0 * w.success_rate),
+                None => "—".into(),
+            },
         ]);
         grid.rows.push(row);
     }
