@@ -99,7 +99,7 @@ fn a_map_given_as_the_agent_is_named_a_map_and_no_hint_points_at_it() {
 fn an_agent_file_given_as_a_map_is_named_an_agent_file() {
     let dir = tempfile::tempdir().unwrap();
     let agent = dir.path().join("agent.ron");
-    std::fs::write(&agent, crate::common::tiny_agent_text()).unwrap();
+    std::fs::write(&agent, unforeseen_harness::fixtures::tiny_agent_text()).unwrap();
     let out = unforeseen(&["check-map", agent.to_str().unwrap()]);
     assert_exit(&out, 2, &["agent.ron", "is an agent file, not a map"]);
 }
