@@ -273,10 +273,27 @@ impl PyController {
     }
 }
 
+/// `reward` if it is a finite number, else a `ValueError` (a NaN or an infinite reward
+/// would poison what test-time learning keeps).
+pub fn finite_reward(reward: f64) -> PyResult<f64> {
+    if reward.is_finite() {
+        Ok(reward)
+    } else {
+        Err(errors::value(format!("reward {reward}: expected a finite number")))
+    }
+}
+
 /// An observation as the joint index of a model with factor `sizes`: an int in
-/// `0..product(sizes)`, or one integer per factor (`(d, v, L, p)`, e.g. `info["observed"]`).
+/// `0..product(sizes)`, or one integer per factor (`(d, v, L, p)`, e.g. `info["observed"]`);
+/// a bool is refused, as the observation or as a factor.
 pub fn joint_index(sizes: &[usize], obs: &Bound<'_, PyAny>) -> PyResult<usize> {
     let n: usize = sizes.iter().product();
+    let is_bool = |x: &Bound<'_, PyAny>| x.is_instance_of::<pyo3::types::PyBool>();
+    if is_bool(obs) {
+        return Err(errors::value(format!(
+            "observation {obs}: a bool is not an observation; expected a joint index in 0..{n} or (d, v, L, p)"
+        )));
+    }
     if let Ok(i) = obs.extract::<i64>() {
         return usize::try_from(i).ok().filter(|i| *i < n).ok_or_else(|| {
             errors::value(format!(
@@ -289,7 +306,13 @@ pub fn joint_index(sizes: &[usize], obs: &Bound<'_, PyAny>) -> PyResult<usize> {
         .try_iter()
         .and_then(|it| {
             it.take(sizes.len() + 1)
-                .map(|x| x?.extract::<i64>())
+                .map(|x| {
+                    let x = x?;
+                    if is_bool(&x) {
+                        return Err(errors::value("a bool is not a factor's value"));
+                    }
+                    x.extract::<i64>()
+                })
                 .collect::<PyResult<Vec<_>>>()
         })
         .map_err(|_| {
@@ -358,6 +381,7 @@ impl PyController {
         terminated: bool,
         truncated: bool,
     ) -> PyResult<()> {
+        let reward = finite_reward(reward)?;
         let i = self.index(next_observation)?;
         self.lock()
             .observe(reward, i, Ending::from_flags(terminated, truncated));

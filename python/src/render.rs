@@ -1,9 +1,18 @@
-//! What `render()` shows: a top-down frame drawn with tiny-skia (road, sidewalks, lane
-//! line, crosswalk, destination line, the light in its colour, the car, pedestrians),
-//! and a one-line text picture of the same.
+//! What `render()` shows: a top-down frame drawn with tiny-skia (road tinted by its
+//! friction with its surface patches, sidewalks, lane line, crosswalk, destination line,
+//! the light in its colour, the car, pedestrians), and a one-line text picture of the same.
 
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Transform};
 use unforeseen_sim::{LightPhase, Map, Snapshot};
+
+/// The road's colour at friction `mu`: the dry asphalt's dark grey at μ 0.8 and above,
+/// shading to blue as the road gets slippery (ice, μ ≤ 0.1, the bluest), as the
+/// filmstrip tints it (`unforeseen_harness::reports::figures::surface_tint`).
+fn asphalt(mu: f64) -> [u8; 3] {
+    let slip = ((0.8 - mu) / 0.7).clamp(0.0, 1.0);
+    let mix = |dry: f64, slick: f64| (dry + (slick - dry) * slip).round() as u8;
+    [mix(70.0, 60.0), mix(70.0, 105.0), mix(75.0, 165.0)]
+}
 
 /// Pixels per metre of a frame unless asked otherwise: the default maps' frames are then
 /// about 1080x130 pixels, the car 45 pixels long and a pedestrian 12 pixels across.
@@ -41,7 +50,13 @@ pub fn frame(map: &Map, snap: &Snapshot, scale: f32) -> (Vec<u8>, usize, usize) 
     let sidewalk = road.sidewalk_width as f32;
     rect(&mut pix, x_lo, half, x_hi, half + sidewalk, [190, 190, 180]);
     rect(&mut pix, x_lo, -half - sidewalk, x_hi, -half, [190, 190, 180]);
-    rect(&mut pix, x_lo, -half, x_hi, half, [70, 70, 75]);
+    rect(&mut pix, x_lo, -half, x_hi, half, asphalt(road.friction));
+    for patch in &snap.surface {
+        let (from, to) = ((patch.from as f32).max(x_lo), (patch.to as f32).min(x_hi));
+        if from < to {
+            rect(&mut pix, from, -half, to, half, asphalt(patch.friction));
+        }
+    }
     // Lane lines: dashed white between lanes.
     for lane in 1..road.lanes {
         let y = -half + lane as f32 * road.lane_width as f32;

@@ -231,6 +231,7 @@ impl PyScaledHabitAgent {
         terminated: bool,
         truncated: bool,
     ) -> PyResult<()> {
+        let reward = crate::agent::finite_reward(reward)?;
         let i = self.index(next_observed)?;
         self.lock()
             .controller()

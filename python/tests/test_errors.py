@@ -104,3 +104,33 @@ def test_bad_agent_file(tmp_path):
 def test_bad_input_raises_value_error_never_a_panic(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+def test_controllers_refuse_nan_rewards_and_bool_observations(agent):
+    """`observe(nan, ...)` and `act([True, False, True, True])` were accepted: a NaN
+    reward poisons what test-time learning keeps, and a bool is not a factor's value."""
+    wrapped = unforeseen.ScaledWrapper(agent=agent)
+    info = {"observed": (3, 0, 1, 0)}
+    controller = agent.controller("scaled")
+    controller.begin_episode(1)
+    wrapped.begin_episode(1)
+    controller.act((3, 0, 1, 0))
+    wrapped.act(None, info)
+    for reward in (float("nan"), float("inf"), -float("inf")):
+        with pytest.raises(ValueError, match=r"reward .*: expected a finite number"):
+            controller.observe(reward, (3, 0, 1, 0), False, False)
+        with pytest.raises(ValueError, match=r"reward .*: expected a finite number"):
+            wrapped.observe(reward, None, info, False, False)
+    for observed in (True, [True, False, True, True]):
+        with pytest.raises(ValueError, match=r"observation"):
+            controller.act(observed)
+        with pytest.raises(ValueError, match=r"observation"):
+            wrapped.act(None, {"observed": observed})
+    controller.observe(-4.5, (3, 1, 1, 0), False, False)  # still usable
+    wrapped.observe(-4.5, None, {"observed": (3, 1, 1, 0)}, False, False)
+
+
+def test_a_habit_array_of_the_wrong_shape_says_what_shape_is_wanted(agent):
+    n_states = int(np.prod(agent.factor_sizes))
+    with pytest.raises(ValueError, match=rf"habit: an array of shape \(192,\); a habit table is \(n_states, n_actions\) = \({n_states}, 3\)"):
+        unforeseen.ScaledWrapper(habit=np.ones(192) / 3, agent=agent)

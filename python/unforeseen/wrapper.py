@@ -92,6 +92,12 @@ class ScaledWrapper:
         self._habit: Any = None
         self._probs: Callable[[Any], Any] | None = None
         if isinstance(habit, np.ndarray):
+            if habit.ndim != 2:
+                n_states = int(np.prod(self._agent.factor_sizes))
+                raise ValueError(
+                    f"habit: an array of shape {habit.shape}; a habit table is (n_states, n_actions) = "
+                    f"({n_states}, 3), one row of action probabilities per state"
+                )
             self._table = np.ascontiguousarray(habit, dtype=np.float64)
         elif hasattr(habit, "probs") and callable(habit.probs):
             self._habit, self._probs = habit, habit.probs
