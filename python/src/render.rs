@@ -11,7 +11,7 @@ use unforeseen_sim::{LightPhase, Map, Snapshot};
 fn asphalt(mu: f64) -> [u8; 3] {
     let slip = ((0.8 - mu) / 0.7).clamp(0.0, 1.0);
     let mix = |dry: f64, slick: f64| (dry + (slick - dry) * slip).round() as u8;
-    [mix(70.0, 60.0), mix(70.0, 105.0), mix(75.0, 165.0)]
+    [mix(70.0, 150.0), mix(70.0, 185.0), mix(75.0, 215.0)]
 }
 
 /// Pixels per metre of a frame unless asked otherwise: the default maps' frames are then

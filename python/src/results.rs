@@ -85,10 +85,11 @@ fn batch_result(lines: &str) -> PyResult<BatchResult> {
 }
 
 /// The output guard of a results file `out` written from Python (`evaluate`): refuses,
-/// with a `ValueError`, an `out` that is one of `inputs` (map files) or holds something
-/// other than result lines (a batch run's file, whose first line names its run,
-/// included) unless `force`, and holds the lock on it until
-/// [`ResultsGuard::release`] (or until collected).
+/// with a `ValueError`, an `out` that is one of `inputs` (map files), or, unless `force`,
+/// one that holds something other than result lines: when `append`, a batch run's file
+/// is accepted (the lines go beside its lines); when replacing, it is refused (its run
+/// would be lost). Holds the lock on it until [`ResultsGuard::release`] (or until
+/// collected).
 #[pyclass(module = "unforeseen._unforeseen")]
 pub struct ResultsGuard {
     held: Option<Guarded>,
@@ -97,13 +98,12 @@ pub struct ResultsGuard {
 #[pymethods]
 impl ResultsGuard {
     #[new]
-    #[pyo3(signature = (out, inputs, force = false))]
-    fn new(out: PathBuf, inputs: Vec<PathBuf>, force: bool) -> PyResult<ResultsGuard> {
+    #[pyo3(signature = (out, inputs, force = false, append = false))]
+    fn new(out: PathBuf, inputs: Vec<PathBuf>, force: bool, append: bool) -> PyResult<ResultsGuard> {
+        let own = if append { Own::Results } else { Own::ResultLines };
         let guard = inputs
             .iter()
-            .fold(Outputs::new().file("out", &out, Own::ResultLines), |g, m| {
-                g.input("maps", m)
-            });
+            .fold(Outputs::new().file("out", &out, own), |g, m| g.input("maps", m));
         let held = guard.guard(force).map_err(errors::to_py)?;
         Ok(ResultsGuard { held: Some(held) })
     }

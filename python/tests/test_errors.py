@@ -16,7 +16,7 @@ def test_unknown_map_name():
 def test_broken_map_file_names_file_line_and_fix(tmp_path):
     bad = tmp_path / "broken.ron"
     bad.write_text('(\n    base: "jaywalk",\n    road: (lane_width: -3.0),\n)\n')
-    with pytest.raises(ValueError, match=r"broken.ron: road.lane_width: .*") as e:
+    with pytest.raises(ValueError, match=r"broken.ron:3:12: road.lane_width: .*") as e:
         unforeseen.make_env(str(bad))
     syntax = tmp_path / "syntax.ron"
     syntax.write_text('(\n    base: "jaywalk",\n    road: (lane_width: 3.0\n')

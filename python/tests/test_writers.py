@@ -207,8 +207,10 @@ def test_train_agents_checks_its_cache_before_any_training(tmp_path):
 
 
 def test_a_results_header_names_what_evaluate_wrote(tmp_path):
-    # evaluate's own file: result lines (no run header); a second method goes beside them.
+    # evaluate's own file: result lines (no run header); a second method goes beside them
+    # when asked (append=True).
     out = tmp_path / "r.jsonl"
     unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out)
-    unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out, method="b")
+    unforeseen.evaluate(AlwaysFast(), ["jaywalk"], [None], episodes=1, protocol="zero-shot", out=out, method="b",
+                        append=True)
     assert [json.loads(line)["method"] for line in out.read_text().splitlines()] == ["always-fast", "b"]

@@ -144,9 +144,9 @@ def evaluate(
     methods), and a line of the same map, method and training seed already there is
     refused (the summary would count it twice). ``out`` is checked first as ``unforeseen
     batch --out`` is: a ``ValueError`` if it is one of the map files, if it holds
-    something other than result lines (a batch run's file, whose first line names its run,
-    included; unless ``force``: then it is replaced), or if
-    another run is writing it.
+    something other than result lines (unless ``force``: then it is replaced; with
+    ``append`` a batch run's file is accepted, its lines kept, and without it refused, so
+    that its run is not lost), or if another run is writing it.
 
     ``policy``: a policy (the module's protocol) or a :class:`~unforeseen.ScaledWrapper`,
     a mapping ``train_seed -> policy`` or a callable ``train_seed -> policy`` (the policy
@@ -192,7 +192,7 @@ def evaluate(
     if out is not None:
         out = arg("out", "path", out)
         files = [os.fspath(m) for m in maps if os.path.exists(m)]
-        guard = _unforeseen.ResultsGuard(out, files, force=force)
+        guard = _unforeseen.ResultsGuard(out, files, force=force, append=append)
     try:
         if out is not None and os.path.isfile(out):
             if append:
