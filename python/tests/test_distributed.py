@@ -234,9 +234,9 @@ from unforeseen import _unforeseen, distributed as d
 ray.init(address=sys.argv[1], log_to_driver=False)
 tmp, good_map, bad_map = sys.argv[2:5]
 count = os.path.join(tmp, "attempts")
-plan = json.loads(_unforeseen.plan_batch(json.dumps({"maps": [good_map], "out": os.path.join(tmp, "plan.jsonl"),
-                                                     "episodes": 1, "methods": ["never-brake"], "train_seeds": [1],
-                                                     "train_episodes": 1})))
+plan = json.loads(_unforeseen.plan_batch({"maps": [good_map], "out": os.path.join(tmp, "plan.jsonl"),
+                                          "episodes": 1, "methods": ["never-brake"], "train_seeds": [1],
+                                          "train_episodes": 1}))
 spec = json.loads(plan["spec"])
 spec["scenarios"] = [[bad_map, bad_map]]  # the map as a node would see it: not a valid map
 

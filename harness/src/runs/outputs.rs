@@ -65,7 +65,7 @@ pub enum Own {
     /// A batch results file (JSON Lines): a run identity first (`{"run": ...}`), or
     /// result lines (Python's `evaluate`).
     Results,
-    /// Result lines without a run identity (Python's `evaluate`, which appends lines).
+    /// Result lines without a run identity (what Python's `evaluate` writes).
     ResultLines,
     /// A search's candidates file: its first line is `{"search": ...}`.
     Candidates,
