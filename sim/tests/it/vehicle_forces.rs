@@ -63,8 +63,13 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
     /// Braking from v on μ with dead time and lag stops the car in
-    /// `v·τ_dead + lag phase + v₁²/(2 a)` within 2%, `a = min(brake/m, μ g)` (no rolling
-    /// resistance and drag here, so that the law is exact).
+    /// `v·τ_dead + lag phase + v₁²/(2 a)` within 2% plus one sub-step's travel at v,
+    /// `a = min(brake/m, μ g)` (no rolling resistance and drag here, so that the law is
+    /// exact in continuous time). The sub-step term is the integration's: the
+    /// semi-implicit Euler step and the brake force held over a sub-step each run half a
+    /// sub-step ahead of the continuous law, which matters on short stops (9 m/s, μ 0.77,
+    /// 23 m/s² of brake on 800 kg stops in 6.08 m by the law, 5.93 m integrated: 0.15 m,
+    /// one sub-step at 9 m/s).
     #[test]
     fn stopping_distance_is_dead_time_lag_and_friction(
         v in 9.0..20.0f64,
@@ -86,7 +91,11 @@ proptest! {
         map.road.friction = mu;
         let want = stopping_distance(&map.vehicle, v, mu);
         let got = distance_until_stopped(&map, Action::SlowDown, 60 * 120);
-        prop_assert!((got - want).abs() <= 0.02 * want, "stopped in {got} m, the law says {want} m");
+        let sub_step = v / map.episode.physics_hz;
+        prop_assert!(
+            (got - want).abs() <= 0.02 * want + sub_step,
+            "stopped in {got} m, the law says {want} m"
+        );
     }
 
     /// "Speed up" levels off at the speed where the drive force equals rolling
