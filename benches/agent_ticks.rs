@@ -18,7 +18,7 @@ use unforeseen_agent::q_learning::QLearning;
 use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_agent::structure::{Factor, Parent, Structure};
 use unforeseen_env::{Env, EnvConfig};
-use unforeseen_harness::episodes::tick_recording::{TickTimes, jaywalk_family, record};
+use unforeseen_harness::episodes::{TickTimes, jaywalk_family, record};
 use unforeseen_sim::embedded;
 
 mod common;

@@ -12,9 +12,9 @@ use unforeseen_agent::controller::Controller;
 use unforeseen_agent::params::{CompetenceCheck, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_env::{Env, EnvConfig};
-use unforeseen_harness::episodes::evaluation::eval_seeds;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::runner::run_episode;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::eval_seeds;
+use unforeseen_harness::episodes::run_episode;
 use unforeseen_harness::training::train;
 use unforeseen_sim::{Action, Dynamics, Map, World, embedded};
 

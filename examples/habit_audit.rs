@@ -24,9 +24,9 @@ use unforeseen_agent::maths::argmax;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_env::{Env, EnvConfig};
-use unforeseen_harness::episodes::evaluation::eval_seeds;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::runner::{EpisodeResult, run_episode};
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::eval_seeds;
+use unforeseen_harness::episodes::{EpisodeResult, run_episode};
 
 /// The greedy action of a per-state table: the habit alone.
 struct Bare(Vec<f64>);

@@ -16,9 +16,9 @@ use std::path::Path;
 
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_env::{Env, EnvConfig};
-use unforeseen_harness::episodes::evaluation::eval_seeds;
-use unforeseen_harness::episodes::methods::{Method, scaled_agent};
-use unforeseen_harness::episodes::runner::run_episode;
+use unforeseen_harness::episodes::eval_seeds;
+use unforeseen_harness::episodes::run_episode;
+use unforeseen_harness::episodes::{Method, scaled_agent};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

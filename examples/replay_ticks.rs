@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::scaled_agent::ScaledAgent;
-use unforeseen_harness::episodes::tick_recording::{Recording, ReplayOutcome, TickTimes, jaywalk_family, record};
+use unforeseen_harness::episodes::{Recording, ReplayOutcome, TickTimes, jaywalk_family, record};
 use unforeseen_harness::training::agent_file;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
 use unforeseen_sim::embedded;
@@ -142,7 +142,7 @@ fn main() -> anyhow::Result<()> {
             fastest.feedforward()
         );
         if let Some(path) = &json {
-            let summary = |t: unforeseen_harness::episodes::tick_recording::TimeSummary| serde_json::json!({"n": t.n, "mean_us": t.mean, "p10_us": t.p10, "median_us": t.p50, "p90_us": t.p90});
+            let summary = |t: unforeseen_harness::episodes::TimeSummary| serde_json::json!({"n": t.n, "mean_us": t.mean, "p10_us": t.p10, "median_us": t.p50, "p90_us": t.p90});
             let v = serde_json::json!({
                 "horizon": horizon,
                 "passes": passes,

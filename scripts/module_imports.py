@@ -7,7 +7,9 @@ inside `use crate::{...}` groups) or `super::b...`.
 Fails on:
 * a cycle: a strongly connected component with more than one file;
 * an import that runs up a floor of the harness (FLOORS, lowest first; docs/ARCHITECTURE.md
-  §1): a module may import its own floor and the floors below, never one above."""
+  §1): a module may import its own floor and the floors below, never one above;
+* a `pub mod` inside a part of the harness (FACES) that is not one of the part's named
+  namespaces: a part's files are `pub(crate)` behind its `mod.rs`, its one face."""
 import os, re, sys
 root = sys.argv[1]
 crates = {'unforeseen': 'src', 'harness': 'harness/src', 'sim': 'sim/src', 'agent': 'agent/src', 'discretizer': 'discretizer/src', 'env': 'env/src', 'python': 'python/src'}
@@ -22,6 +24,16 @@ FLOORS = {'harness': [
     ['runs'],
     ['fixtures'],
 ]}
+# The harness's parts whose mod.rs is their one face, and the modules inside them that
+# are public namespaces (every other module inside is `pub(crate)` or private).
+FACES = {
+    'harness/src/episodes/mod.rs': {'survivability'},
+    'harness/src/training/mod.rs': {'agent_file'},
+    'harness/src/reports/mod.rs': {'figures'},
+    'harness/src/runs/batch/mod.rs': set(),
+    'harness/src/runs/compare/mod.rs': set(),
+    'harness/src/runs/search/mod.rs': set(),
+}
 def floor_of(floors, module):
     best, depth = None, -1
     for i, floor in enumerate(floors):
@@ -130,4 +142,13 @@ for name, src in crates.items():
         for u in upward:
             print('   ', u)
         total += len(upward)
+faces = []
+for face, namespaces in FACES.items():
+    for m in re.findall(r'^pub mod (\w+);', strip(open(os.path.join(root, face)).read()), re.M):
+        if m not in namespaces:
+            faces.append(f'{face}: `pub mod {m}` (make it pub(crate) and re-export what other crates use)')
+print(f'harness: {len(FACES)} faces, public modules behind them: {faces or "none"}')
+for f in faces:
+    print('   ', f)
+total += len(faces)
 sys.exit(1 if total else 0)

@@ -185,4 +185,7 @@ pub enum InspectError {
     /// A field has an invalid value; the message names the field, e.g. `B[1] column 0 ...`.
     #[error("{0}")]
     Invalid(String),
+    /// A model in pymdp's general layout was refused ([`crate::aif::error::ModelError`]).
+    #[error("{0}")]
+    Model(#[from] crate::aif::error::ModelError),
 }

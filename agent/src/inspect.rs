@@ -1,5 +1,6 @@
 //! `unforeseen inspect --model FILE.json`: exact filtering, free energy, surprise and
-//! EFE planning on a single-factor model, for cross-checking against pymdp.
+//! EFE planning on a single-factor model, for cross-checking against pymdp. Models with
+//! several factors and modalities go to [`crate::aif::inspect`] ([`inspect_json`]).
 //!
 //! Input: `{"A": A[o][s], "B": B[u][s_next][s_prev], "C": log-preferences, "D": p(s_1),
 //! "obs": [o_1..o_t], "actions": [u_1..u_{t-1}], "policy_len": H, "gamma": γ}`.
@@ -219,11 +220,18 @@ pub fn inspect(m: &InspectModel) -> Result<InspectReport, InspectError> {
     })
 }
 
-/// JSON in, pretty JSON out.
+/// JSON in, pretty JSON out. A model whose `obs` is a list of lists (one index per
+/// modality and step) is a general one in pymdp's layout ([`crate::aif::inspect`]); one
+/// with a list of indices is this module's single-factor format.
 pub fn inspect_json(s: &str) -> Result<String, InspectError> {
-    let m: InspectModel = serde_json::from_str(s).map_err(|e| InspectError::Json(e.to_string()))?;
-    let r = inspect(&m)?;
-    serde_json::to_string_pretty(&r).map_err(|e| InspectError::Json(e.to_string()))
+    let v: serde_json::Value = serde_json::from_str(s).map_err(|e| InspectError::Json(e.to_string()))?;
+    let out = if crate::aif::inspect::is_general(&v) {
+        serde_json::to_string_pretty(&crate::aif::inspect::inspect(&v)?)
+    } else {
+        let m: InspectModel = serde_json::from_value(v).map_err(|e| InspectError::Json(e.to_string()))?;
+        serde_json::to_string_pretty(&inspect(&m)?)
+    };
+    out.map_err(|e| InspectError::Json(e.to_string()))
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 //! Module map (named after the paper): [`maths`], [`params`] (declared with [`param_decl`]; [`param_table`], the scaled agent's parameters by name), [`structure`], [`model`] (the world model, one concept per file), [`transition`] (factored `B`),
 //! [`surprise`] (§II), [`gate`] (§VI surprise on the state), [`handback`] (the safe hand-back, beyond the paper), [`competence`] (the competence check of the habit, beyond the paper), [`perception`] (§III), [`planning`] (§IV, Prop. 1, Cor. 1),
 //! [`scaling`] (§IV, Theorem 1), [`learning`] (§V), [`q_learning`], [`bayes_rl`],
-//! [`habit`] (`π_o` as an interface), [`scaled_agent`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`].
+//! [`habit`] (`π_o` as an interface), [`scaled_agent`] (the paper's agent), [`controller`], [`persist`], [`inspect`], [`error`], [`limits`]; [`aif`]: any discrete model in pymdp's layout, with pymdp's algorithms and the paper's gate.
 //!
 //! ```
 //! use unforeseen_agent::{controller::Controller, model::WorldModel, params::*,
@@ -24,6 +24,7 @@
 //! let d = agent.act(st.encode(&[3, 1, 1, 0]));
 //! assert!(d.action < 3);
 //! ```
+pub mod aif;
 pub mod bayes_rl;
 pub mod competence;
 pub mod controller;

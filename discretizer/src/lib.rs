@@ -7,7 +7,7 @@
 //! | `d` | `0..=n_d-1` | distance-to-destination bin (0 = arrived, 1 = the crosswalk zone, highest = far) |
 //! | `v` | `0..=n_v-1` | speed bin |
 //! | `L` | `0, 1` | traffic light: 0 red (amber counts as red), 1 green |
-//! | `p` | `0, 1` | a pedestrian is on the crosswalk |
+//! | `p` | `0, 1` | an obstacle is in the car's path: a pedestrian on the crosswalk, or a vehicle in its lane ahead up to the junction box's far edge or crossing in the box (`Snapshot::obstacle_in_path`; on a map without traffic, the paper's pedestrian on the crosswalk) |
 //!
 //! with joint index `s = ((d * n_v + v) * 2 + L) * 2 + p` (64 states for the default
 //! 4 x 4 x 2 x 2). Bin edges come from the map ([`unforeseen_sim::Bins`]), so a finer
@@ -176,7 +176,7 @@ impl Discretizer {
             d: self.distance_bin(snap.distance_to_goal),
             v: self.speed_bin(snap.car_speed),
             l: usize::from(snap.light == LightPhase::Green),
-            p: usize::from(snap.pedestrians.iter().any(|p| p.on_crosswalk)),
+            p: usize::from(snap.obstacle_in_path()),
         }
     }
 

@@ -3,7 +3,9 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use unforeseen_discretizer::{Discretizer, State, distance_edges};
-use unforeseen_sim::{Bins, CrosswalkBins, DistanceEdges, LightPhase, Map, PedestrianSnapshot, Snapshot};
+use unforeseen_sim::{
+    Aspect, Bins, CrosswalkBins, DistanceEdges, LightPhase, Map, PedestrianSnapshot, SignalState, Snapshot, Walk,
+};
 
 /// The training intersection with the paper's bins as fixed edges and `noise`.
 fn paper_bins(noise: f64) -> Map {
@@ -28,6 +30,18 @@ fn snapshot(distance: f64, speed: f64, light: LightPhase, peds_on: &[bool]) -> S
         distance_to_goal: distance,
         light,
         light_time_left: 1.0,
+        signals: SignalState {
+            road: Aspect::Lit(light),
+            cross: Aspect::Lit(LightPhase::Red),
+            walk_road: if light == LightPhase::Red {
+                Walk::Walk
+            } else {
+                Walk::DontWalk
+            },
+            walk_cross: Walk::Walk,
+        },
+        vehicles: Vec::new(),
+        vehicle_in_path: false,
         pedestrians: peds_on
             .iter()
             .map(|&on| PedestrianSnapshot {

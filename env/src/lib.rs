@@ -50,7 +50,7 @@ pub mod seeds;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use unforeseen_discretizer::{Discretizer, DiscretizerError, State};
-use unforeseen_sim::{LightPhase, Map, Snapshot, World};
+use unforeseen_sim::{LightPhase, Map, Margins, Snapshot, World};
 
 pub use reward::RewardTerms;
 pub use unforeseen_sim::Action;
@@ -219,6 +219,8 @@ pub struct Env {
     noise: ChaCha8Rng,
     snapshot: Option<Snapshot>,
     info: Option<Info>,
+    /// Whether each episode's margins are measured ([`Env::measure_margins`]).
+    margins: bool,
 }
 
 impl std::fmt::Debug for Env {
@@ -257,7 +259,20 @@ impl Env {
             noise: ChaCha8Rng::seed_from_u64(0),
             snapshot: None,
             info: None,
+            margins: false,
         })
+    }
+
+    /// Whether the episodes from the next [`Env::reset`] on measure their margins
+    /// ([`unforeseen_sim::margins`]: how close they come to a collision); measuring
+    /// changes nothing in an episode.
+    pub fn measure_margins(&mut self, on: bool) {
+        self.margins = on;
+    }
+
+    /// The current episode's smallest margins so far (none unless measured).
+    pub fn margins(&self) -> Option<Margins> {
+        self.world.as_ref().and_then(World::margins)
     }
 
     /// The map.
@@ -278,7 +293,10 @@ impl Env {
     /// Starts an episode: the world's randomness (light offset, spawns) from `seed`, the
     /// observation noise from `seed ^ NOISE_STREAM`.
     pub fn reset(&mut self, seed: u64) -> (Observation, Info) {
-        let world = World::from_map(&self.map, seed);
+        let mut world = World::from_map(&self.map, seed);
+        if self.margins {
+            world.measure_margins();
+        }
         self.noise = ChaCha8Rng::seed_from_u64(seed ^ NOISE_STREAM);
         self.world = Some(world);
         let info = self.look(Events::default(), RewardTerms::default());

@@ -11,11 +11,7 @@ fn map(name: &str) -> Map {
 
 /// A map from RON text over the embedded maps.
 fn map_from(text: &str) -> Map {
-    let embedded = |base: &str| {
-        let name = base.strip_suffix(".ron").unwrap_or(base);
-        embedded::source(name).map(|t| (format!("embedded:{name}"), t.to_string()))
-    };
-    Map::from_str_named("test.ron", text, &embedded).expect("valid map")
+    Map::from_str_named("test.ron", text, &embedded::base).expect("valid map")
 }
 
 fn kinematic_env(map: &Map) -> Env {

@@ -7,9 +7,15 @@
 //! commit), then the parts are renamed into place and the journal removed. A kill before
 //! the commit leaves the earlier set and parts that [`recover`] removes; a kill between
 //! two renames leaves a journal that [`recover`] completes, so the set becomes the new
-//! one. The output guard runs [`recover`] in every output folder before a run writes,
-//! and any reader may. Every temporary is locked while its writer lives, so [`recover`]
-//! tells a live writer's files from a dead one's.
+//! one. A set may also remove files ([`remove_with_set`]: a file the earlier set had and
+//! this one has not), listed in the journal and removed after the renames. The output
+//! guard runs [`recover`] in every output folder before a run writes, and any reader
+//! may. Every temporary is locked while its writer lives, so [`recover`] tells a live
+//! writer's files from a dead one's.
+//!
+//! A file a run streams while it lasts ([`Streamed`], a search's candidates) is not an
+//! output: it is a part under its own name that `--resume` reads after a kill, committed
+//! (rewritten into the output) with the rest of the set at the end, and removed with it.
 
 use std::collections::BTreeSet;
 use std::io::Write;
@@ -71,7 +77,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io("create folder", dir, e))?;
     recover(dir)?;
     let result = (|| -> std::io::Result<()> {
-        let prefix = STAGED.with_borrow(|s| s.as_ref().map(|(id, _)| format!("{PART_PREFIX}{id}-")));
+        let prefix = STAGED.with_borrow(|s| s.as_ref().map(|set| format!("{PART_PREFIX}{}-", set.id)));
         let mut builder = tempfile::Builder::new();
         builder.prefix(prefix.as_deref().unwrap_or(TEMP_PREFIX));
         #[cfg(unix)]
@@ -83,8 +89,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         tmp.write_all(bytes)?;
         tmp.as_file().sync_all()?;
         let tmp = match STAGED.with_borrow_mut(|staged| match staged {
-            Some((_, list)) => {
-                list.push((tmp, path.to_path_buf(), _registered));
+            Some(set) => {
+                set.writes.push((tmp, path.to_path_buf(), _registered));
                 None
             }
             None => Some((tmp, _registered)),
@@ -101,6 +107,50 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         Ok(())
     })();
     result.map_err(|e| Error::io("write", path, e))
+}
+
+/// A file a run streams line by line while it lasts (module docs): created with its
+/// first lines through [`write_atomic`], then appended to, each append flushed, so a kill
+/// leaves every finished line for `--resume`. It is a part, not an output: the run
+/// commits its content with the rest of its set ([`all_or_none`]) and removes it there
+/// ([`remove_with_set`]), so a failure partway (a full disk) leaves the earlier set as it
+/// was.
+#[derive(Debug)]
+pub struct Streamed {
+    file: std::fs::File,
+    path: PathBuf,
+    appends: usize,
+}
+
+impl Streamed {
+    /// Creates (or replaces) `path` holding `head`, open for appending.
+    pub fn create(path: &Path, head: &[u8]) -> Result<Streamed, Error> {
+        write_atomic(path, head)?;
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .map_err(|e| Error::io("append to", path, e))?;
+        Ok(Streamed {
+            file,
+            path: path.to_path_buf(),
+            appends: 0,
+        })
+    }
+
+    /// Appends `bytes` (whole lines) and flushes them.
+    pub fn append(&mut self, bytes: &[u8]) -> Result<(), Error> {
+        let n = self.appends;
+        self.appends += 1;
+        fault::before_append(n)
+            .and_then(|()| self.file.write_all(bytes))
+            .and_then(|()| self.file.flush())
+            .map_err(|e| Error::io("write", &self.path, e))
+    }
+
+    /// Where it is.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
 }
 
 /// The permissions the written file gets: those of the file it replaces, else what a new
@@ -122,16 +172,26 @@ const PART_PREFIX: &str = ".unforeseen-part-";
 /// Name prefix of a set's journal (`.unforeseen-set-ID.json`).
 const JOURNAL_PREFIX: &str = ".unforeseen-set-";
 
-std::thread_local! {
-    /// The set [`all_or_none`] is writing on this thread (its id) and the writes it
-    /// holds back until its closure succeeds.
-    static STAGED: std::cell::RefCell<Option<(String, Vec<Staged>)>> = const { std::cell::RefCell::new(None) };
+/// The set [`all_or_none`] is writing on a thread: its id, and the writes and removals
+/// it holds back until its closure succeeds.
+struct Set {
+    id: String,
+    writes: Vec<Staged>,
+    removes: Vec<PathBuf>,
 }
 
-/// A set's journal: the renames that make it, part to file (absolute paths).
+std::thread_local! {
+    /// The set [`all_or_none`] is writing on this thread.
+    static STAGED: std::cell::RefCell<Option<Set>> = const { std::cell::RefCell::new(None) };
+}
+
+/// A set's journal: the renames that make it, part to file, then the files it removes
+/// (absolute paths).
 #[derive(serde::Serialize, serde::Deserialize)]
 struct Journal {
     renames: Vec<(PathBuf, PathBuf)>,
+    #[serde(default)]
+    removes: Vec<PathBuf>,
 }
 
 /// A fresh id for a set (process, time and a counter: unique among the writers of a
@@ -159,21 +219,59 @@ fn folder_of(path: &Path) -> &Path {
 /// it fails (a full disk) every part is removed and the previous files stay as they
 /// were, never a mix of old and new outputs.
 pub fn all_or_none<T, E: From<Error>>(write: impl FnOnce() -> Result<T, E>) -> Result<T, E> {
-    let outer = STAGED.with_borrow_mut(|s| s.replace((set_id(), Vec::new())));
+    let outer = STAGED.with_borrow_mut(|s| {
+        s.replace(Set {
+            id: set_id(),
+            writes: Vec::new(),
+            removes: Vec::new(),
+        })
+    });
     let result = write();
     let staged = STAGED.with_borrow_mut(|s| std::mem::replace(s, outer));
     let value = result?;
-    if let Some((id, staged)) = staged {
-        commit(&id, staged)?;
+    if let Some(set) = staged {
+        commit(set)?;
     }
     Ok(value)
 }
 
-/// Commits the staged set `id`: the journal in every folder of the set, then the
-/// renames, then the journals removed. Holds [`TEMPORARIES`] throughout, so that SIGINT
+/// Removes `path` as part of the set [`all_or_none`] is writing on this thread: after
+/// its renames, in the same commit (a kill in between leaves the removal to
+/// [`recover`]), and not at all when the set fails. Outside a set, removes it now. A
+/// missing file is no error.
+pub fn remove_with_set(path: &Path) -> Result<(), Error> {
+    let path = std::path::absolute(path).map_err(|e| Error::io("resolve", path, e))?;
+    let path = match STAGED.with_borrow_mut(|s| match s {
+        Some(set) => {
+            set.removes.push(path.clone());
+            None
+        }
+        None => Some(path),
+    }) {
+        Some(p) => p,
+        None => return Ok(()),
+    };
+    remove_if_there(&path)
+}
+
+/// Removes `path`; a missing file is no error.
+fn remove_if_there(path: &Path) -> Result<(), Error> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::io("remove", path, e)),
+        _ => Ok(()),
+    }
+}
+
+/// Commits the staged set: the journal in every folder of the set, then the renames and
+/// removals, then the journals removed. Holds [`TEMPORARIES`] throughout, so that SIGINT
 /// or SIGTERM ([`remove_temporaries`]) waits for the set instead of cutting it.
-fn commit(id: &str, staged: Vec<Staged>) -> Result<(), Error> {
-    if staged.is_empty() {
+fn commit(set: Set) -> Result<(), Error> {
+    let Set {
+        id,
+        writes: staged,
+        removes,
+    } = set;
+    if staged.is_empty() && removes.is_empty() {
         return Ok(());
     }
     let absolute = |p: &Path| std::path::absolute(p).map_err(|e| Error::io("resolve", p, e));
@@ -181,10 +279,16 @@ fn commit(id: &str, staged: Vec<Staged>) -> Result<(), Error> {
     for (tmp, path, _) in &staged {
         renames.push((absolute(tmp.path())?, absolute(path)?));
     }
-    let mut folders: Vec<PathBuf> = renames.iter().map(|(_, p)| folder_of(p).to_path_buf()).collect();
+    let mut folders: Vec<PathBuf> = renames
+        .iter()
+        .map(|(_, p)| p)
+        .chain(&removes)
+        .map(|p| folder_of(p).to_path_buf())
+        .collect();
     folders.sort();
     folders.dedup();
-    let journal = serde_json::to_vec(&Journal { renames })?;
+    let journal = Journal { renames, removes };
+    let text = serde_json::to_vec(&journal)?;
     let registry = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
     let mut journals = Vec::new();
     for dir in &folders {
@@ -192,7 +296,7 @@ fn commit(id: &str, staged: Vec<Staged>) -> Result<(), Error> {
         let written = (|| -> std::io::Result<std::fs::File> {
             let mut f = std::fs::File::create(&path)?;
             let _ = f.try_lock();
-            f.write_all(&journal)?;
+            f.write_all(&text)?;
             f.sync_all()?;
             sync_folder(dir);
             Ok(f)
@@ -218,10 +322,14 @@ fn commit(id: &str, staged: Vec<Staged>) -> Result<(), Error> {
         parts.push((tmp.into_temp_path(), path));
         registered.push(reg);
     }
-    let renamed = parts.iter().enumerate().try_for_each(|(done, (part, path))| {
-        fault::before_rename(done);
-        std::fs::rename(part, path).map_err(|e| Error::io("write", path, e))
-    });
+    let renamed = parts
+        .iter()
+        .enumerate()
+        .try_for_each(|(done, (part, path))| {
+            fault::before_rename(done);
+            std::fs::rename(part, path).map_err(|e| Error::io("write", path, e))
+        })
+        .and_then(|()| journal.removes.iter().try_for_each(|p| remove_if_there(p)));
     if renamed.is_ok() {
         for dir in &folders {
             sync_folder(dir);
@@ -278,6 +386,11 @@ pub fn recover(dir: &Path) -> Result<(), Error> {
                 }
                 folders.push(folder_of(file).to_path_buf());
             }
+            for gone in &journal.removes {
+                remove_if_there(gone)?;
+                folders.push(folder_of(gone).to_path_buf());
+            }
+            folders.sort();
             folders.dedup();
             for f in &folders {
                 sync_folder(f);
@@ -301,12 +414,34 @@ pub fn recover(dir: &Path) -> Result<(), Error> {
     Ok(())
 }
 
-/// A kill between two renames of a set, for the tests of [`all_or_none`]: with the
-/// `fault-injection` feature (which only the tests enable), the environment variable
-/// `UNFORESEEN_KILL_AT_RENAME=N` aborts the process just before the set's rename `N`
-/// (0-based), as `kill -9` would: no destructor runs, and the journal and the parts not
-/// yet renamed stay on disk.
+/// Faults for the tests of [`all_or_none`] and [`Streamed`], with the `fault-injection`
+/// feature (which only the tests enable):
+///
+/// * a kill between two renames of a set: `UNFORESEEN_KILL_AT_RENAME=N` aborts the
+///   process just before the set's rename `N` (0-based), as `kill -9` would: no
+///   destructor runs, and the journal and the parts not yet renamed stay on disk;
+/// * a full disk: `UNFORESEEN_FULL_DISK_AT_APPEND=N` fails the `N`-th append (0-based)
+///   of each [`Streamed`] file with the error a full disk gives (`ENOSPC`).
 mod fault {
+    /// Fails append `n` when asked (see the module docs).
+    #[cfg(feature = "fault-injection")]
+    pub fn before_append(n: usize) -> std::io::Result<()> {
+        let at = std::env::var("UNFORESEEN_FULL_DISK_AT_APPEND").ok();
+        if at.and_then(|v| v.parse::<usize>().ok()) == Some(n) {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::StorageFull,
+                "No space left on device (injected)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Nothing, without the `fault-injection` feature.
+    #[cfg(not(feature = "fault-injection"))]
+    pub fn before_append(_n: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+
     /// Aborts before rename `done` when asked (see the module docs).
     #[cfg(feature = "fault-injection")]
     pub fn before_rename(done: usize) {
@@ -435,6 +570,27 @@ mod tests {
         all_or_none(|| write_atomic(&a, b"new")).unwrap();
         assert_eq!(std::fs::read_to_string(&a).unwrap(), "new");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    #[test]
+    fn a_set_removes_its_files_only_when_it_commits() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, gone) = (dir.path().join("a.csv"), dir.path().join("gone.ron"));
+        std::fs::write(&gone, "old").unwrap();
+        let failed = all_or_none(|| -> Result<(), Error> {
+            write_atomic(&a, b"new")?;
+            remove_with_set(&gone)?;
+            Err(Error::Interrupted)
+        });
+        assert!(failed.is_err());
+        assert!(gone.is_file() && !a.exists());
+        all_or_none(|| -> Result<(), Error> {
+            write_atomic(&a, b"new")?;
+            remove_with_set(&gone)
+        })
+        .unwrap();
+        assert!(!gone.exists() && a.is_file());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

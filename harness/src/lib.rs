@@ -13,19 +13,20 @@
 //! One episode steps in one place, [`unforeseen_env::Env`]; this crate's runner, training
 //! and references are loops over it. Its parts, one folder each:
 //!
-//! * [`episodes`]: one episode and the methods that drive it — the [`runner`](episodes::runner),
-//!   the compared [`methods`](episodes::methods) with their ablations and the scripted
-//!   [`reference`](episodes::reference)s, the evaluation [`protocol`](episodes::protocol)s,
-//!   the [`metrics`](episodes::metrics) of the paper's table, the per-state
-//!   [`rewards`](episodes::rewards) (the C vector of §IV), the
-//!   [`survivability`](episodes::survivability) check of a scenario, the
-//!   [`evaluation`](episodes::evaluation) of a method on a map under a protocol, one
-//!   [`trace`](episodes::trace)d episode, the test-time [`learning_curves`](episodes::learning_curves)
-//!   and the [`tick_recording`](episodes::tick_recording) of reasoning ticks for the
-//!   benches;
+//! * [`episodes`]: one episode and the methods that drive it — the runner
+//!   ([`run_episode`](episodes::run_episode)), the compared [`Method`](episodes::Method)s
+//!   with their ablations and the scripted references
+//!   ([`BrakeOnPedestrian`](episodes::BrakeOnPedestrian), [`NeverBrake`](episodes::NeverBrake)),
+//!   the evaluation [`Protocol`](episodes::Protocol)s, the metrics of the paper's table
+//!   ([`Aggregate`](episodes::Aggregate)), the per-state rewards (the C vector of §IV,
+//!   [`state_rewards`](episodes::state_rewards)), the
+//!   [`survivability`](episodes::survivability) check of a scenario, the evaluation of a
+//!   method on a map under a protocol ([`evaluate_map`](episodes::evaluate_map)), a controller run in order ([`run_controller`](episodes::run_controller)), one traced episode
+//!   ([`trace`](episodes::trace)), the test-time learning curves ([`learn`](episodes::learn))
+//!   and the recording of reasoning ticks for the benches ([`record`](episodes::record));
 //! * [`training`]: the training loop (Q-learning, the world model and Bayesian RL on the
-//!   same episodes), [`seed_agents`](training::seed_agents) (one agent per training
-//!   seed, in parallel, with an on-disk cache) and the [`agent_file`](training::agent_file);
+//!   same episodes), one agent per training seed in parallel with an on-disk cache
+//!   ([`train_agents`](training::train_agents)) and the [`agent_file`](training::agent_file);
 //! * [`runs`]: what runs many episodes — [`batch`](runs::batch) (scenario suites and
 //!   sweeps, in parallel and in shards), deployment [`stream`](runs::stream)s, the
 //!   [`compare`](runs::compare) study (the paper's table over agents and protocols),
@@ -38,8 +39,14 @@
 //!   the same value from every front, whose planning owns defaults, checks, agents, the
 //!   output guard and identity, and whose job writes its files;
 //! * [`reports`]: what the jobs render with: SVG [`figures`](reports::figures), the HTML
-//!   [`replay_page`](reports::replay_page) of an episode and printed
-//!   [`tables`](reports::tables).
+//!   replay page of an episode ([`replay_html`](reports::replay_html)) and printed
+//!   documents ([`Document`](reports::Document)).
+//!
+//! **One face per part.** Each part's `mod.rs` is its face: the files inside a part are
+//! `pub(crate)`, and what other crates use is re-exported there, so every public item has
+//! one path (`episodes::Method`, `runs::batch::BatchRequest`). The exceptions are modules
+//! whose names are the namespace of what they hold (`training::agent_file::load`,
+//! `episodes::survivability::check`, `reports::figures`, and each job of [`runs`]).
 //!
 //! Shared by all of them: [`files`] are written atomically, [`maps`] finds a map by path or by embedded name,
 //! [`overrides`] applies `KEY=VALUE` parameter overrides, [`limits`] bounds what one

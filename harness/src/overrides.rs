@@ -59,7 +59,8 @@ pub fn override_error(key: &str, value: &str, e: SetError) -> Error {
 
 /// Applies `KEY=VALUE` overrides in order, then checks the result (ranges and bounds
 /// of [`ScaledParams::check`]).
-pub fn apply(mut p: ScaledParams, sets: &[String]) -> Result<ScaledParams, Error> {
+pub fn apply(p: ScaledParams, sets: &[String]) -> Result<ScaledParams, Error> {
+    let mut pairs = Vec::with_capacity(sets.len());
     for set in sets {
         let (key, value) = set.split_once('=').ok_or_else(|| {
             Error::flag(
@@ -70,7 +71,19 @@ pub fn apply(mut p: ScaledParams, sets: &[String]) -> Result<ScaledParams, Error
                 ),
             )
         })?;
-        set_one(&mut p, key.trim(), value.trim())?;
+        pairs.push((key.trim(), value.trim()));
+    }
+    apply_pairs(p, pairs)
+}
+
+/// Applies `(key, value)` overrides in order (as [`set_one`]), then checks the result
+/// (ranges and bounds of [`ScaledParams::check`]).
+pub fn apply_pairs<'a>(
+    mut p: ScaledParams,
+    pairs: impl IntoIterator<Item = (&'a str, &'a str)>,
+) -> Result<ScaledParams, Error> {
+    for (key, value) in pairs {
+        set_one(&mut p, key, value)?;
     }
     p.check_ref().map_err(|e| Error::Override {
         setting: e.name.to_string(),

@@ -1,6 +1,6 @@
 //! The agents from Python: training and agent files ([`unforeseen_harness::training`],
 //! [`unforeseen_harness::training::agent_file`]), a controller of every method the command line has
-//! ([`unforeseen_harness::episodes::methods::Method`]) with parameters through `--set`'s path
+//! ([`unforeseen_harness::episodes::Method`]) with parameters through `--set`'s path
 //! ([`unforeseen_harness::overrides`]), and the library's evaluation ([`unforeseen_harness::episodes::evaluation`]).
 
 use std::path::PathBuf;
@@ -12,10 +12,10 @@ use unforeseen_agent::controller::{Controller, Decision, Ending};
 use unforeseen_agent::param_decl::ParamValue;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::runs::evaluate::EvalRequest;
-use unforeseen_harness::training::seed_agents::TrainSeeds;
+use unforeseen_harness::training::TrainSeeds;
 
 use crate::convert;
 use crate::errors;
@@ -201,7 +201,7 @@ fn train_agents(
         ..unforeseen_harness::training::TrainConfig::new(episodes, 0)
     };
     let agents = crate::interrupt::interruptible(py, |progress| {
-        unforeseen_harness::training::seed_agents::train_agents(&map, &seeds.0, &cfg, cache.as_deref(), progress)
+        unforeseen_harness::training::train_agents(&map, &seeds.0, &cfg, cache.as_deref(), progress)
     })?;
     Ok(agents
         .into_iter()
@@ -401,7 +401,7 @@ impl PyController {
 /// `(world, controller)` seeds of evaluation episode `episode` of the method named
 /// `method` on `map`, as `unforeseen eval` uses them: a built-in method's, or a Python
 /// policy's under the name its lines carry
-/// ([`unforeseen_harness::episodes::evaluation::eval_seeds_named`]).
+/// ([`unforeseen_harness::episodes::eval_seeds_named`]).
 #[pyfunction]
 fn eval_seeds(
     seed: &Bound<'_, PyAny>,
@@ -414,7 +414,7 @@ fn eval_seeds(
     let method = convert::text("method", method)?;
     let episode = convert::whole("episode", episode, convert::SEEDS)?;
     let map = crate::maps::load(&map.to_string_lossy(), None)?;
-    let s = unforeseen_harness::episodes::evaluation::eval_seeds_named(seed, &map, &method, episode);
+    let s = unforeseen_harness::episodes::eval_seeds_named(seed, &map, &method, episode);
     Ok((s.world, s.controller))
 }
 

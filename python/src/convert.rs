@@ -205,16 +205,24 @@ enum Kind {
     Number,
 }
 
+/// The most draws or candidates of any job (the estimate's or the search's; the job's own
+/// bound is the library's check).
+const MAX_BUDGET: usize = {
+    use unforeseen_harness::runs::{estimate, search};
+    if estimate::MAX_BUDGET > search::MAX_BUDGET {
+        estimate::MAX_BUDGET
+    } else {
+        search::MAX_BUDGET
+    }
+};
+
 /// Every field of every job's request and its kind, the bounds those of the library.
 const FIELDS: &[(&str, Kind)] = &[
     ("episodes", Kind::Whole(1, MAX_EPISODES)),
     ("train_episodes", Kind::Whole(1, MAX_EPISODES)),
     ("seed", Kind::Whole(0, u64::MAX)),
     ("jobs", Kind::Whole(1, MAX_JOBS as u64)),
-    (
-        "budget",
-        Kind::Whole(1, unforeseen_harness::runs::search::MAX_BUDGET as u64),
-    ),
+    ("budget", Kind::Whole(1, MAX_BUDGET as u64)),
     ("rounds", Kind::Whole(0, u64::MAX)),
     ("max_failures", Kind::Whole(0, u64::MAX)),
     ("maps", Kind::Paths),
@@ -233,10 +241,12 @@ const FIELDS: &[(&str, Kind)] = &[
     ("protocol", Kind::Text),
     ("shard", Kind::Text),
     ("timeout_as", Kind::Text),
+    ("estimator", Kind::Text),
     ("resume", Kind::Bool),
     ("force", Kind::Bool),
     ("ablations", Kind::Bool),
     ("sobol_share", Kind::Number),
+    ("target_rel_error", Kind::Number),
 ];
 
 /// `v` as the JSON value of a request field of kind `kind` (None as null).

@@ -13,6 +13,8 @@
 //! * [`vector`]: many envs stepped in Rust threads with the GIL released;
 //! * [`render`]: the top-down frame (tiny-skia) and the text line;
 //! * [`agent`]: training, agent files, every method's controller, evaluation;
+//! * [`aif`]: the general active-inference agent on any model in pymdp's layout, behind
+//!   the surprise gate (`unforeseen.aif`);
 //! * [`results`]: `compare` and `batch`, run as the command line runs them;
 //! * [`reports`]: the reports of `compare`, `eval` and `batch` as Python objects: their
 //!   files' data, and the command line's printed table as `str()`, Markdown and HTML;
@@ -24,16 +26,18 @@
 //! * [`errors`]: Rust errors as Python exceptions (`ValueError` for what the user can fix).
 
 mod agent;
+mod aif;
 mod convert;
 mod env;
 mod errors;
+mod estimate;
 mod interrupt;
 mod maps;
 mod policy;
 mod render;
 mod reports;
 mod requests;
-mod results;
+mod runs;
 mod search_units;
 mod units;
 mod vector;
@@ -56,22 +60,29 @@ fn version() -> &'static str {
 /// The extension module.
 #[pymodule]
 fn _unforeseen(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    // NumPy's C API, fetched now, at import: the numpy crate fetches it on first use and
-    // reports a failure as a panic, which a Ctrl-C pending at that moment made (a
-    // `PanicException` instead of `KeyboardInterrupt` while stepping a vector env).
-    numpy::PyArray1::<f32>::zeros(m.py(), [0], false);
+    // NumPy's C API and the numpy crate's shared borrow checking, set up now, at import:
+    // the crate sets each up on first use and reports a failure there as a panic. Its
+    // set-up runs Python code (`numpy.lib.NumpyVersion`), so a Ctrl-C pending at that
+    // moment made a `PanicException` instead of `KeyboardInterrupt` while stepping a
+    // vector env. Here the module's name is found first, where a failure (the Ctrl-C
+    // itself) is the import's exception; what follows runs no Python code.
+    numpy::get_array_module(m.py())?;
+    let probe = numpy::PyArray1::<i64>::zeros(m.py(), [0], false);
+    drop(numpy::PyArrayMethods::readonly(&probe));
     m.add_function(wrap_pyfunction!(embedded_maps, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     convert::register(m)?;
     env::register(m)?;
     vector::register(m)?;
     agent::register(m)?;
-    results::register(m)?;
+    aif::register(m)?;
+    runs::register(m)?;
     reports::register(m)?;
     wrapper::register(m)?;
     policy::register(m)?;
     requests::register(m)?;
     units::register(m)?;
     search_units::register(m)?;
+    estimate::register(m)?;
     Ok(())
 }

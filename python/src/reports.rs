@@ -1,7 +1,7 @@
 //! The reports of `compare`, `eval` and `batch` as Python objects: each holds its
 //! report's serde data (what compare.json, eval.json, or the results file's lines and
 //! the summary hold) and the document the command line prints
-//! ([`unforeseen_harness::reports::tables`]). `str()` is the command line's table,
+//! ([`unforeseen_harness::reports::Document`]). `str()` is the command line's table,
 //! `_repr_markdown_` / `_repr_html_` the same table for notebooks, `to_dict()` and
 //! `result["key"]` the data, `to_records()` the table's rows as flat dicts and
 //! `to_pandas()` those rows as a DataFrame (where pandas is installed).
@@ -10,11 +10,11 @@ use pyo3::exceptions::{PyImportError, PyKeyError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use serde_json::{Map, Value};
-use unforeseen_harness::reports::tables::Document;
-use unforeseen_harness::runs::batch::table::{batch_summary, expectation_failures};
+use unforeseen_harness::reports::Document;
 use unforeseen_harness::runs::batch::{ResultLine, summarize};
+use unforeseen_harness::runs::batch::{batch_summary, expectation_failures};
 use unforeseen_harness::runs::compare::CompareReport;
-use unforeseen_harness::runs::compare::table::compare;
+use unforeseen_harness::runs::compare::compare_table;
 use unforeseen_harness::runs::evaluate::EvalOutcome;
 
 use crate::errors;
@@ -259,7 +259,7 @@ impl CompareResult {
         Ok(CompareResult {
             report: Report {
                 data,
-                doc: compare(report),
+                doc: compare_table(report),
                 rows,
             },
         })

@@ -29,9 +29,10 @@ fn request_defaults(job: &str) -> PyResult<String> {
         "search" => defaults::<unforeseen_harness::runs::search::SearchRequest>(),
         "compare" => defaults::<unforeseen_harness::runs::compare::CompareRequest>(),
         "eval" => defaults::<unforeseen_harness::runs::evaluate::EvalRequest>(),
+        "estimate" => defaults::<unforeseen_harness::runs::estimate::EstimateRequest>(),
         other => {
             return Err(errors::value(format!(
-                "job: no request named '{other}'; the jobs are batch, search, compare, eval"
+                "job: no request named '{other}'; the jobs are batch, search, compare, eval, estimate"
             )));
         }
     };

@@ -21,7 +21,7 @@ use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::error::Error;
 use unforeseen_harness::runs::batch::AgentChoice;
 use unforeseen_harness::runs::search::{CandidateWire, Evaluator, SearchConfig, SearchRequest, SearchSetup};
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::Agent;
 
 use crate::agent::PyAgent;
 use crate::errors;
@@ -31,8 +31,8 @@ use crate::units::parse_agent;
 
 /// A search rebuilt from its request and the agents given (what [`SearchConfig`]
 /// borrows).
-struct Built {
-    setup: SearchSetup,
+pub(crate) struct Built {
+    pub(crate) setup: SearchSetup,
     agents: Vec<Agent>,
 }
 
@@ -60,7 +60,7 @@ fn resolve(
 impl Built {
     /// The setup with the agents it runs: the one given, or those of its training seeds
     /// among `parsed` (each seed must be there).
-    fn new(setup: SearchSetup, parsed: Vec<Agent>) -> PyResult<Built> {
+    pub(crate) fn new(setup: SearchSetup, parsed: Vec<Agent>) -> PyResult<Built> {
         let agents = match &setup.agents {
             AgentChoice::None => Vec::new(),
             AgentChoice::Given(agent) => vec![agent.as_ref().clone()],
@@ -76,7 +76,7 @@ impl Built {
         Ok(Built { setup, agents })
     }
 
-    fn config(&self, jobs: usize, command: String) -> SearchConfig<'_> {
+    pub(crate) fn config(&self, jobs: usize, command: String) -> SearchConfig<'_> {
         let mut cfg = self.setup.config(&self.agents, jobs.max(1), command);
         // The tasks and the driver evaluate the whole search (a shard is refused before).
         cfg.shard = None;
@@ -171,9 +171,9 @@ fn evaluate_search_candidates(
 }
 
 /// Calls the driver's Python `evaluate(candidates) -> lines per candidate`.
-struct PyEvaluator {
+pub(crate) struct PyEvaluator {
     evaluate: Py<PyAny>,
-    /// The Python error a call raised (re-raised as is once the search stops).
+    /// The Python error a call raised (re-raised as is once the run stops).
     raised: Mutex<Option<PyErr>>,
     out: PathBuf,
 }
@@ -208,7 +208,7 @@ impl Evaluator for PyEvaluator {
 /// Ctrl-C raises `KeyboardInterrupt` once the search stops ([`interruptible_then`]): at
 /// its next episode, or before its next call to `evaluate`; a call under way is asked to
 /// return early by setting `stop` (e.g. a `threading.Event` that `evaluate` checks),
-/// when given. The candidates finished stay in `candidates.jsonl` for `resume`.
+/// when given. The candidates finished stay in `candidates.jsonl.part` for `resume`.
 #[pyfunction]
 #[pyo3(signature = (spec, agents, evaluate, from_file = false, jobs = 1, command = String::new(), stop = None))]
 #[allow(clippy::too_many_arguments)]
@@ -230,20 +230,8 @@ fn drive_search(
     let cfg = built.config(jobs.clamp(1, unforeseen_harness::limits::MAX_JOBS), command);
     cfg.check().map_err(errors::to_py)?;
     let out = request.out.clone();
-    let remote = PyEvaluator {
-        evaluate,
-        raised: Mutex::new(None),
-        out: out.clone(),
-    };
-    let signalled = std::cell::Cell::new(false);
-    let on_signal = |py: Python<'_>| {
-        signalled.set(true);
-        match &stop {
-            Some(stop) => stop.call_method0(py, "set").map(drop),
-            None => Ok(()),
-        }
-    };
-    let done = interruptible_then(py, on_signal, |cancel| {
+    let remote = PyEvaluator::new(evaluate, out.clone());
+    remote.drive(py, stop, |cancel| {
         let summary = unforeseen_harness::runs::search::run_with(
             &cfg,
             Path::new(&out),
@@ -253,13 +241,41 @@ fn drive_search(
             Some(&remote),
         )?;
         Ok(serde_json::to_string(&summary)?)
-    });
-    // The error `evaluate` raised as is (not the search's report of it), unless a signal
-    // came: then the signal's exception.
-    let raised = remote.raised.into_inner().unwrap_or_else(|p| p.into_inner());
-    match (done, raised) {
-        (Err(_), Some(first)) if !signalled.get() => Err(first),
-        (done, _) => done,
+    })
+}
+
+impl PyEvaluator {
+    /// The evaluator calling `evaluate`; `out` names the run in its errors.
+    pub(crate) fn new(evaluate: Py<PyAny>, out: PathBuf) -> PyEvaluator {
+        PyEvaluator {
+            evaluate,
+            raised: Mutex::new(None),
+            out,
+        }
+    }
+
+    /// Runs `work` (a run that calls this evaluator) with the GIL released. Ctrl-C raises
+    /// `KeyboardInterrupt` once it stops ([`interruptible_then`]), a call under way asked
+    /// to return early by setting `stop` when given; an error `evaluate` raised is raised
+    /// as is (not the run's report of it), unless a signal came.
+    pub(crate) fn drive<F>(&self, py: Python<'_>, stop: Option<Py<PyAny>>, work: F) -> PyResult<String>
+    where
+        F: FnOnce(&dyn unforeseen_harness::progress::Progress) -> Result<String, Error> + Send,
+    {
+        let signalled = std::cell::Cell::new(false);
+        let on_signal = |py: Python<'_>| {
+            signalled.set(true);
+            match &stop {
+                Some(stop) => stop.call_method0(py, "set").map(drop),
+                None => Ok(()),
+            }
+        };
+        let done = interruptible_then(py, on_signal, work);
+        let raised = self.raised.lock().unwrap_or_else(|p| p.into_inner()).take();
+        match (done, raised) {
+            (Err(_), Some(first)) if !signalled.get() => Err(first),
+            (done, _) => done,
+        }
     }
 }
 

@@ -19,13 +19,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use serde_json::{Value, json};
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::{
     AgentChoice, BatchConfig, BatchRequest, RunIdentity, Scenario, checked_sweep, run_unit,
 };
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::Agent;
 use unforeseen_harness::training::{TimeoutAs, TrainConfig};
 
 use crate::agent::PyAgent;
@@ -140,10 +140,8 @@ fn train_agent<'py>(
     let text = py
         .detach(|| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-            pool.install(|| {
-                unforeseen_harness::training::seed_agents::train_agents(&map, &[seed], &config, None, &NoProgress)
-            })
-            .map(|mut a| a.remove(0).bundle.to_ron_string())
+            pool.install(|| unforeseen_harness::training::train_agents(&map, &[seed], &config, None, &NoProgress))
+                .map(|mut a| a.remove(0).bundle.to_ron_string())
         })
         .map_err(errors::to_py)?;
     Ok(PyBytes::new(py, text.as_bytes()))

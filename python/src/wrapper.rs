@@ -17,7 +17,7 @@ use unforeseen_agent::habit::{PolicyHabit, TableHabit};
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::scaled_agent::ScaledAgent;
 use unforeseen_env::ObservationForm;
-use unforeseen_harness::episodes::methods::Method;
+use unforeseen_harness::episodes::Method;
 
 use crate::agent::{PyAgent, decision_dict, scaled_params};
 use crate::errors;
@@ -285,13 +285,17 @@ fn q_table_habit<'py>(
 
 /// The batch summary over training seeds of a results file (`unforeseen batch`'s
 /// `results.summary.json` rows), as JSON text: lines written by `unforeseen.evaluate`
-/// are read by the same code as the command line's.
+/// are read by the same code as the command line's. The file is read against the run
+/// its identity names (`runs::merge::read_run`): a file of two runs is refused, and a
+/// partial run (a shard, a run cut short) too, listing the missing units, unless
+/// `partial`.
 #[pyfunction]
-fn summarize_json(py: Python<'_>, path: PathBuf) -> PyResult<String> {
-    let lines = py
-        .detach(|| unforeseen_harness::runs::batch::read_lines(&path))
+#[pyo3(signature = (path, partial = false))]
+fn summarize_json(py: Python<'_>, path: PathBuf, partial: bool) -> PyResult<String> {
+    let run = py
+        .detach(|| unforeseen_harness::runs::merge::read_run(&path, partial))
         .map_err(errors::to_py)?;
-    serde_json::to_string(&unforeseen_harness::runs::batch::summarize(&lines)).map_err(errors::to_py)
+    serde_json::to_string(&unforeseen_harness::runs::batch::summarize(&run.lines)).map_err(errors::to_py)
 }
 
 /// Registers the classes and functions.

@@ -58,7 +58,11 @@ ARGUMENTS: list[tuple[str, Callable[[Any], Any], str, str]] = [
     ("batch.train_episodes",
      lambda v: unforeseen.batch("jaywalk", train_seeds=[1], train_episodes=v, cache=None), "train_episodes",
      EPISODES),
-    ("search.budget", lambda v: _search(budget=v), "budget", "1..=65536"),
+    # The conversion's bound is the larger of the search's (65536) and the estimate's;
+    # each job's own is the library's.
+    ("search.budget", lambda v: _search(budget=v), "budget", "1..=1000000"),
+    ("estimate.budget", lambda v: unforeseen.estimate("maps/spaces/no-such-space.ron", method="never-brake", budget=v),
+     "budget", "1..=1000000"),
     ("search.episodes", lambda v: _search(episodes=v), "episodes", EPISODES),
     ("search.seed", lambda v: _search(seed=v), "seed", SEEDS),
     ("search.jobs", lambda v: _search(jobs=v), "jobs", "1..=256"),

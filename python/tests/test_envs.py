@@ -106,6 +106,12 @@ def test_map_overrides_go_through_the_map_loader():
         unforeseen.make_env("jaywalk", no_such_field=1)
     with pytest.raises(ValueError, match="section__width"):
         unforeseen.make_env("jaywalk", width=1.0)
+    # A name the optional junction shares with the road is the road's; the junction's
+    # is written with its section, and gives the map a junction.
+    with pytest.raises(ValueError, match=r"\(overrides\): junction\.lane_width: "):
+        unforeseen.make_env("jaywalk", junction__lane_width=-1.0)
+    with pytest.raises(ValueError, match=r"\(overrides\): road\.lane_width: "):
+        unforeseen.make_env("jaywalk", lane_width=-1.0)
 
 
 def test_render_modes():
@@ -139,3 +145,41 @@ def test_each_step_gets_its_own_info_dicts():
     assert second is not first and second["reward_terms"] is not first["reward_terms"]
     assert kept["state"] == first["state"] and isinstance(second["state"], tuple)
     assert list(second) == list(kept), "the keys keep their documented order"
+
+
+def test_overrides_equal_the_same_values_in_a_map_file(tmp_path):
+    """Overrides are laid over the loaded map as typed values (no map text written and
+    parsed again): the map equals, field for field, the one a map file with `base:` and
+    the same values loads to, and its episodes are the same, bit for bit."""
+    import json
+
+    overrides = dict(max_steps=30, lane_width=3.2, speed_edges=[0.5, 3.0, 6.0], offset="Random",
+                     vehicle__start_speed=4, crosswalk__width=5)
+    file = tmp_path / "over.ron"
+    file.write_text('(base: "jaywalk", road: (lane_width: 3.2), bins: (speed_edges: [0.5, 3.0, 6.0]),\n'
+                    ' light: (offset: Random), vehicle: (start_speed: 4), crosswalk: (width: 5),\n'
+                    ' episode: (max_steps: 30))\n')
+    given, written = unforeseen.make_env("jaywalk", **overrides), unforeseen.make_env(str(file))
+
+    def fields(env):
+        m = json.loads(env.unwrapped._env.map_json)
+        return {k: v for k, v in m.items() if k not in ("name", "description", "base")}
+
+    assert fields(given) == fields(written)
+    assert fields(given) != fields(unforeseen.make_env("jaywalk"))
+    for seed in (1, 2, 3):
+        assert rollout(given, seed=seed, actions=[1, 1, 0, 2]) == rollout(written, seed=seed, actions=[1, 1, 0, 2])
+
+
+@pytest.mark.parametrize(
+    "overrides,message",
+    [
+        (dict(lane_width=[1.0, 2.0]), r"^jaywalk \(overrides\): road\.lane_width: Expected f64 but found a sequence"),
+        (dict(speed_edges=[0.5, "x"]), r"^jaywalk \(overrides\): bins\.speed_edges: RON text inside a list"),
+        (dict(offset="Randum"), r"^jaywalk \(overrides\):1:1: light\.offset: "),
+        (dict(lanes=0), r"^jaywalk \(overrides\): road\.lanes: "),
+    ],
+)
+def test_an_override_error_names_the_map_and_the_field(overrides, message):
+    with pytest.raises(ValueError, match=message):
+        unforeseen.make_env("jaywalk", **overrides)

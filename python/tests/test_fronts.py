@@ -97,23 +97,25 @@ def _as_json(value: Any) -> Any:
     return list(value) if isinstance(value, tuple) else value
 
 
-@pytest.mark.parametrize("job", ["batch", "search"])
+@pytest.mark.parametrize("job", ["batch", "search", "estimate"])
 def test_local_and_ray_take_the_request_with_the_librarys_defaults(job: str):
     from unforeseen import distributed
-    from unforeseen.requests import BATCH_DEFAULTS, PYTHON_DEFAULTS, SEARCH_DEFAULTS, flag
+    from unforeseen.requests import BATCH_DEFAULTS, ESTIMATE_DEFAULTS, PYTHON_DEFAULTS, SEARCH_DEFAULTS, flag
 
     local, ray, defaults, ray_only = {
         "batch": (unforeseen.batch, distributed.run_batch, BATCH_DEFAULTS,
                   {"units_per_task", "address", "max_retries", "quiet"}),
         "search": (unforeseen.search, distributed.run_search, SEARCH_DEFAULTS,
                    {"candidates_per_task", "address", "max_retries", "command"}),
+        "estimate": (unforeseen.estimate, distributed.run_estimate, ESTIMATE_DEFAULTS,
+                     {"candidates_per_task", "address", "max_retries"}),
     }[job]
     on_ray = _request_parameters(ray, ray_only)
     assert on_ray == _request_parameters(local, {"command"}), "the same arguments, names and defaults"
     given = {k: _as_json(v) for k, v in on_ray.items()}
     # The space has no default: the request refuses it empty, Python takes None for it.
     # Python takes the library's defaults but for PYTHON_DEFAULTS (no agent cache unless given).
-    assert given == {**defaults, **PYTHON_DEFAULTS, **({"space": None} if job == "search" else {})}
+    assert given == {**defaults, **PYTHON_DEFAULTS, **({"space": None} if job != "batch" else {})}
     # The Ray driver's command has one option per field, spelt as the command line's flag.
     parser = distributed._parser()
     actions = parser._subparsers._group_actions[0].choices[job]._actions
@@ -203,7 +205,7 @@ def test_a_bad_field_names_the_field_in_python_and_the_flag_on_the_command_line(
         unforeseen.batch("jaywalk", train_seeds="3..1", out=tmp_path / "r.jsonl")
     with pytest.raises(ValueError, match="^sets horizon=1,,2: an empty value"):
         unforeseen.batch("jaywalk", sets=["horizon=1,,2"], methods=["never-brake"], out=tmp_path / "r.jsonl")
-    with pytest.raises(ValueError, match=r"^budget 0: expected a whole number in 1\.\.=65536"):
+    with pytest.raises(ValueError, match=r"^budget 0: expected a whole number in 1\.\.=1000000"):
         unforeseen.search(REPO / "maps" / "spaces" / "jaywalk.ron", budget=0, method="never-brake",
                           out=tmp_path / "s")
     cli = required_cli()
@@ -241,3 +243,28 @@ def test_one_search_request_gives_the_same_outputs_through_every_front(agent_fil
     ray_out = tmp_path / "ray"
     run_search(space=space, method="q-learning", agent=agent_file, out=ray_out, **args)
     assert _search_outputs(ray_out) == expected
+
+
+def test_one_estimate_request_gives_the_same_files_through_every_front(agent_file: Path, tmp_path: Path,
+                                                                       monkeypatch: pytest.MonkeyPatch):
+    """The command line, the library and the Ray driver write the same estimate.jsonl and
+    summary.json, byte for byte, for both estimators (importance sampling's rounds refit
+    the proposal from the draws, so a draw evaluated otherwise would change every later one)."""
+    space = REPO / "maps" / "spaces" / "jaywalk.ron"
+    monkeypatch.setitem(sys.modules, "ray", _InlineRay())
+    from unforeseen.distributed import run_estimate
+
+    for estimator, budget in [("mc", 50), ("is", 200)]:
+        args = dict(space=str(space), method="q-learning", agent=str(agent_file), estimator=estimator, budget=budget,
+                    episodes=1, seed=5)
+        cli_out = tmp_path / f"{estimator}-cli"
+        _cli("estimate", "--space", str(space), "--method", "q-learning", "--agent", str(agent_file), "--estimator",
+             estimator, "--budget", str(budget), "--episodes", "1", "--seed", "5", "--jobs", "1", "--quiet",
+             "--out", str(cli_out))
+        files = ["estimate.jsonl", "summary.json"]
+        expected = [(cli_out / f).read_bytes() for f in files]
+        assert json.loads(expected[1])["evaluations"] == budget
+        unforeseen.estimate(**args, out=tmp_path / f"{estimator}-py")
+        run_estimate(**args, out=tmp_path / f"{estimator}-ray", candidates_per_task=7)
+        for front in ("py", "ray"):
+            assert [(tmp_path / f"{estimator}-{front}" / f).read_bytes() for f in files] == expected, (estimator, front)

@@ -270,10 +270,38 @@ def test_search_stops_on_ctrl_c(which, tmp_path):
     assert seconds < 3.0, f"{which} took {seconds - 1:.2f} s to stop after SIGINT (sent at 1 s)"
     if which == "run_search":
         # The waiting driver cancelled its pending tasks; the search wrote only its
-        # candidates file (the identity line, for resume=True), its lock and the
+        # streamed candidates (the identity line, for resume=True), its lock and the
         # (empty) folder of failure maps.
         assert "0 task(s) cancelled" not in done.stdout, done.stdout
-        assert sorted(p.name for p in out.iterdir()) == [".lock", "candidates.jsonl", "failures"]
+        assert sorted(p.name for p in out.iterdir()) == [".lock", "candidates.jsonl.part", "failures"]
         assert list((out / "failures").iterdir()) == []
     temporary = [p for p in tmp_path.rglob("*") if p.name.startswith(".tmp") or p.name.startswith("unforeseen-")]
     assert temporary == [], "a temporary file was left"
+
+
+def test_summarize_reads_a_file_against_its_run(tmp_path):
+    """``summarize`` reads a batch run's file as ``unforeseen plot-sweep`` does: a partial
+    run (a unit missing) is refused naming the unit, unless ``partial=True``; a file of
+    two runs is refused; the whole run is summarized."""
+    whole = tmp_path / "whole.jsonl"
+    unforeseen.batch("jaywalk", episodes=2, seed=7, methods=["never-brake", "brake-on-pedestrian"],
+                     protocol="zero-shot", out=whole)
+    text = whole.read_text()
+    assert len(unforeseen.summarize(whole)) == 2
+    import json
+
+    *kept, last = text.splitlines(keepends=True)
+    cut = tmp_path / "cut.jsonl"
+    cut.write_text("".join(kept))
+    with pytest.raises(ValueError, match="1 of the run's 2 units are missing") as refused:
+        unforeseen.summarize(cut)
+    missing = json.loads(last)["method"]
+    assert missing in str(refused.value) and "partial=True" in str(refused.value), refused.value
+    assert missing not in [r["method"] for r in unforeseen.summarize(cut, partial=True)]
+    other = tmp_path / "other.jsonl"
+    unforeseen.batch("jaywalk", episodes=2, seed=8, methods=["never-brake", "brake-on-pedestrian"],
+                     protocol="zero-shot", out=other)
+    both = tmp_path / "both.jsonl"
+    both.write_text(text + other.read_text())
+    with pytest.raises(ValueError, match="two runs"):
+        unforeseen.summarize(both, partial=True)

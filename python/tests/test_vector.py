@@ -199,3 +199,65 @@ def test_get_attr_set_attr_and_call():
     with pytest.raises(AttributeError, match="stepped together"):
         vec.call("step", 0)
     assert vec.call("map_name") == ("two_pedestrians",) * 3
+
+
+# Steps a vector env of many envs until Ctrl-C (SIGINT from a timer thread, at a random
+# moment); prints the exception's type. With `first`, the signal falls within the first
+# milliseconds of stepping a fresh interpreter, when the NumPy calls are made the first time.
+CTRL_C_WHILE_STEPPING = r"""
+import os, random, signal, sys, threading, time
+import numpy as np
+import unforeseen
+
+tries, first = int(sys.argv[1]), sys.argv[2] == "first"
+rng = random.Random(int(sys.argv[3]))
+vec = unforeseen.VectorEnv("jaywalk", 64, num_threads=2)
+vec.reset(seed=1)
+actions = np.ones(vec.num_envs, dtype=np.int64)
+seen = []
+for _ in range(tries):
+    delay = rng.uniform(0.0, 0.002 if first else 0.03)
+    try:
+        threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT)).start()
+        start = time.monotonic()
+        while time.monotonic() - start < 5.0:
+            vec.step(actions)
+        seen.append("none")
+    except BaseException as e:
+        seen.append(type(e).__name__)
+print(" ".join(seen))
+"""
+
+
+def _ctrl_c_while_stepping(tries: int, when: str, seed: int) -> list[str]:
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", CTRL_C_WHILE_STEPPING, str(tries), when, str(seed)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return done.stdout.split()
+
+
+def test_ctrl_c_while_stepping_a_vector_env_raises_keyboard_interrupt():
+    """Issue 49: Ctrl-C while stepping ``VectorEnv`` once raised ``PanicException`` (a NumPy
+    call failing on the pending signal) instead of ``KeyboardInterrupt``. 200 signals at
+    random moments in one interpreter, and 10 in the first steps of a fresh one each."""
+    seen = _ctrl_c_while_stepping(200, "any", seed=1)
+    for k in range(10):
+        seen += _ctrl_c_while_stepping(1, "first", seed=100 + k)
+    assert len(seen) == 210
+    assert set(seen) == {"KeyboardInterrupt"}, {name: seen.count(name) for name in set(seen)}
+
+
+def test_import_sets_up_every_numpy_call_a_step_makes():
+    """What the numpy crate would set up on the first step (its C API, its shared borrow
+    checking, whose set-up runs Python code a pending Ctrl-C interrupts) is set up when
+    ``unforeseen`` is imported, so no step meets a set-up that fails on a signal."""
+    import subprocess
+    import sys
+
+    probe = ("import numpy, unforeseen; "
+             "print(hasattr(numpy._core.multiarray, '_RUST_NUMPY_BORROW_CHECKING_API'))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=60)
+    assert done.stdout.split() == ["True"], done.stdout + done.stderr

@@ -39,6 +39,8 @@ HELD = {
     "results": "holds a batch's results",
     "summary": "holds a batch's summary",
     "candidates": "holds a search's candidates",
+    "estimates": "holds an estimate's draws",
+    "estimate-summary": "holds an estimate's summary",
     "model": "holds a planning model",
     "stream": "holds a deployment stream",
     "html": "holds an HTML page",
@@ -58,6 +60,8 @@ def foreign(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     run = lambda *a: subprocess.run([str(cli), *a], check=True, capture_output=True, timeout=300)  # noqa: E731
     run("search", "--method", "never-brake", "--budget", "2", "--episodes", "1", "--jobs", "1", "--space",
         str(MAPS / "spaces" / "jaywalk.ron"), "--out", str(d / "search"))
+    run("estimate", "--method", "never-brake", "--budget", "50", "--episodes", "1", "--jobs", "1", "-q", "--space",
+        str(MAPS / "spaces" / "jaywalk.ron"), "--out", str(d / "estimate"))
     run("export-model", "--agent", str(d / "agent.ron"), "--obs", "1,1,1,1", "--out", str(d / "model.json"))
     run("trace", "--map", str(d / "tiny.ron"), "--agent", str(d / "agent.ron"), "-q", "--out", str(d / "trace"),
         "--html", str(d / "page.html"))
@@ -68,6 +72,8 @@ def foreign(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         "results": d / "results.jsonl",
         "summary": d / "results.summary.json",
         "candidates": d / "search" / "candidates.jsonl",
+        "estimates": d / "estimate" / "estimate.jsonl",
+        "estimate-summary": d / "estimate" / "summary.json",
         "model": d / "model.json",
         "stream": MAPS / "streams" / "deployment.ron",
         "html": d / "page.html",
@@ -111,6 +117,11 @@ def _search(f, out, force):
                   force=force, cache=None)
 
 
+def _estimate(f, out, force):
+    return unforeseen.estimate(MAPS / "spaces" / "jaywalk.ron", method="never-brake", budget=50, episodes=1, jobs=1,
+                               out=out, force=force, cache=None)
+
+
 #: (writer, call, outputs: (name inside a folder out, or "" for the file out itself, or
 #: ".summary.json" beside it; the kind written there, None for one not in HELD)).
 WRITERS = [
@@ -121,7 +132,9 @@ WRITERS = [
     ("evaluate_builtin", _eval_builtin, True, [("eval.json", None)]),
     ("compare", _compare, True, [("compare.json", None), ("compare.csv", None), ("compare_seeds.csv", None),
                                  ("compare.svg", "svg")]),
-    ("search", _search, True, [("candidates.jsonl", "candidates"), ("summary.json", None), ("search.svg", "svg")]),
+    ("search", _search, True, [("candidates.jsonl", "candidates"), ("candidates.jsonl.part", "candidates"),
+                               ("summary.json", None), ("search.svg", "svg")]),
+    ("estimate", _estimate, True, [("estimate.jsonl", "estimates"), ("summary.json", "estimate-summary")]),
 ]
 
 CASES = [(w, call, folder, name, kind) for (w, call, folder, outs) in WRITERS for (name, own) in outs

@@ -33,6 +33,7 @@ from ._unforeseen import (
     stream_seed,
 )
 from .envs import ACTIONS, LIGHTS, UnforeseenEnv
+from .estimate import estimate
 from .evaluate import EvaluateResult, evaluate, evaluate_policy, summarize
 from .search import search
 from .vector import VectorEnv
@@ -56,6 +57,7 @@ __all__ = [
     "compare",
     "embedded_maps",
     "env_id",
+    "estimate",
     "eval_seeds",
     "evaluate",
     "evaluate_builtin",

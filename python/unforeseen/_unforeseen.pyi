@@ -245,8 +245,8 @@ def batch(request: dict[str, Any], agent: Agent | None = None) -> BatchResult:
     given loaded instead of the request's agent file. A bad field raises ``ValueError``
     naming it."""
 def request_defaults(job: str) -> str:
-    """The fields of the request of ``job`` (``"batch"``, ``"search"``, ``"compare"`` or
-    ``"eval"``) with their defaults (JSON text)."""
+    """The fields of the request of ``job`` (``"batch"``, ``"search"``, ``"compare"``,
+    ``"eval"`` or ``"estimate"``) with their defaults (JSON text)."""
 def batch_result(lines: str) -> BatchResult:
     """The report of result lines (the JSON text of their list) that ``evaluate`` wrote,
     summarized and printed as ``unforeseen batch`` does its own."""
@@ -396,8 +396,9 @@ class ResultsGuard:
     def __init__(self, out: str, inputs: list[str], force: bool = False, append: bool = False) -> None: ...
     def release(self) -> None: ...
 
-def summarize_json(path: str) -> str:
-    """The batch summary over training seeds of a results file, as JSON text."""
+def summarize_json(path: str, partial: bool = False) -> str:
+    """The batch summary over training seeds of a results file, as JSON text (a partial
+    run refused unless ``partial``)."""
 def check_batch(request: dict[str, Any], agent: Agent | None = None) -> None:
     """The batch request checked as :func:`plan_batch` checks it, without its output guard."""
 def plan_batch(request: dict[str, Any], agent: Agent | None = None) -> str:
@@ -420,6 +421,25 @@ def search(request: dict[str, Any], agent: Agent | None = None, command: str = "
     """``unforeseen search`` in this process: the search request (its fields) planned, trained and run by the library as the command line runs it, writing
     its folder of outputs; ``summary.json``'s contents (JSON text). A bad field raises
     ``ValueError`` naming it; Ctrl-C raises KeyboardInterrupt at the next episode."""
+def estimate(request: dict[str, Any]) -> str:
+    """``unforeseen estimate`` in this process: the estimate request (its fields) planned,
+    trained and run by the library as the command line runs it, writing ``estimate.jsonl``
+    and ``summary.json``; ``summary.json``'s contents (JSON text). A bad field raises
+    ``ValueError`` naming it; Ctrl-C raises KeyboardInterrupt at the next episode."""
+def plan_estimate(request: dict[str, Any]) -> str:
+    """The estimate request (its fields) checked as ``unforeseen estimate`` checks it,
+    writing nothing; JSON text of ``spec`` (the request), ``search_spec`` (the search
+    request whose candidates are the draws), ``train``, ``train_episodes``,
+    ``timeout_as`` and ``agent`` (the agent file's text, or null)."""
+def drive_estimate(
+    spec: str,
+    agents: Sequence[tuple[int | None, bytes]],
+    evaluate: Callable[[list[str]], list[list[str]]],
+    stop: Any | None = None,
+) -> str:
+    """Runs an estimate's stages in Rust (the request ``spec`` from :func:`plan_estimate`,
+    into its folder), each block of draws evaluated by ``evaluate`` (candidate JSON texts
+    of ``search_spec``'s search -> each one's lines); ``summary.json``'s contents."""
 def evaluate_search_candidates(
     spec: str,
     agents: Sequence[tuple[int | None, bytes]],
@@ -441,3 +461,97 @@ def drive_search(
     """Runs a search's stages in Rust (the request ``spec`` from :func:`plan_search`, into
     its ``out``) with ``evaluate`` for its candidates; the summary (JSON text).
     Ctrl-C raises KeyboardInterrupt, calling ``stop.set()`` so an ``evaluate`` under way can return early."""
+
+@final
+class AifAgent:
+    """A model in pymdp's layout behind the paper's surprise gate (the library's
+    ``aif::gate::GatedAgent``); the pymdp-style front is :class:`unforeseen.aif.Agent`.
+    Every bad array raises ``ValueError`` naming it."""
+
+    def __init__(
+        self,
+        A: list[npt.NDArray[np.float64]],
+        B: list[npt.NDArray[np.float64]],
+        C: list[npt.NDArray[np.float64]] | None,
+        D: list[npt.NDArray[np.float64]] | None,
+        E: npt.NDArray[np.float64] | None,
+        pA: list[npt.NDArray[np.float64]] | None,
+        pB: list[npt.NDArray[np.float64]] | None,
+        A_dependencies: list[list[int]] | None,
+        B_dependencies: list[list[int]] | None,
+        policies: list[list[list[int]]] | None,
+        policy_len: int,
+        gamma: float,
+        alpha: float,
+        num_iter: int,
+        action_selection: str,
+        sampling_mode: str,
+        use_utility: bool,
+        use_states_info_gain: bool,
+        use_param_info_gain: bool,
+        preferences: str,
+        epsilon: float,
+        habit_name: str,
+        seed: int,
+    ) -> None: ...
+    def infer_states(
+        self, observation: Sequence[int], empirical_prior: list[npt.NDArray[np.float64]] | None = None
+    ) -> list[npt.NDArray[np.float64]]:
+        """The posterior over each factor (pymdp's fpi), from ``empirical_prior`` (default D)."""
+    def vfe(
+        self,
+        observation: Sequence[int],
+        empirical_prior: list[npt.NDArray[np.float64]],
+        qs: list[npt.NDArray[np.float64]],
+    ) -> float:
+        """The variational free energy of ``qs``, nats."""
+    def infer_policies(
+        self, qs: list[npt.NDArray[np.float64]]
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """``(q_pi, neg_efe)`` of every policy (pymdp's order and sign)."""
+    def sample_action(self, q_pi: npt.NDArray[np.float64]) -> npt.NDArray[np.int64]:
+        """The action, one control per factor."""
+    def update_empirical_prior(
+        self, action: Sequence[int], qs: list[npt.NDArray[np.float64]]
+    ) -> list[npt.NDArray[np.float64]]:
+        """The prior of the next step after ``action``."""
+    def infer_parameters(
+        self,
+        beliefs: list[list[list[float]]],
+        observations: list[list[int]],
+        actions: list[list[int]],
+        lr_pA: float | None,
+        lr_pB: float | None,
+    ) -> None:
+        """Dirichlet learning from one sequence (``beliefs[t][f]``, ``observations[t][m]``, ``actions[t][f]``)."""
+    def step(self, observation: Sequence[int]) -> tuple[npt.NDArray[np.int64], dict[str, Any]]:
+        """One gated tick: the action and ``surprise`` (bits), ``planned``, ``q_pi`` (when planned), ``qs``."""
+    @property
+    def epsilon(self) -> float:
+        """ε in bits (negative: plan on every tick); settable, the learned habit kept."""
+    @epsilon.setter
+    def epsilon(self, value: float) -> None: ...
+    def reset(self) -> None:
+        """Start an episode (prior D; the learned habit kept)."""
+    def utility(self, observation: Sequence[int]) -> float:
+        """``Σ_m C[m][o_m]``."""
+    def arrays(self, name: str) -> list[npt.NDArray[np.float64]] | None:
+        """``A``, ``B``, ``C``, ``pA`` or ``pB`` (None when absent)."""
+    @property
+    def D(self) -> list[npt.NDArray[np.float64]]: ...
+    @property
+    def E(self) -> npt.NDArray[np.float64] | None: ...
+    @property
+    def policies(self) -> list[list[list[int]]]: ...
+    @property
+    def num_states(self) -> list[int]: ...
+    @property
+    def num_obs(self) -> list[int]: ...
+    @property
+    def num_controls(self) -> list[int]: ...
+    @property
+    def A_dependencies(self) -> list[list[int]]: ...
+    @property
+    def B_dependencies(self) -> list[list[int]]: ...
+    @property
+    def policy_len(self) -> int: ...

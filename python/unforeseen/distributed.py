@@ -58,6 +58,15 @@ shows no progress bar; it passes the output guard and takes the lock of ``unfore
 (``OUT/.lock``). Ctrl-C stops it within a fraction of a second (the binding sets an
 event the evaluator checks between waits; pending tasks are cancelled) and raises
 ``KeyboardInterrupt``; the finished candidates stay for ``resume=True``.
+
+How an estimate runs
+--------------------
+:func:`run_estimate` takes the arguments of :func:`unforeseen.estimate` and keeps the
+estimator's stages in Rust (through the binding's ``drive_estimate``): each block of
+draws (each cross-entropy round, each block of the final or Monte Carlo stage) goes to
+the same evaluator as a search's candidates, so ``estimate.jsonl`` and ``summary.json``
+equal ``unforeseen estimate``'s byte for byte. An interrupted estimate starts over (its
+files are written once, at the end).
 """
 
 from __future__ import annotations
@@ -74,9 +83,9 @@ from pathlib import Path
 from typing import Any
 
 from . import _unforeseen
-from .requests import BATCH_DEFAULTS, SEARCH_DEFAULTS, flag, flag_message
+from .requests import BATCH_DEFAULTS, ESTIMATE_DEFAULTS, SEARCH_DEFAULTS, flag, flag_message
 
-__all__ = ["DEFAULT_MAX_RETRIES", "main", "run_batch", "run_search"]
+__all__ = ["DEFAULT_MAX_RETRIES", "main", "run_batch", "run_estimate", "run_search"]
 
 #: Retries of a task whose worker process or node died (system failures only).
 DEFAULT_MAX_RETRIES = 3
@@ -375,8 +384,40 @@ def run_search(
                                    "finish with --resume")
     # The request, maps and space checked before any task runs.
     plan = json.loads(_unforeseen.plan_search(fields, given))
-    spec = plan["spec"]
     from_file = plan["agent"] is not None
+    # Set by the binding on Ctrl-C: `evaluate` runs on the driver's other threads, which
+    # never see the signal themselves.
+    stop = threading.Event()
+    agents, evaluate = _candidate_tasks(plan, plan["spec"], from_file, threads, candidates_per_task, address,
+                                        max_retries, stop)
+    summary = _unforeseen.drive_search(
+        plan["spec"],
+        agents,
+        evaluate,
+        from_file=from_file,
+        jobs=max(1, max_failures),
+        command=command if command is not None else f"unforeseen.distributed.run_search(space={str(space)!r}, ...)",
+        stop=stop,
+    )
+    return json.loads(summary)
+
+
+def _candidate_tasks(
+    plan: dict[str, Any],
+    spec: str,
+    from_file: bool,
+    threads: int,
+    candidates_per_task: int | None,
+    address: str | None,
+    max_retries: int,
+    stop: threading.Event,
+) -> tuple[list[tuple[int | None, bytes]], Callable[[list[str]], list[list[str]]]]:
+    """The agents of a planned search or estimate (``plan``: the agent file's text, or the
+    training seeds to train, each trained once on the cluster), as ``(training seed,
+    agent text)`` pairs, and the evaluator of the search ``spec``'s candidates that the
+    binding's driver calls: each call's candidates split into blocks run as Ray tasks
+    (``candidates_per_task``, default about 4 tasks per CPU) through :func:`_drive`, the
+    agents reaching them through the object store."""
     ray = _ray()
     _connect(ray, address)
     options = _task_options(max_retries)
@@ -391,10 +432,6 @@ def run_search(
     texts = ray.get(refs) if refs else []
     task = ray.remote(num_cpus=threads, **options)(_search_task)
     cpus = max(1, int(ray.cluster_resources().get("CPU", 1)) // threads)
-
-    # Set by the binding on Ctrl-C: `evaluate` runs on the driver's other threads, which
-    # never see the signal themselves.
-    stop = threading.Event()
 
     def evaluate(candidates: list[str]) -> list[list[str]]:
         per = candidates_per_task or max(1, math.ceil(len(candidates) / (4 * cpus)))
@@ -414,16 +451,52 @@ def run_search(
         _drive(ray, blocks, submit, sink, stop)
         return [g for g in lines if g is not None]
 
-    summary = _unforeseen.drive_search(
-        spec,
-        list(zip(agent_seeds, texts, strict=True)),
-        evaluate,
-        from_file=from_file,
-        jobs=max(1, max_failures),
-        command=command if command is not None else f"unforeseen.distributed.run_search(space={str(space)!r}, ...)",
-        stop=stop,
-    )
-    return json.loads(summary)
+    return list(zip(agent_seeds, texts, strict=True)), evaluate
+
+
+def run_estimate(
+    space: str | os.PathLike[str] | None = None,
+    *,
+    map: str | os.PathLike[str] = "jaywalk",
+    method: str = "scaled",
+    protocol: str = "zero-shot",
+    estimator: str = "mc",
+    target_rel_error: float = 0.3,
+    budget: int = 2000,
+    episodes: int = 4,
+    seed: int = 7,
+    jobs: int | None = None,
+    out: str | os.PathLike[str] = "out/estimate",
+    force: bool = False,
+    agent: str | os.PathLike[str] | None = None,
+    train_seeds: Iterable[int] | str | None = None,
+    train_episodes: int = 6000,
+    timeout_as: str = "truncation",
+    cache: str | os.PathLike[str] | None = None,
+    candidates_per_task: int | None = None,
+    address: str | None = "auto",
+    max_retries: int = DEFAULT_MAX_RETRIES,
+) -> dict[str, Any]:
+    """``unforeseen estimate`` on a Ray cluster: the arguments of :func:`unforeseen.estimate`
+    (the estimate request, checked by the library as the command line checks it), and
+    the same ``estimate.jsonl`` and ``summary.json``, byte for byte, whatever the number
+    of workers. The estimator's stages run in order on the driver, in the library
+    (``unforeseen::runs::estimate``); each block of draws runs as tasks of
+    ``candidates_per_task`` draws (default: about 4 tasks per CPU), each draw evaluated
+    as the search evaluates a candidate. On the cluster ``jobs`` is the threads, and
+    CPUs, of each task (None: 1); agents train once per seed on the cluster and are not
+    cached (``cache`` is not used). Returns ``summary.json``'s contents.
+    """
+    fields = {k: v for k, v in locals().items() if k in ESTIMATE_DEFAULTS}
+    if space is None:
+        fields.pop("space")
+    threads, _ = _task_request("estimate", fields, "candidates_per_task", candidates_per_task, max_retries,
+                               "run it again")
+    plan = json.loads(_unforeseen.plan_estimate(fields))
+    stop = threading.Event()
+    agents, evaluate = _candidate_tasks(plan, plan["search_spec"], plan["agent"] is not None, threads,
+                                        candidates_per_task, address, max_retries, stop)
+    return json.loads(_unforeseen.drive_estimate(plan["spec"], agents, evaluate, stop=stop))
 
 
 def _request_options(parser: argparse.ArgumentParser, defaults: dict[str, Any], positional: str | None) -> None:
@@ -461,7 +534,35 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--address", default="auto", help="Ray cluster address (default: auto, the local cluster)")
     s.add_argument("--candidates-per-task", type=int, help="candidates per task (default: about 4 tasks per CPU)")
     s.add_argument("--max-retries", type=int, default=DEFAULT_MAX_RETRIES)
+    e = sub.add_parser("estimate", help="unforeseen estimate on a Ray cluster (its options, plus --address)")
+    _request_options(e, ESTIMATE_DEFAULTS, positional=None)
+    e.add_argument("--quiet", "-q", action="store_true")
+    e.add_argument("--address", default="auto", help="Ray cluster address (default: auto, the local cluster)")
+    e.add_argument("--candidates-per-task", type=int, help="draws per task (default: about 4 tasks per CPU)")
+    e.add_argument("--max-retries", type=int, default=DEFAULT_MAX_RETRIES)
     return p
+
+
+def _main_estimate(args: argparse.Namespace) -> int:
+    try:
+        summary = run_estimate(
+            **{f: getattr(args, f) for f in ESTIMATE_DEFAULTS},
+            candidates_per_task=args.candidates_per_task,
+            address=args.address,
+            max_retries=args.max_retries,
+        )
+    except ValueError as e:
+        print(f"error: {flag_message(str(e), ESTIMATE_DEFAULTS)}", file=sys.stderr)
+        return 2
+    except (RuntimeError, ConnectionError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    p = summary["estimates"]["p_fail"]
+    print(
+        f"{summary['evaluations']} draws evaluated; P(fails) {p['p']} [{p['ci95_low']}, {p['ci95_high']}]; "
+        f"wrote {args.out}/{{estimate.jsonl, summary.json}}"
+    )
+    return 0
 
 
 def _main_search(args: argparse.Namespace, argv: Sequence[str]) -> int:
@@ -494,6 +595,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     if args.command == "search":
         return _main_search(args, argv)
+    if args.command == "estimate":
+        return _main_estimate(args)
     try:
         report = run_batch(
             **{f: getattr(args, f) for f in BATCH_DEFAULTS},

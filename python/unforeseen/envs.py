@@ -107,7 +107,9 @@ class UnforeseenEnv(gym.Env):
     ``render_scale``: pixels per metre of a frame (default 10);
     ``pedestrian_slots`` (kinematic, default 4); any other keyword overrides a map field
     (``max_steps=60``, ``lane_width=3.0``, ``reward__goal=40``; ``section__field`` when a
-    name is in several sections), checked by the map loader.
+    name is in several sections; a name the optional ``junction`` shares with a section
+    every map has means the latter's: ``junction__lane_width`` for the cross street's),
+    checked by the map loader.
 
     ## Rendering
 

@@ -252,10 +252,14 @@ def _kept(out: str, names: list[str], seeds: list[int | None], method: str | Non
     return text if not text or text.endswith("\n") else text + "\n"
 
 
-def summarize(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
+def summarize(path: str | os.PathLike[str], partial: bool = False) -> list[dict[str, Any]]:
     """The batch summary over training seeds of a results file (``results.summary.json``'s
     rows: means with 95% intervals and the worst seed), computed by the Rust code
-    ``unforeseen batch`` uses. A path that is not a file is a ``ValueError``."""
+    ``unforeseen batch`` uses. A path that is not a file is a ``ValueError``. The file is
+    read against the run its first line names, as ``unforeseen plot-sweep`` reads it: a
+    file of two runs is a ``ValueError``, and so is a partial run (a shard, a run cut
+    short), listing the missing units, unless ``partial=True``. Lines without a run
+    (``evaluate``'s) are read whole."""
     if not os.path.isfile(path):
         raise ValueError(f"{os.fspath(path)}: not a results file (no such file); give the file `evaluate` or `batch` wrote")
-    return json.loads(_unforeseen.summarize_json(os.fspath(path)))
+    return json.loads(_unforeseen.summarize_json(os.fspath(path), partial))

@@ -1,16 +1,18 @@
-"""The requests of jobs (``batch``, ``search``, ``compare``, ``eval``) as the extension
+"""The requests of jobs (``batch``, ``search``, ``compare``, ``eval``, ``estimate``) as the extension
 reads them: the keyword arguments, as given, become the library's request
-(``BatchRequest``, ``SearchRequest``, ``CompareRequest``, ``EvalRequest``) in the
+(``BatchRequest``, ``SearchRequest``, ``CompareRequest``, ``EvalRequest``,
+``EstimateRequest``) in the
 extension's conversion layer, whose defaults, checks, agent choice and run identity are
 the command line's. A bad field raises ``ValueError`` naming the field (``train_seeds:
 ...``, ``episodes -5: expected a whole number in 1..=1000000``); ``python -m
 unforeseen.distributed`` spells it as its flag (:func:`flag_message`).
 
-:data:`BATCH_DEFAULTS`, :data:`SEARCH_DEFAULTS`, :data:`COMPARE_DEFAULTS` and
-:data:`EVAL_DEFAULTS` are the requests' fields with their defaults, read from the
+:data:`BATCH_DEFAULTS`, :data:`SEARCH_DEFAULTS`, :data:`COMPARE_DEFAULTS`,
+:data:`EVAL_DEFAULTS` and :data:`ESTIMATE_DEFAULTS` are the requests' fields with their defaults, read from the
 library: :func:`unforeseen.batch`, :func:`unforeseen.distributed.run_batch`,
 :func:`unforeseen.search`, :func:`unforeseen.distributed.run_search`,
-:func:`unforeseen.compare` and :func:`unforeseen.evaluate_builtin` take these fields with
+:func:`unforeseen.compare`, :func:`unforeseen.evaluate_builtin` and
+:func:`unforeseen.estimate` take these fields with
 these defaults (a test checks their signatures against them), and the Ray driver's
 command line derives its options from them, except the fields of
 :data:`PYTHON_DEFAULTS`.
@@ -35,6 +37,9 @@ COMPARE_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("comp
 
 #: The eval request's fields and their defaults (``unforeseen eval``'s).
 EVAL_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("eval"))
+
+#: The estimate request's fields and their defaults (``unforeseen estimate``'s).
+ESTIMATE_DEFAULTS: dict[str, Any] = json.loads(_unforeseen.request_defaults("estimate"))
 
 #: The defaults the Python functions take where the command line's differ: no agent
 #: cache unless one is given (``cache="out/agents"`` shares the command line's), so that a

@@ -29,6 +29,14 @@ pub fn load(name: &str) -> Result<Map, MapError> {
     })
 }
 
+/// An embedded map as a base (`"jaywalk"` or `"jaywalk.ron"`): its origin
+/// (`embedded:jaywalk`) and text, the resolver [`Map::from_str_named`] takes for a map
+/// whose bases are embedded.
+pub fn base(base: &str) -> Option<(String, String)> {
+    let name = base.strip_suffix(".ron").unwrap_or(base);
+    source(name).map(|t| (format!("{}{name}", crate::EMBEDDED_PREFIX), t.to_string()))
+}
+
 /// Why a map could not be had.
 #[derive(Debug, thiserror::Error)]
 pub enum LookupError {

@@ -30,22 +30,35 @@
 //! surface, stepping), [`embedded`] (the shipped
 //! maps), and the loader with its diagnostics ([`MapError`], [`Diagnostic`]).
 
+mod draw;
 pub mod dynamics;
 pub mod embedded;
+pub mod junction;
 pub mod light;
 mod load;
 mod locate;
 pub mod map;
 mod map_texts;
+pub mod margins;
+mod overrides;
+mod routes;
+pub mod signals;
+pub mod traffic;
 mod validate;
 pub mod world;
 
+pub use junction::{Approach, Layout};
 pub use light::{LightPhase, light_at};
 pub use load::{Diagnostic, EMBEDDED_PREFIX, MAX_BASE_DEPTH, MAX_FILE_BYTES, MAX_NESTING, MapError};
 pub use map::{
-    Bins, Crosswalk, CrosswalkBins, DistanceEdges, Dynamics, Episode, Expectation, Light, LightCondition, Map, Offset,
-    Pause, Phase, Reward, Road, Side, SpawnRule, SurfacePatch, Trigger, Vehicle,
+    Arm, Behaviour, Bins, CrossCycle, Crosswalk, CrosswalkBins, DarkReading, DistanceEdges, Dynamics, Episode,
+    Expectation, Junction, Light, LightCondition, Map, Offset, Outage, Pause, Phase, Reward, Road, Route, Side,
+    SpawnRule, SurfacePatch, TrafficRule, Trigger, Vehicle,
 };
+pub use margins::Margins;
+pub use overrides::FieldValue;
+pub use signals::{Aspect, SignalState, Walk};
+pub use traffic::VehicleSnapshot;
 pub use validate::{
     DECISION_DT, MAX_EPISODE_PLANNING, MAX_EPISODE_SUBSTEPS, MAX_JOINT_STATES, MAX_LIST, MAX_METRES, MAX_PEDESTRIANS,
     MAX_SPAWN_RULES, MAX_STEPS, MAX_SUBSTEPS, PHYSICS_HZ,

@@ -11,8 +11,8 @@ use serde::Deserialize;
 use serde::de::{self, Deserializer, Visitor};
 
 use crate::map::{
-    BinsPatch, CrosswalkPatch, EpisodePatch, Expectation, LightPatch, Map, MapPatch, Pause, Phase, RewardPatch,
-    RoadPatch, SpawnRule, SurfacePatch, VehiclePatch,
+    BinsPatch, CrosswalkPatch, EpisodePatch, Expectation, JunctionPatch, LightPatch, Map, MapPatch, Outage, Pause,
+    Phase, RewardPatch, RoadPatch, SpawnRule, SurfacePatch, TrafficRule, VehiclePatch,
 };
 use crate::{locate, validate};
 
@@ -40,7 +40,7 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
-    fn new(file: &str, path: &str, message: impl Into<String>, hint: Option<String>) -> Self {
+    pub(crate) fn new(file: &str, path: &str, message: impl Into<String>, hint: Option<String>) -> Self {
         Diagnostic {
             file: file.to_string(),
             position: None,
@@ -237,7 +237,7 @@ fn too_large(origin: &str) -> Diagnostic {
 }
 
 /// Checks that need no parsing: size, emptiness, binary content, nesting depth.
-fn check_text(origin: &str, text: &str) -> Result<(), Diagnostic> {
+pub(crate) fn check_text(origin: &str, text: &str) -> Result<(), Diagnostic> {
     if text.len() > MAX_FILE_BYTES {
         return Err(too_large(origin));
     }
@@ -357,14 +357,14 @@ fn too_deep(text: &str) -> Option<(usize, usize)> {
     None
 }
 
-fn ron_options() -> ron::Options {
+pub(crate) fn ron_options() -> ron::Options {
     // Implicit `Some`: `base: "intersection.ron"` and `min_success: 0.9` need no `Some(..)`.
     ron::Options::default()
         .with_recursion_limit(MAX_NESTING * 2)
         .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
 }
 
-fn spanned(origin: &str, path: &str, e: &ron::error::SpannedError) -> Diagnostic {
+pub(crate) fn spanned(origin: &str, path: &str, e: &ron::error::SpannedError) -> Diagnostic {
     let hint = match &e.code {
         ron::Error::Eof => Some("the file ends early: is it truncated or missing a `)`?".into()),
         ron::Error::ExceededRecursionLimit => Some("maps need only a few levels of brackets".into()),
@@ -528,6 +528,9 @@ enum Kind {
     Reward,
     Episode,
     Expect,
+    Junction,
+    Outage,
+    Traffic,
     Leaf,
 }
 
@@ -546,6 +549,9 @@ fn fields_of(kind: Kind) -> &'static [&'static str] {
         Kind::Reward => field_names::<RewardPatch>(),
         Kind::Episode => field_names::<EpisodePatch>(),
         Kind::Expect => field_names::<Expectation>(),
+        Kind::Junction => field_names::<JunctionPatch>(),
+        Kind::Outage => field_names::<Outage>(),
+        Kind::Traffic => field_names::<TrafficRule>(),
         Kind::Leaf => &[],
     }
 }
@@ -564,6 +570,9 @@ fn child(kind: Kind, field: &str) -> Kind {
         (Kind::Map, "expect") => Kind::Expect,
         (Kind::Light, "cycle") => Kind::Phase,
         (Kind::Rule, "pause") => Kind::Pause,
+        (Kind::Map, "junction") => Kind::Junction,
+        (Kind::Junction, "outages") => Kind::Outage,
+        (Kind::Map, "traffic") => Kind::Traffic,
         _ => Kind::Leaf,
     }
 }
@@ -707,6 +716,9 @@ mod doc_tests {
             Kind::Reward,
             Kind::Episode,
             Kind::Expect,
+            Kind::Junction,
+            Kind::Outage,
+            Kind::Traffic,
         ];
         for k in kinds {
             for f in fields_of(k) {

@@ -11,6 +11,17 @@ use serde::{Deserialize, Serialize};
 /// Defines a configuration struct with documented defaults, plus a crate-private
 /// "patch" twin whose fields are all optional: a scenario built on a base map
 /// only sets the fields that differ, and `apply` copies them over the base.
+/// A value given for a field of a map section, converted to the field's type (the typed
+/// overrides of `overrides.rs`: `Map::with_overrides`).
+pub(crate) trait Convert {
+    /// Why a value does not convert.
+    type Error;
+    /// The value as a `T`.
+    fn to<T: serde::de::DeserializeOwned>(&self) -> Result<T, Self::Error>;
+    /// Whether a field of type `T` takes whole numbers only.
+    fn whole<T: serde::de::DeserializeOwned>() -> bool;
+}
+
 macro_rules! config_struct {
     (
         $(#[$meta:meta])*
@@ -50,6 +61,22 @@ macro_rules! config_struct {
             /// Overwrite the fields of `base` that this patch sets.
             pub(crate) fn apply(self, base: &mut $name) {
                 $( if let Some(v) = self.$field { base.$field = v; } )*
+            }
+        }
+
+        impl $name {
+            /// The fields, each with whether it takes a whole number only (as `C` says).
+            pub(crate) fn override_fields<C: $crate::map::Convert>() -> Vec<(&'static str, bool)> {
+                vec![$( (stringify!($field), C::whole::<$ty>()) ),*]
+            }
+
+            /// Sets `field` to `value` converted to its type; `None` when there is no
+            /// such field.
+            pub(crate) fn set<C: $crate::map::Convert>(&mut self, field: &str, value: &C) -> Option<Result<(), C::Error>> {
+                match field {
+                    $( stringify!($field) => Some(value.to::<$ty>().map(|v| self.$field = v)), )*
+                    _ => None,
+                }
             }
         }
     };
@@ -635,6 +662,227 @@ mod names {
     }
 }
 
+// The junction's and the traffic's sections (issue 45; their run-time parts are
+// junction.rs, signals.rs and traffic.rs).
+
+/// One arm of the junction, named by the compass with the road's +x as east.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum Arm {
+    /// The car's approach (x below the box): its crosswalk is the map's `crosswalk`.
+    West,
+    /// The road beyond the box, where oncoming traffic comes from.
+    East,
+    /// The cross street at negative y (the car's right).
+    South,
+    /// The cross street at positive y (the car's left).
+    North,
+}
+
+impl Arm {
+    /// All arms.
+    pub const ALL: [Arm; 4] = [Arm::West, Arm::East, Arm::South, Arm::North];
+
+    /// Whether this arm belongs to the road (West, East) rather than the cross street.
+    pub fn on_road(self) -> bool {
+        matches!(self, Arm::West | Arm::East)
+    }
+}
+
+/// The cross street's signal phases.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum CrossCycle {
+    /// Derived from the car's signal (`light.cycle`): during each red run of it the
+    /// cross street shows red for `all_red` s (the clearance), green, amber for
+    /// `amber` s, and red again for the last `all_red` s; red whenever the car's
+    /// signal is green or amber.
+    Derived {
+        /// Seconds of cross amber before the clearance.
+        amber: f64,
+        /// Seconds of all-red clearance at each end of the cross green.
+        all_red: f64,
+    },
+    /// Explicit phases, one cycle exactly as long as `light.cycle` and starting with
+    /// it (the same offset). A phase that gives the cross street green or amber while
+    /// the car's signal shows green or amber is refused at load.
+    Cycle(Vec<Phase>),
+}
+
+/// What the car's agent reads from a dark signal (its L factor): a named map choice,
+/// since a dark head shows none of the phases L knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum DarkReading {
+    /// As red: road codes treat a dark signal as an all-way stop (e.g. California
+    /// Vehicle Code §21800(d): stop, then proceed with caution when it is safe).
+    Red,
+    /// As green: the head is ignored and the road taken as unsignalised with right of
+    /// way (what the agent does if it takes no signal for no restriction).
+    Green,
+}
+
+/// A power outage: every head of the junction goes dark when `start` first holds
+/// (`AtTime(t)` for one scheduled at t, or any trigger of the pedestrian rules, a
+/// phase-start trigger holding while the car's signal shows that phase), for
+/// `duration` s. The controller's cycle runs on underneath.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Outage {
+    /// When the heads go dark.
+    pub start: Trigger,
+    /// How long they stay dark, s (> 0).
+    pub duration: f64,
+}
+
+/// Stop lines lie this far before their crosswalk (or before the box where the arm has
+/// none), m, on a map without a junction (lead and oncoming traffic still stop there).
+pub const DEFAULT_STOP_GAP: f64 = 1.0;
+
+config_struct! {
+    /// A cross street meeting the road, with its own lanes and sidewalks, crosswalks
+    /// on up to every arm, stop lines, and one signal controller for every approach.
+    pub struct Junction / JunctionPatch as "Junction" {
+        /// x of the cross street's centre line, m. Default 72.5 (with the default
+        /// crosswalk and cross street, the box spans x 69..76, 1 m after the crosswalk).
+        x: f64 = 72.5,
+        /// Lanes of the cross street (the kerb lane each way is driven). Default 2.
+        lanes: u32 = 2,
+        /// Width of one cross-street lane, m. Default 3.5.
+        lane_width: f64 = 3.5,
+        /// Width of each cross-street sidewalk, m. Default 2.0.
+        sidewalk_width: f64 = 2.0,
+        /// Crosswalks on the other arms (East, South, North), each as wide as the map's
+        /// `crosswalk` and as far from the box (the near approach's is `crosswalk`). Default [].
+        crosswalks: Vec<Arm> = Vec::new(),
+        /// Distance of every stop line before its approach's crosswalk (the box where the
+        /// arm has none), m. Default 1.0.
+        stop_gap: f64 = DEFAULT_STOP_GAP,
+        /// The cross street's phases. Default `Derived(amber: 2.0, all_red: 1.0)`.
+        cross: CrossCycle = CrossCycle::Derived { amber: 2.0, all_red: 1.0 },
+        /// Outages: times the whole junction goes dark. Default [].
+        outages: Vec<Outage> = Vec::new(),
+        /// What the car's agent reads from a dark signal. Default `Red`.
+        dark_reads_as: DarkReading = DarkReading::Red,
+        /// Speed limit of the road (the car's street: lead and oncoming traffic), m/s: no
+        /// traffic rule of it may draw a faster desired speed. Default 13.9 (50 km/h).
+        road_speed_limit: f64 = 13.9,
+        /// Speed limit of the cross street, m/s, as `road_speed_limit`. Default 13.9.
+        cross_speed_limit: f64 = 13.9,
+    }
+}
+
+/// The route a vehicle drives (straight through the junction).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Route {
+    /// In the car's lane, ahead of it (`start` m ahead of its front).
+    Lead,
+    /// In the opposite lane, towards the car, from beyond the junction.
+    Oncoming,
+    /// Across, northbound from the cross street's south arm (needs a junction).
+    FromSouth,
+    /// Across, southbound from the cross street's north arm (needs a junction).
+    FromNorth,
+    /// Oncoming, turning left in the box across the car's lane onto the cross street's
+    /// south arm, as a quarter circle (needs a junction).
+    OncomingLeft,
+}
+
+/// How a vehicle deviates from a careful driver, for the unforeseen.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Behaviour {
+    /// Stops at its stop line on red, and on amber when it can stop with its
+    /// comfortable deceleration; on a dark signal it stops at the line and goes after
+    /// standing there 1 s (an all-way stop); follows what is ahead in its lane.
+    Careful,
+    /// Ignores its signal, and the car (still following other vehicles ahead).
+    RunsRed,
+    /// Obeys its signal but not the car: turning left (`OncomingLeft`) it takes its turn
+    /// across the car's path without yielding (a careful turner waits at the box while
+    /// the car comes within `YIELD_GAP` s of it), and it does not brake for the car.
+    DoesNotYield,
+    /// As `Careful`, until its front is `at` m past its stop line: there it stops as
+    /// hard as it can and stands `hold` s (a breakdown in the junction box), then drives
+    /// on as `Careful`.
+    Stalls {
+        /// Metres past its stop line where it stalls.
+        at: f64,
+        /// Seconds it stands. Default: for ever.
+        #[serde(default = "for_ever")]
+        hold: f64,
+    },
+    /// As `Careful`, until `after` s after it appeared: it brakes at `decel` m/s² to a
+    /// standstill, stands `hold` s, and drives on.
+    BrakesHard {
+        /// Seconds after appearing.
+        after: f64,
+        /// Deceleration, m/s².
+        decel: f64,
+        /// Seconds standing before it drives on.
+        hold: f64,
+    },
+}
+
+fn for_ever() -> f64 {
+    f64::INFINITY
+}
+
+/// A rule that spawns other vehicles.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrafficRule {
+    /// Where it drives. Default `Lead`.
+    pub route: Route,
+    /// When the rule fires (the pedestrian rules' triggers: phase starts repeat, the
+    /// others fire once). Default `AtTime(0.0)`.
+    pub trigger: Trigger,
+    /// The car's signal required when it fires (never met while dark, except `Any`).
+    /// Default `Any`.
+    pub light: LightCondition,
+    /// Probability that a firing spawns a vehicle, in [0, 1]. Default 1.0.
+    pub probability: f64,
+    /// Delay between firing and appearing (min, max), s, uniform. Default (0.0, 0.0).
+    pub delay: (f64, f64),
+    /// Desired speed (min, max), m/s, uniform; it appears at this speed. Default (8.0, 10.0).
+    pub speed: (f64, f64),
+    /// Where it appears: metres before its stop line (`Lead`: ahead of the car's front).
+    /// Behind a vehicle of its route that is there, it appears standing `min_gap` behind
+    /// it instead. Default 30.0.
+    pub start: f64,
+    /// How it deviates from a careful driver. Default `Careful`.
+    pub behaviour: Behaviour,
+    /// Body length, m. Default 4.5.
+    pub length: f64,
+    /// Body width, m. Default 1.8.
+    pub width: f64,
+    /// IDM's maximum acceleration A, m/s². Default 1.5.
+    pub accel: f64,
+    /// IDM's comfortable deceleration b, m/s². Default 2.0.
+    pub brake: f64,
+    /// IDM's time headway T, s. Default 1.5.
+    pub headway: f64,
+    /// IDM's minimum gap s0, m. Default 2.0.
+    pub min_gap: f64,
+}
+
+impl Default for TrafficRule {
+    fn default() -> Self {
+        TrafficRule {
+            route: Route::Lead,
+            trigger: Trigger::AtTime(0.0),
+            light: LightCondition::Any,
+            probability: 1.0,
+            delay: (0.0, 0.0),
+            speed: (8.0, 10.0),
+            start: 30.0,
+            behaviour: Behaviour::Careful,
+            length: 4.5,
+            width: 1.8,
+            accel: 1.5,
+            brake: 2.0,
+            headway: 1.5,
+            min_gap: 2.0,
+        }
+    }
+}
+
 /// A complete scenario. `Map::default()` is the training intersection without
 /// pedestrians.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
@@ -655,6 +903,15 @@ pub struct Map {
     pub vehicle: Vehicle,
     /// Pedestrian spawn rules (a map that sets this list replaces the base's list). Default [].
     pub pedestrians: Vec<SpawnRule>,
+    /// The cross street, its box, crosswalks, stop lines and signals. Default `None`: the
+    /// straight road of the paper (not serialised when absent, so a map without a
+    /// junction keeps its content hash and results files keep their run identity).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub junction: Option<Junction>,
+    /// Spawn rules of other vehicles (a map that sets this list replaces the base's list).
+    /// Default [] (not serialised when empty, as `junction`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub traffic: Vec<TrafficRule>,
     /// Discretizer bins.
     pub bins: Bins,
     /// Reward.
@@ -702,6 +959,10 @@ pub(crate) struct MapPatch {
     #[serde(default)]
     pedestrians: Option<Vec<SpawnRule>>,
     #[serde(default)]
+    junction: Option<JunctionPatch>,
+    #[serde(default)]
+    traffic: Option<Vec<TrafficRule>>,
+    #[serde(default)]
     bins: Option<BinsPatch>,
     #[serde(default)]
     reward: Option<RewardPatch>,
@@ -731,6 +992,12 @@ impl MapPatch {
         }
         if let Some(p) = self.pedestrians {
             base.pedestrians = p;
+        }
+        if let Some(p) = self.junction {
+            p.apply(base.junction.get_or_insert_default());
+        }
+        if let Some(p) = self.traffic {
+            base.traffic = p;
         }
         if let Some(p) = self.bins {
             p.apply(&mut base.bins);

@@ -9,6 +9,8 @@
 use crate::light::LightPhase;
 use crate::map::{DistanceEdges, Dynamics, Map, Offset, Trigger};
 
+mod junction_rules;
+
 /// Largest number of physics sub-steps per decision tick.
 pub const MAX_SUBSTEPS: f64 = 10_000.0;
 /// Largest episode length, decision ticks.
@@ -582,6 +584,8 @@ pub(crate) fn validate(map: &Map) -> Vec<Problem> {
             );
         }
     }
+
+    junction_rules::check(&mut c, map);
 
     if map.expect.len() > MAX_LIST {
         c.fail("expect", format!("more than {MAX_LIST} expectations"), "");

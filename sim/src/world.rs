@@ -7,9 +7,13 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier2d::prelude::*;
 
+use crate::draw::uniform;
 use crate::dynamics::{Drivetrain, Pedal};
 use crate::light::{LightPhase, light_at};
 use crate::map::{Dynamics, LightCondition, Map, Offset, Pause, Side, SurfacePatch, Trigger};
+use crate::margins::Margins;
+use crate::signals::{Aspect, Controller, SignalState, TriggerView};
+use crate::traffic::{Body, Traffic, VehicleSnapshot};
 
 /// The three longitudinal actions of the paper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -78,10 +82,23 @@ pub struct Snapshot {
     pub car_speed: f64,
     /// `road.goal_x - car_x`, m; <= 0 once arrived.
     pub distance_to_goal: f64,
-    /// Light shown now.
+    /// The car's signal as its agent reads it (its L factor): the phase its head shows,
+    /// or while dark the map's `junction.dark_reads_as`.
     pub light: LightPhase,
-    /// Seconds until the light changes.
+    /// Seconds until the car's signal changes (0 while dark: no head counts down).
     pub light_time_left: f64,
+    /// Every head of the junction now (without a junction: the car's light, and a
+    /// cross street that is always red).
+    pub signals: SignalState,
+    /// The other vehicles now.
+    pub vehicles: Vec<VehicleSnapshot>,
+    /// Whether a vehicle is in the car's path: in its lane ahead of it within 3 s at
+    /// the car's speed plus 3 s at the speed it closes on it (10 m at least), or on a route that crosses the car's (cross
+    /// traffic, an oncoming left-turner) in the box past its stop line, or before its
+    /// line (a turner: its turn) too fast to stop there at twice its comfortable braking
+    /// (about to run its red, or to turn without yielding). Always false on a map
+    /// without traffic.
+    pub vehicle_in_path: bool,
     /// Pedestrians currently in the world (spawned and not yet gone).
     pub pedestrians: Vec<PedestrianSnapshot>,
     /// The surface patches on the road now (`road.surface`'s, once appeared), in the
@@ -94,6 +111,13 @@ impl Snapshot {
     pub fn pedestrian_on_crosswalk(&self) -> bool {
         self.pedestrians.iter().any(|p| p.on_crosswalk)
     }
+
+    /// Whether an obstacle is in the car's path: a pedestrian on the crosswalk or a
+    /// vehicle in its path ([`Snapshot::vehicle_in_path`]). What the agent's `p` reads
+    /// (issue 45); the paper's "pedestrian on the crosswalk" on a map without traffic.
+    pub fn obstacle_in_path(&self) -> bool {
+        self.vehicle_in_path || self.pedestrian_on_crosswalk()
+    }
 }
 
 /// What one decision tick did.
@@ -101,7 +125,8 @@ impl Snapshot {
 pub struct StepOutcome {
     /// Decision ticks done (after this one).
     pub step: u32,
-    /// The car touched a pedestrian (their colliders intersect after a sub-step).
+    /// The car touched a pedestrian or another vehicle (their colliders intersect after
+    /// a sub-step).
     pub collision: bool,
     /// The car's front reached the destination (and there was no collision).
     pub goal: bool,
@@ -111,7 +136,7 @@ pub struct StepOutcome {
     pub progress: f64,
     /// The car's front crossed the crosswalk's near edge during this tick, in a sub-step
     /// whose light (at the sub-step's start, as the spawn rules see it) was `Red` (amber
-    /// is not a violation). Reported whatever the map's `reward.red_light`.
+    /// and a dark signal are not a violation). Reported whatever the map's `reward.red_light`.
     pub red_light: bool,
 }
 
@@ -174,12 +199,19 @@ pub struct World {
     fired: Vec<bool>,
     pending: Vec<Pending>,
     peds: Vec<Pedestrian>,
-    prev_phase: LightPhase,
+    /// The car's signal's phase shown at the last sub-step (`None`: dark).
+    prev_phase: Option<LightPhase>,
+    /// The signal controller of every approach.
+    signals: Controller,
+    /// The other vehicles.
+    traffic: Traffic,
     terminal: Option<StepOutcome>,
     /// The drive train and brakes under `dynamics: Forces`.
     drivetrain: Option<Drivetrain>,
     /// Which of `road.surface` lie on the road now (a triggered patch appears later).
     surface_on: Vec<bool>,
+    /// The episode's margins so far, when measured ([`World::measure_margins`]).
+    margins: Option<Margins>,
 }
 
 impl World {
@@ -226,7 +258,7 @@ impl World {
             .mass(v.mass as Real)
             .friction(0.0);
         let (car, car_collider) = phys.insert(body, collider);
-        let prev_phase = light_at(&map.light, light_offset, 0.0).0;
+        let prev_phase = Some(light_at(&map.light, light_offset, 0.0).0);
         let drivetrain = (v.dynamics == Dynamics::Forces)
             .then(|| Drivetrain::new(v, map.road.air_density, 1.0 / map.episode.physics_hz));
         World {
@@ -243,10 +275,24 @@ impl World {
             pending: Vec::new(),
             peds: Vec::new(),
             prev_phase,
+            signals: Controller::new(map, light_offset),
+            traffic: Traffic::new(map, seed),
             terminal: None,
             drivetrain,
             surface_on: map.road.surface.iter().map(|p| p.trigger.is_none()).collect(),
+            margins: None,
         }
+    }
+
+    /// Measures the episode's margins after every sub-step from now on
+    /// ([`crate::margins`]); they change nothing in the episode.
+    pub fn measure_margins(&mut self) {
+        self.margins.get_or_insert_with(Margins::default);
+    }
+
+    /// The episode's smallest margins so far (none unless [`World::measure_margins`]).
+    pub fn margins(&self) -> Option<Margins> {
+        self.margins
     }
 
     /// The surface patches on the road now, in the map's order (a later one lies over
@@ -318,19 +364,25 @@ impl World {
         let near_x = self.map.crosswalk_near_x();
         let v0 = self.car_speed();
         for k in 1..=self.substeps {
+            let t = self.time_at(self.substep);
+            let view = self.trigger_view(t);
+            self.signals.fire(&view);
             self.spawn_due();
             self.lay_surface();
             self.move_pedestrians();
+            if !self.traffic.is_empty() {
+                self.move_traffic(t, &view);
+            }
             self.control_car(action, v0, k);
             let before = self.car_front();
-            let t = self.time_at(self.substep);
             self.phys.step();
             self.substep += 1;
             self.after_substep();
+            self.measure();
             if before < near_x && self.car_front() >= near_x {
-                red_light |= light_at(&self.map.light, self.light_offset, t).0 == LightPhase::Red;
+                red_light |= self.signals.state(t).road == Aspect::Lit(LightPhase::Red);
             }
-            if self.car_touches_pedestrian() {
+            if self.car_touches_pedestrian() || self.traffic.hits(&self.phys, self.car_collider) {
                 collision = true;
                 break;
             }
@@ -355,6 +407,38 @@ impl World {
         out
     }
 
+    /// What triggers may look at, at the start of the sub-step at time `t`.
+    fn trigger_view(&self, t: f64) -> TriggerView {
+        TriggerView {
+            t,
+            phase: self.signals.cycle_phase(t).0,
+            to_cross: self.map.crosswalk_near_x() - self.car_front(),
+            speed: self.car_speed(),
+        }
+    }
+
+    /// Spawn the vehicles due and drive every vehicle one sub-step from time `t`.
+    fn move_traffic(&mut self, t: f64, view: &TriggerView) {
+        let signals = self.signals.state(t);
+        let h = 1.0 / self.map.episode.physics_hz;
+        let front = self.car_front();
+        self.traffic
+            .spawn_due(&mut self.phys, self.substep, h, view, signals.road.phase(), front);
+        let car = self.car_body();
+        self.traffic.drive(&mut self.phys, h, &signals, car);
+    }
+
+    /// The car's box and velocity, as the other vehicles see it.
+    fn car_body(&self) -> Body {
+        let (v, front) = (&self.map.vehicle, self.car_front());
+        let lane = self.map.road.car_lane_y();
+        Body {
+            x: (front - v.length, front),
+            y: (lane - v.width / 2.0, lane + v.width / 2.0),
+            vel: (self.car_speed(), 0.0),
+        }
+    }
+
     /// Whether the car's collider overlaps a pedestrian's on the current poses: the
     /// test Rapier's narrow phase runs on a sensor pair (parry's `intersection_test`),
     /// run after every sub-step, so a collision is reported on the sub-step the shapes
@@ -368,6 +452,52 @@ impl World {
             rapier2d::parry::query::intersection_test(car.position(), car.shape(), ped.position(), ped.shape())
                 .is_ok_and(|hit| hit.intersecting)
         })
+    }
+
+    /// Takes in this sub-step's margins of every pedestrian ([`crate::margins`]), when
+    /// measured: the clearance of the colliders on the current poses, and on a collision
+    /// course within the episode's remaining time its time-to-collision and stopping
+    /// margin.
+    fn measure(&mut self) {
+        let Some(mut margins) = self.margins else { return };
+        let car = &self.phys.colliders[self.car_collider];
+        let speed = self.car_speed();
+        let stop = crate::dynamics::stopping_distance(&self.map.vehicle, speed, self.car_friction());
+        let episode_end = f64::from(self.map.episode.max_steps) * self.map.episode.decision_dt;
+        let horizon = (episode_end - self.time_at(self.substep)).max(0.0) as Real;
+        let car_velocity = Vector::new(speed as Real, 0.0);
+        for p in &self.peds {
+            let ped = &self.phys.colliders[p.collider];
+            let Ok(clearance) =
+                rapier2d::parry::query::distance(car.position(), car.shape(), ped.position(), ped.shape())
+            else {
+                continue;
+            };
+            let walking = if p.moving && p.pause_left <= 0.0 {
+                p.dir * p.speed
+            } else {
+                0.0
+            };
+            let options = rapier2d::parry::query::ShapeCastOptions {
+                stop_at_penetration: true,
+                ..rapier2d::parry::query::ShapeCastOptions::with_max_time_of_impact(horizon)
+            };
+            let hit = rapier2d::parry::query::cast_shapes(
+                car.position(),
+                car_velocity,
+                car.shape(),
+                ped.position(),
+                Vector::new(0.0, walking as Real),
+                ped.shape(),
+                options,
+            );
+            let course = hit.ok().flatten().map(|h| {
+                let ttc = f64::from(h.time_of_impact);
+                (ttc, speed * ttc - stop)
+            });
+            margins.record(f64::from(clearance.distance), course);
+        }
+        self.margins = Some(margins);
     }
 
     /// Velocity control for sub-step `k` (1-based) of a tick that began at
@@ -431,6 +561,7 @@ impl World {
         } else if vx > max {
             body.set_linvel(Vector::new(max, 0.0), true);
         }
+        self.traffic.retire(&mut self.phys);
         // Remove pedestrians that reached the far sidewalk.
         let mut i = 0;
         while i < self.peds.len() {
@@ -450,20 +581,9 @@ impl World {
         if self.surface_on.iter().all(|on| *on) {
             return;
         }
-        let t = self.time_at(self.substep);
-        let phase = light_at(&self.map.light, self.light_offset, t).0;
-        let to_cross = self.map.crosswalk_near_x() - self.car_front();
-        let speed = self.car_speed();
+        let view = self.trigger_view(self.time_at(self.substep));
         for (on, patch) in self.surface_on.iter_mut().zip(&self.map.road.surface) {
-            *on = *on
-                || match patch.trigger {
-                    None => true,
-                    Some(Trigger::RedStarts) => phase == LightPhase::Red,
-                    Some(Trigger::GreenStarts) => phase == LightPhase::Green,
-                    Some(Trigger::AtTime(at)) => t + 1e-9 >= at,
-                    Some(Trigger::CarWithin { min, max }) => to_cross >= min && to_cross <= max,
-                    Some(Trigger::CarArrivesWithin(secs)) => to_cross > 0.0 && speed > 1e-3 && to_cross <= secs * speed,
-                };
+            *on = *on || patch.trigger.is_none_or(|t| view.holds(t));
         }
     }
 
@@ -471,7 +591,9 @@ impl World {
     /// pedestrians whose delay has elapsed.
     fn spawn_due(&mut self) {
         let t = self.time_at(self.substep);
-        let (phase, _) = light_at(&self.map.light, self.light_offset, t);
+        // The phase the car's head shows (`None` while dark: no phase starts, and only
+        // `LightCondition::Any` is met).
+        let phase = self.signals.state(t).road.phase();
         let front = self.car_front();
         let speed = self.car_speed();
         let near_x = self.map.crosswalk_near_x();
@@ -491,11 +613,11 @@ impl World {
                     } else {
                         LightPhase::Green
                     };
-                    if at_start && phase == want {
+                    if at_start && phase == Some(want) {
                         elapsed = self.phase_elapsed(t);
                         true
                     } else {
-                        phase == want && self.prev_phase != want
+                        phase == Some(want) && self.prev_phase != Some(want)
                     }
                 }
                 Trigger::AtTime(at) => !self.fired[i] && t + 1e-9 >= at,
@@ -506,8 +628,8 @@ impl World {
             };
             let light_ok = match rule.light {
                 LightCondition::Any => true,
-                LightCondition::Green => phase.is_green(),
-                LightCondition::Red => !phase.is_green(),
+                LightCondition::Green => phase.is_some_and(LightPhase::is_green),
+                LightCondition::Red => phase.is_some_and(|p| !p.is_green()),
             };
             if !(fires && light_ok) {
                 continue;
@@ -618,7 +740,7 @@ impl World {
     /// The observable state after the last tick.
     pub fn snapshot(&self) -> Snapshot {
         let t = self.time_at(self.substep);
-        let (light, left) = light_at(&self.map.light, self.light_offset, t);
+        let (light, left) = self.signals.reading(t);
         let car_x = self.car_front();
         let half = self.map.road.half_width();
         let cw = &self.map.crosswalk;
@@ -652,15 +774,10 @@ impl World {
             light_time_left: left,
             pedestrians,
             surface: self.surface().copied().collect(),
+            signals: self.signals.state(t),
+            vehicles: self.traffic.snapshots(&self.phys),
+            vehicle_in_path: self.traffic.in_path(self.car_body()),
         }
-    }
-}
-
-fn uniform(rng: &mut ChaCha8Rng, (lo, hi): (f64, f64)) -> f64 {
-    if hi > lo {
-        lo + rng.random_range(0.0..1.0) * (hi - lo)
-    } else {
-        lo
     }
 }
 

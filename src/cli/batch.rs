@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::ProtocolChoice;
-use unforeseen_harness::runs::batch::table as tables;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::ProtocolChoice;
+use unforeseen_harness::runs::batch::batch_summary;
 use unforeseen_harness::runs::batch::{AgentChoice, BatchRequest, ScenarioKind, Shard, SummaryRow, stream_learning};
 
 /// Arguments of `batch`.
@@ -219,10 +219,10 @@ pub fn run_cli(args: BatchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Prints the summary table ([`tables::batch_summary`]), then warns on stderr about each
+/// Prints the summary table ([`batch_summary`]), then warns on stderr about each
 /// map within a stream that learning makes worse.
 pub(super) fn print_summary(rows: &[SummaryRow]) {
-    outln!("{}", tables::batch_summary(rows));
+    outln!("{}", batch_summary(rows));
     for l in stream_learning(rows).iter().filter(|l| l.worse) {
         errln!(
             "warning: stream '{}': learning makes map '{}' worse for {} [{}]: success {:.1}% continual, {:.1}% zero-shot over its {} episodes",

@@ -8,9 +8,9 @@ use std::path::{Path, PathBuf};
 use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use super::{AgentArgs, warn_replacing};
-use unforeseen_harness::episodes::protocol::ProtocolChoice;
+use unforeseen_harness::episodes::ProtocolChoice;
 use unforeseen_harness::runs::batch::AgentChoice;
-use unforeseen_harness::runs::compare::table as tables;
+use unforeseen_harness::runs::compare::compare_table;
 use unforeseen_harness::runs::compare::{COMPARE_FILES, CompareRequest};
 
 /// Arguments of `compare`.
@@ -109,7 +109,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     }
     let agents = job.agents(&Bars::counting(quiet, "episodes"))?;
     let report = job.run(&agents, &Bars::new(quiet))?;
-    outln!("{}", tables::compare(&report));
+    outln!("{}", compare_table(&report));
     let dir = &args.out;
     warn_replacing(dir, &COMPARE_FILES);
     progress::phase(quiet, format_args!("writing {}", dir.display()));

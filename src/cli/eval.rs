@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::progress::Progress;
 use unforeseen_harness::runs::evaluate::{EVAL_FILE, EvalRequest, EvalScene};
 

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
-use unforeseen_harness::reports::tables::Grid;
+use unforeseen_harness::reports::Grid;
 use unforeseen_harness::runs::learn::{LEARN_FILES, LearnReport, LearnRequest, MapLearning};
 
 /// Arguments of `learn`.

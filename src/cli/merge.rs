@@ -5,7 +5,7 @@ use clap::Args;
 use std::path::PathBuf;
 
 use super::batch::print_summary;
-use unforeseen_harness::runs::batch::table as tables;
+use unforeseen_harness::runs::batch::expectation_failures;
 use unforeseen_harness::runs::merge::{merge, write_merged};
 use unforeseen_harness::runs::outputs::Outputs;
 
@@ -47,7 +47,7 @@ pub fn run(args: MergeArgs) -> anyhow::Result<()> {
         report.checked,
         report.failed
     );
-    let failures = tables::expectation_failures(&report.rows);
+    let failures = expectation_failures(&report.rows);
     if !failures.is_empty() {
         for f in &failures {
             errln!("expectation failed: {f}");

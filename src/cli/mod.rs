@@ -11,8 +11,8 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_harness::limits::MAX_EPISODES;
 
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::{Protocol, ProtocolChoice};
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::{Protocol, ProtocolChoice};
 use unforeseen_harness::progress::Progress;
 use unforeseen_harness::training::{DEFAULT_TRAIN_MAP, TrainConfig, train_with_progress};
 
@@ -59,6 +59,7 @@ pub fn stream_failed() -> Option<String> {
 pub mod batch;
 pub mod check_map;
 pub mod compare;
+pub mod estimate;
 pub mod eval;
 pub mod export_model;
 pub mod inspect;
@@ -68,6 +69,7 @@ pub mod outputs;
 pub mod params;
 pub mod plot_sweep;
 pub mod progress;
+pub mod run_model;
 pub mod search;
 pub mod signals;
 pub mod trace;
@@ -90,6 +92,7 @@ of another kind is refused unless --force; no output may be an input):
   plot-sweep    sweep.svg
   export-model  out/model.json
   search        out/search/: candidates.jsonl, summary.json, search.svg, failures/*.ron
+  estimate      out/estimate/: estimate.jsonl, summary.json
 Progress: bars on a terminal; otherwise one line per phase on stderr (-q: none).
 Architecture and equations: docs/ARCHITECTURE.md in the repository.";
 
@@ -134,12 +137,18 @@ pub enum Command {
     /// Plot a sweep's results (success and reward against reasoning compute) as SVG.
     #[command(allow_negative_numbers = true)]
     PlotSweep(plot_sweep::PlotSweepArgs),
-    /// Cross-check the agent's math on a single-factor model given as JSON (pymdp layout).
+    /// Cross-check the agent's math on a model given as JSON in pymdp's layout (any number of factors and modalities).
     #[command(allow_negative_numbers = true)]
     Inspect(inspect::InspectArgs),
+    /// Run the surprise-gated agent on a model in pymdp's layout, in a world given in the same layout.
+    #[command(allow_negative_numbers = true)]
+    RunModel(run_model::RunModelArgs),
     /// Search a space of map variations for the fair scenarios where a method fails.
     #[command(allow_negative_numbers = true)]
     Search(search::SearchArgs),
+    /// Estimate how rare a method's failures are on a space: P(an episode fails) and P(fails | fair), with intervals.
+    #[command(allow_negative_numbers = true)]
+    Estimate(estimate::EstimateArgs),
     /// Write a trained agent's planning model in the `inspect` JSON layout (for pymdp).
     #[command(allow_negative_numbers = true)]
     ExportModel(export_model::ExportModelArgs),
@@ -159,11 +168,13 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Learn(args) => learn::run(args),
         Command::CheckMap(args) => check_map::run(args),
         Command::Inspect(args) => inspect::run(args),
+        Command::RunModel(args) => run_model::run(args),
         Command::ExportModel(args) => export_model::run(args),
         Command::Batch(args) => batch::run_cli(args),
         Command::Merge(args) => merge::run(args),
         Command::PlotSweep(args) => plot_sweep::run(args),
         Command::Search(args) => search::run(args),
+        Command::Estimate(args) => estimate::run(args),
     }
 }
 

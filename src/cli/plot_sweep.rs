@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use unforeseen_harness::error::Error;
 use unforeseen_harness::reports::figures::{Series, line_panels};
-use unforeseen_harness::runs::batch::{ResultLine, read_results};
+use unforeseen_harness::runs::batch::ResultLine;
 use unforeseen_harness::runs::outputs::Own;
 
 /// Arguments of `plot-sweep`.
@@ -52,64 +52,30 @@ const COLORS: [RGBColor; 12] = [
     RGBColor(187, 187, 187),
 ];
 
-/// The result lines of `path` for one plot: refuses a file holding two runs (two
-/// different `{"run": ...}` identity lines: concatenated results of different runs),
-/// and, unless `partial`, a file missing units of the run its identity names (a shard,
-/// a cut line), listing them; says on stderr how many lines were cut (a last line
-/// without its newline, not read) and how many repeated a unit already read (left out,
-/// the first kept).
+/// The result lines of `path` for one plot, read against the run its identity names
+/// (`runs::merge::read_run`: two runs refused, a partial run refused unless `partial`);
+/// says on stderr how many lines were cut (a last line without its newline, not read),
+/// how many repeated a unit already read (left out, the first kept) and, with
+/// `--partial`, which units are missing.
 fn checked_lines(path: &std::path::Path, partial: bool) -> Result<Vec<ResultLine>, Error> {
-    let file = read_results(path)?;
-    if let Some((first_line, first)) = file.identities.first()
-        && let Some((line, other)) = file.identities.iter().find(|(_, id)| id != first)
-    {
-        return Err(Error::Results {
-            path: path.to_path_buf(),
-            problem: format!(
-                "holds two runs (line {line} differs from line {first_line}: {}); plot each run's results file on its own",
-                other.differences(first).join("; ")
-            ),
-        });
-    }
-    if let Some(n) = file.cut_line {
+    let run = unforeseen_harness::runs::merge::read_run(path, partial)?;
+    if let Some(n) = run.cut_line {
         errln!(
             "warning: {}: line {n} is cut (no newline at its end: a killed run or a full disk?); left out",
             path.display()
         );
     }
-    let mut seen = std::collections::BTreeSet::new();
-    let mut lines = Vec::new();
-    let mut repeated = 0;
-    for l in file.lines {
-        if seen.insert((l.parsed.unit, l.parsed.key())) {
-            lines.push(l.parsed);
-        } else {
-            repeated += 1;
-        }
-    }
-    if repeated > 0 {
+    if run.repeated > 0 {
         errln!(
-            "warning: {}: {repeated} line(s) repeat a unit read already (duplicated lines?); each unit is plotted once, from its first line",
-            path.display()
+            "warning: {}: {} line(s) repeat a unit read already (duplicated lines?); each unit is plotted once, from its first line",
+            path.display(),
+            run.repeated
         );
     }
-    if let Some((_, identity)) = file.identities.first() {
-        let results_error = |problem: String| Error::Results {
-            path: path.to_path_buf(),
-            problem,
-        };
-        let missing = unforeseen_harness::runs::merge::missing_units(identity, &lines).map_err(results_error)?;
-        if let Some((n, total, text)) = missing {
-            let what = format!("{} of the run's {total} units are missing: {text}", n);
-            if !partial {
-                return Err(results_error(format!(
-                    "{what}; plot the whole run (`unforeseen merge` its shards, or `unforeseen batch --resume`), or add --partial to plot what is there"
-                )));
-            }
-            errln!("warning: {}: --partial: {what}", path.display());
-        }
+    if let Some(what) = &run.missing {
+        errln!("warning: {}: --partial: {what}", path.display());
     }
-    Ok(lines)
+    Ok(run.lines)
 }
 
 /// Runs `plot-sweep`.

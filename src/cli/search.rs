@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::runs::batch::Shard;
 use unforeseen_harness::runs::search::{SearchRequest, Summary};
 use unforeseen_harness::training::DEFAULT_TRAIN_MAP;

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use super::progress::{self, Bars};
 use super::{AgentArgs, warn_replacing};
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::files::num;
 use unforeseen_harness::runs::trace::{TRACE_FILES, TraceReport, TraceRequest, mode, surprise_bits};
 

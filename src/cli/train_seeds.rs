@@ -5,7 +5,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 
 use super::progress::{self, Bars};
-use unforeseen_harness::training::seed_agents::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
+use unforeseen_harness::training::{Agent, DEFAULT_CACHE, TrainSeeds, train_agents};
 use unforeseen_harness::training::{TimeoutAs, TrainConfig};
 
 /// Options of a training-seed study.

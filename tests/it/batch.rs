@@ -7,13 +7,13 @@ use unforeseen_harness::fixtures;
 
 use std::path::Path;
 use std::sync::OnceLock;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::{
     BatchConfig, ParamSet, ResultLine, Scenario, Shard, load_scenarios, read_lines, run, sweep,
 };
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::Agent;
 
 fn scenarios() -> Vec<Scenario> {
     let names = ["jaywalk".to_string(), "intersection".to_string()];
@@ -483,5 +483,25 @@ fn force_driven_maps_do_not_depend_on_jobs() {
     let a = run(&config(&scenarios, &params, 1, None), &one, false, &NoProgress).unwrap();
     let b = run(&config(&scenarios, &params, 2, None), &two, false, &NoProgress).unwrap();
     assert_eq!(a.len(), 2 * (1 + 2 + 2));
+    assert_eq!(without_timing(&a), without_timing(&b));
+}
+
+/// The junction's maps (signals, an outage, vehicles on routes spawned by rules) give the
+/// same results on one worker and on two.
+#[test]
+fn junction_maps_do_not_depend_on_jobs() {
+    let paths = [
+        "maps/junction/training.ron",
+        "maps/junction/dark_signal.ron",
+        "maps/junction/left_turner.ron",
+    ];
+    let scenarios = load_scenarios(&paths.iter().map(Into::into).collect::<Vec<_>>()).unwrap();
+    let params = vec![ParamSet(Vec::new())];
+    let dir = tempfile::tempdir().unwrap();
+    let one = dir.path().join("one.jsonl");
+    let two = dir.path().join("two.jsonl");
+    let a = run(&config(&scenarios, &params, 1, None), &one, false, &NoProgress).unwrap();
+    let b = run(&config(&scenarios, &params, 2, None), &two, false, &NoProgress).unwrap();
+    assert_eq!(a.len(), 3 * (1 + 2 + 2));
     assert_eq!(without_timing(&a), without_timing(&b));
 }

@@ -10,6 +10,7 @@ mod common;
 mod compare_determinism;
 mod corrupt_agent_files;
 mod doc_paths;
+mod estimate;
 mod guard;
 mod merge;
 mod newcomer;

@@ -111,12 +111,12 @@ fn unknown_keys_and_bad_values_name_the_key_and_the_allowed_values() {
 fn factor_names_are_checked_against_the_model() {
     let bundle = fixtures::bundle();
     let p = apply(ScaledParams::default(), &["gate_factor=x".into()]).unwrap();
-    let e = unforeseen_harness::episodes::methods::scaled_agent(bundle, p)
+    let e = unforeseen_harness::episodes::scaled_agent(bundle, p)
         .unwrap_err()
         .to_string();
     assert!(e.contains("gate_factor") && e.contains("d, v, L, p"), "{e}");
     let p = apply(ScaledParams::default(), &["persistence_ignores=v".into()]).unwrap();
-    let e = unforeseen_harness::episodes::methods::scaled_agent(bundle, p)
+    let e = unforeseen_harness::episodes::scaled_agent(bundle, p)
         .unwrap_err()
         .to_string();
     assert!(

@@ -1,6 +1,6 @@
 //! Every command in README.md runs as written and exits 0, at small sizes: each ```sh
 //! block runs under `bash -euo pipefail` in one scratch folder (a reader following the
-//! README top to bottom, with `maps/` beside them), in order, and each ```ron block is
+//! README top to bottom, with `maps/` and `examples/` beside them), in order, and each ```ron block is
 //! validated with `unforeseen check-map`. Every SVG figure the commands write is then
 //! checked for overlapping or cut-off text.
 //!
@@ -149,6 +149,7 @@ fn every_command_in_the_readme_runs_as_written() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path();
     std::os::unix::fs::symlink(root.join("maps"), dir.join("maps")).unwrap();
+    std::os::unix::fs::symlink(root.join("examples"), dir.join("examples")).unwrap();
     let bin = dir.join("bin");
     std::fs::create_dir(&bin).unwrap();
     write_executable(

@@ -4,10 +4,10 @@
 
 use std::path::{Path, PathBuf};
 use unforeseen_discretizer::{Discretizer, State};
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::metrics::Aggregate;
-use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::episodes::rewards::{entered_bins, red_light_cost, state_rewards};
+use unforeseen_harness::episodes::Aggregate;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
+use unforeseen_harness::episodes::{entered_bins, red_light_cost, state_rewards};
 use unforeseen_harness::fixtures;
 use unforeseen_harness::runs::batch::check_expectations;
 

@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_harness::episodes::evaluation::evaluate;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::metrics::Aggregate;
+use unforeseen_harness::episodes::Aggregate;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::run_controller;
 use unforeseen_harness::episodes::survivability::witness;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::training::{TrainConfig, train};
@@ -81,7 +81,7 @@ fn the_method_factory_builds_the_references_from_an_agent_file_too() {
         assert!(!method.learns_across_episodes(&ScaledParams::default()));
         let mut controller = method.controller(&bundle, &ScaledParams::default(), &jaywalk).unwrap();
         assert_eq!(controller.name(), method.name());
-        let results = evaluate(&jaywalk, controller.as_mut(), method, EPISODES, 7, &NoProgress).unwrap();
+        let results = run_controller(&jaywalk, controller.as_mut(), method, EPISODES, 7, &NoProgress).unwrap();
         let agg = Aggregate::of(&results);
         assert_eq!(agg.inference_rate, 0.0, "{method} never reasons");
         let alone = witness(&jaywalk, method, EPISODES, 7).unwrap();
@@ -197,7 +197,7 @@ fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
 /// same map, `red_light: 0`) the witness ignores the light, as before.
 #[test]
 fn brake_on_pedestrian_stops_for_red_where_the_map_has_the_rule() {
-    use unforeseen_harness::episodes::evaluation::evaluate_scripted;
+    use unforeseen_harness::episodes::evaluate_scripted;
     let mut map = unforeseen_harness::maps::load(&shipped("red_light/red_on_approach.ron")).unwrap();
     assert_eq!(map.reward.red_light, -100.0);
     let run = |map: &unforeseen_sim::Map, method| {

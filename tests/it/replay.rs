@@ -101,18 +101,18 @@ fn trace_html_is_self_contained_and_carries_every_tick() {
 #[test]
 fn names_in_the_page_cannot_end_its_script() {
     let map = unforeseen_harness::maps::load("jaywalk").unwrap();
-    let (_, ticks) = unforeseen_harness::episodes::trace::trace(
+    let (_, ticks) = unforeseen_harness::episodes::trace(
         fixtures::bundle(),
         &Default::default(),
-        unforeseen_harness::episodes::methods::Method::QLearning,
+        unforeseen_harness::episodes::Method::QLearning,
         &map,
         3,
-        unforeseen_harness::episodes::protocol::Protocol::ZeroShot,
+        unforeseen_harness::episodes::Protocol::ZeroShot,
         0,
     )
     .unwrap();
     let title = "a </script><script>alert(1)</script> & \"quoted\" title";
-    let page = unforeseen_harness::reports::replay_page::replay_html(title, "ended", &map, &ticks, 0.2).unwrap();
+    let page = unforeseen_harness::reports::replay_html(title, "ended", &map, &ticks, 0.2).unwrap();
     assert_eq!(
         page.matches("</script>").count(),
         2,

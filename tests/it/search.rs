@@ -3,13 +3,13 @@
 //! are a few candidates of a few episodes, on a small space.
 
 use std::path::Path;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::episodes::survivability::{CAREFUL_CRUISE, at_cruise, careful_witness, witness};
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::Shard;
 use unforeseen_harness::runs::search::{self, Fairness, SearchConfig, Space, Value, sobol_candidates};
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::Agent;
 use unforeseen_sim::Map;
 
 use crate::common::{assert_exit, run_cli};
@@ -108,7 +108,7 @@ fn every_point_is_a_valid_map_or_a_rejection_with_a_reason() {
         match space.apply(&values, &format!("p{i}")) {
             Ok(map) => {
                 // The loader reads the map it writes back as the same map.
-                let text = search::space::map_ron(&map).expect("writes");
+                let text = search::map_ron(&map).expect("writes");
                 let again = Map::from_str_named("again.ron", &text, &|_| None).expect("a valid map");
                 assert_eq!(again, map);
             }
@@ -205,12 +205,31 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
     assert_eq!(s1.counts, s2.counts);
     std::fs::metadata(one.join("search.svg")).expect("the figure is written");
     // Every line after the identity is a batch result line.
-    let lines = search::output::read_result_lines(&one.join("candidates.jsonl")).expect("batch lines");
+    let lines = search::read_result_lines(&one.join("candidates.jsonl")).expect("batch lines");
     assert!(
         lines.len().is_multiple_of(3) && lines.len() >= 3 * s1.counts.evaluated,
         "{}",
         lines.len()
     );
+    // Every line names the careful cruise that decided its candidate's survivability, at
+    // the survivable witness's success; the summary states the failure threshold.
+    let text = std::fs::read_to_string(one.join("candidates.jsonl")).expect("read");
+    let parsed: Vec<search::CandidateLine> = text
+        .lines()
+        .skip(1)
+        .map(|l| serde_json::from_str(l).expect("a candidate line"))
+        .collect();
+    for l in &parsed {
+        let c = l.careful_cruise.expect("the deciding cruise");
+        let witness = parsed
+            .iter()
+            .find(|w| w.candidate == l.candidate && w.role == search::Role::SurvivableWitness)
+            .expect("the witness's line");
+        assert_eq!(c.success_rate, witness.result.success_rate, "{l:?}");
+        assert!(c.fraction > 0.0 && c.fraction <= 1.0 && c.speed_mps > 0.0, "{c:?}");
+    }
+    assert_eq!(s1.failure_threshold.failure_success, Some(0.5));
+    assert_eq!(s1.failure_threshold.witness_episodes, 3);
     // q-learning drives on in the jaywalk: the search finds a fair failure, and the
     // minimised scenario is one measured to fail, fairly.
     assert!(
@@ -226,7 +245,7 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
         assert!(f.method_success.iter().all(|&(_, s)| s < 0.5), "{f:?}");
         // The written map is that scenario: re-run as batch would, it fails again.
         let map = unforeseen_harness::maps::load_file(&f.file).expect("a valid map file");
-        let results = unforeseen_harness::episodes::evaluation::evaluate_under(
+        let results = unforeseen_harness::episodes::evaluate_under(
             Protocol::ZeroShot,
             &map,
             bundle(),
@@ -237,7 +256,7 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
             &NoProgress,
         )
         .expect("runs");
-        let agg = unforeseen_harness::episodes::metrics::Aggregate::of(&results);
+        let agg = unforeseen_harness::episodes::Aggregate::of(&results);
         assert_eq!(Some(agg.success_rate), f.method_success.first().map(|s| s.1));
         assert!(
             witness(&map, Method::BrakeOnPedestrian, 3, 5)

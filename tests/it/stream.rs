@@ -8,13 +8,13 @@ use unforeseen_harness::fixtures;
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::{
     BatchConfig, ParamSet, ResultLine, Shard, load_stream_scenario, read_lines, run,
 };
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::Agent;
 
 /// A stream over two embedded maps in a fixed sequence (intersection, intersection,
 /// jaywalk, repeated), and the shared test agent's file, in `dir`.

@@ -10,8 +10,8 @@
 
 use std::path::Path;
 
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::runs::batch::{BatchConfig, ParamSet, SCRIPTED_ONLY, load_stream_scenario, run};
 use unforeseen_harness::runs::stream::{MAX_MAPS, Stream};

@@ -29,24 +29,30 @@ enum Kind {
     Results,
     Summary,
     Candidates,
+    Estimates,
+    EstimateSummary,
     Model,
     Stream,
     Html,
     Svg,
+    ModelRun,
 }
 
 impl Kind {
-    const ALL: [Kind; 10] = [
+    const ALL: [Kind; 13] = [
         Kind::Map,
         Kind::Space,
         Kind::Agent,
         Kind::Results,
         Kind::Summary,
         Kind::Candidates,
+        Kind::Estimates,
+        Kind::EstimateSummary,
         Kind::Model,
         Kind::Stream,
         Kind::Html,
         Kind::Svg,
+        Kind::ModelRun,
     ];
 
     /// What the refusal says the file holds.
@@ -58,10 +64,13 @@ impl Kind {
             Kind::Results => "holds a batch's results",
             Kind::Summary => "holds a batch's summary",
             Kind::Candidates => "holds a search's candidates",
+            Kind::Estimates => "holds an estimate's draws",
+            Kind::EstimateSummary => "holds an estimate's summary",
             Kind::Model => "holds a planning model",
             Kind::Stream => "holds a deployment stream",
             Kind::Html => "holds an HTML page",
             Kind::Svg => "holds an SVG figure",
+            Kind::ModelRun => "holds a gated run's summary",
         }
     }
 }
@@ -89,6 +98,8 @@ impl Foreign {
         assert!(matches!(made.status.code(), Some(0 | 1)), "{}", output_text(&made));
         let search = f.path("search");
         assert_exit(&run(&search_args(&search, &[])), 0, &[]);
+        let estimate = f.path("estimate");
+        assert_exit(&run(&estimate_args(&estimate, &[])), 0, &[]);
         let model = f.path("model.json");
         assert_exit(
             &run_cli(&[
@@ -103,6 +114,8 @@ impl Foreign {
             0,
             &[],
         );
+        let model_run = f.path("model_run.json");
+        assert_exit(&run(&run_model_args(&model_run, &[])), 0, &[]);
         let trace = f.path("trace");
         let html = f.path("page.html");
         assert_exit(&run(&f.trace_args(&trace, &["--html", s(&html)])), 0, &[]);
@@ -117,10 +130,13 @@ impl Foreign {
             (Kind::Results, results.clone()),
             (Kind::Summary, unforeseen_harness::runs::outputs::summary_path(&results)),
             (Kind::Candidates, search.join("candidates.jsonl")),
+            (Kind::Estimates, estimate.join("estimate.jsonl")),
+            (Kind::EstimateSummary, estimate.join("summary.json")),
             (Kind::Model, model),
             (Kind::Stream, copy("stream.ron", "maps/streams/deployment.ron")),
             (Kind::Html, html),
             (Kind::Svg, trace.join("theta.svg")),
+            (Kind::ModelRun, model_run),
         ];
         for (kind, p) in &files {
             assert!(p.is_file(), "{kind:?}: {} was written", p.display());
@@ -193,6 +209,60 @@ fn search_args(out: &Path, extra: &[&str]) -> Vec<String> {
     .map(String::from)
     .to_vec();
     a.extend(extra.iter().map(|x| x.to_string()));
+    a
+}
+
+/// An estimate of never-brake on the jaywalk space, its smallest budget of one episode
+/// per draw, into `out`.
+fn estimate_args(out: &Path, extra: &[&str]) -> Vec<String> {
+    let mut a: Vec<String> = [
+        "estimate",
+        "--method",
+        "never-brake",
+        "--budget",
+        "50",
+        "--episodes",
+        "1",
+        "--jobs",
+        "1",
+        "-q",
+        "--space",
+        SPACE,
+        "--out",
+        s(out),
+    ]
+    .map(String::from)
+    .to_vec();
+    a.extend(extra.iter().map(|x| x.to_string()));
+    a
+}
+
+/// `run-model` on the shipped T-maze model and world, its summary written to `out`.
+fn run_model_args(out: &Path, extra: &[&str]) -> Vec<String> {
+    let mut a: Vec<String> = [
+        "run-model",
+        "--model",
+        "examples/models/tmaze_model.json",
+        "--env",
+        "examples/models/tmaze_env.json",
+        "--episodes",
+        "2",
+        "--steps",
+        "3",
+        "--out",
+        s(out),
+    ]
+    .map(String::from)
+    .to_vec();
+    a.extend(extra.iter().map(|x| x.to_string()));
+    a
+}
+
+/// [`search_args`] with the run seed `seed` (another search than the default's).
+fn search_seeded(out: &Path, seed: &str, extra: &[&str]) -> Vec<String> {
+    let mut a = search_args(out, extra);
+    let i = a.iter().position(|x| x == "--seed").unwrap();
+    a[i + 1] = seed.into();
     a
 }
 
@@ -360,10 +430,26 @@ fn writers() -> Vec<Writer> {
             folder: true,
             outputs: &[
                 ("candidates.jsonl", Some(Kind::Candidates)),
+                ("candidates.jsonl.part", Some(Kind::Candidates)),
                 ("summary.json", None),
                 ("search.svg", Some(Kind::Svg)),
             ],
             args: |_, out, x| search_args(out, x),
+        },
+        Writer {
+            name: "estimate",
+            folder: true,
+            outputs: &[
+                ("estimate.jsonl", Some(Kind::Estimates)),
+                ("summary.json", Some(Kind::EstimateSummary)),
+            ],
+            args: |_, out, x| estimate_args(out, x),
+        },
+        Writer {
+            name: "run-model",
+            folder: false,
+            outputs: &[("", Some(Kind::ModelRun))],
+            args: |_, out, x| run_model_args(out, x),
         },
     ]
 }
@@ -520,9 +606,64 @@ fn a_refused_search_resume_keeps_the_earlier_set() {
     assert_exit(&run(&search_args(&out, &[])), 0, &[]);
     assert!(out.join("summary.json").is_file() && out.join("search.svg").is_file());
     let before = snapshot(&out);
-    let r = run(&search_args(&out, &["--resume", "--seed", "8"]));
+    let r = run(&search_seeded(&out, "8", &["--resume"]));
     assert_eq!(r.status.code(), Some(2), "{}", output_text(&r));
+    assert!(
+        output_text(&r).contains("seed: the file has 9, this run 8"),
+        "{}",
+        output_text(&r)
+    );
     assert_unchanged(&before, &out, "search --resume --seed 8");
+}
+
+/// A full disk partway through a search (the `fault-injection` hook failing the N-th
+/// append of the streamed candidates with `ENOSPC`), over an earlier search's set in
+/// `--out`: exit 1 naming the file, and the earlier set byte for byte; `--resume` then
+/// completes the run from the part, to the set an uninterrupted run writes.
+#[test]
+fn a_full_disk_during_a_search_keeps_the_earlier_set() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("s");
+    let fresh = d.path().join("fresh");
+    assert_exit(&run(&search_seeded(&fresh, "8", &[])), 0, &[]);
+    assert_exit(&run(&search_args(&out, &[])), 0, &[]);
+    let before = snapshot(&out);
+    assert!(before.len() >= 3, "{before:?}");
+    let part = out.join("candidates.jsonl.part");
+    for at in 0..2 {
+        let r = std::process::Command::new(env!("CARGO_BIN_EXE_unforeseen"))
+            .args(search_seeded(&out, "8", &[]))
+            .env("UNFORESEEN_FULL_DISK_AT_APPEND", at.to_string())
+            .output()
+            .unwrap();
+        let text = output_text(&r);
+        assert_eq!(r.status.code(), Some(1), "full disk at append {at}: {text}");
+        assert!(
+            text.contains("candidates.jsonl.part") && text.contains("No space left"),
+            "{text}"
+        );
+        let kept: Vec<_> = snapshot(&out).into_iter().filter(|(p, _)| *p != part).collect();
+        assert!(kept == before, "full disk at append {at}: the earlier set changed");
+        assert!(part.is_file(), "the part stays for --resume");
+    }
+    assert_exit(&run(&search_seeded(&out, "8", &["--resume"])), 0, &[]);
+    assert!(!part.exists(), "the part is committed with the set");
+    let untimed = |dir: &Path| -> Vec<String> {
+        std::fs::read_to_string(dir.join("candidates.jsonl"))
+            .unwrap()
+            .lines()
+            .map(|l| {
+                let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+                v.as_object_mut().unwrap().remove("timing_us_per_tick");
+                v.to_string()
+            })
+            .collect()
+    };
+    assert_eq!(
+        untimed(&out),
+        untimed(&fresh),
+        "the resumed run is the uninterrupted one"
+    );
 }
 
 #[test]
@@ -908,10 +1049,7 @@ fn a_kill_between_two_renames_leaves_the_old_set_or_the_new_one() {
             .to_vec()
     });
     kills += no_kill_mixes_a_set("search", std::slice::from_ref(&o), 3, &|seed| {
-        let mut a = search_args(&o, &[]);
-        let i = a.iter().position(|x| x == "--seed").unwrap();
-        a[i + 1] = seed.into();
-        a
+        search_seeded(&o, seed, &[])
     });
     eprintln!("{kills} kills (job, rename), none left a mix");
 }

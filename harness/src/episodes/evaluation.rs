@@ -40,7 +40,7 @@ pub fn eval_seeds_named(seed: u64, map: &Map, method: &str, episode: u64) -> Epi
 /// Runs `episodes` episodes of `controller` on `map` in order (test-time learning
 /// carries over from one episode to the next: the continual protocol on a controller
 /// the caller built), as one phase of `progress` (`METHOD MAP`, one step per episode).
-pub fn evaluate(
+pub fn run_controller(
     map: &Map,
     controller: &mut dyn Controller,
     method: Method,

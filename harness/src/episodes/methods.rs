@@ -69,7 +69,7 @@ impl Method {
         Method::ScaledOneStepGate,
         Method::ScaledGateLearnsAll,
     ];
-    /// The scripted references ([`crate::episodes::reference`]): the careful driver and the car
+    /// The scripted references ([`crate::episodes::BrakeOnPedestrian`], [`crate::episodes::NeverBrake`]): the careful driver and the car
     /// that never brakes. They need no trained agent.
     pub const REFERENCE: [Method; 2] = [Method::BrakeOnPedestrian, Method::NeverBrake];
 

@@ -1,6 +1,7 @@
 //! The metrics of §VI: training reward, test reward, success rate, collision rate,
 //! inference rate (share of ticks that ran planning) and measured reasoning time; and
-//! red-light violations per episode (the traffic rule, not in the paper).
+//! beyond the paper, red-light violations per episode (the traffic rule) and the margins
+//! of how close the episodes came to a collision (docs/ARCHITECTURE.md §2, "Margins").
 
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::Action;
@@ -42,6 +43,21 @@ pub struct Aggregate {
     pub us_per_tick: f64,
     /// Mean wall-clock microseconds per reasoning tick (0 when none reasoned).
     pub us_per_reasoning_tick: f64,
+    /// Smallest clearance between the car and a pedestrian over the episodes, m (none
+    /// when no pedestrian appeared in any).
+    #[serde(default)]
+    pub min_clearance_m: Option<f64>,
+    /// Smallest time-to-collision over the episodes, s (none when no episode was on a
+    /// collision course).
+    #[serde(default)]
+    pub min_ttc_s: Option<f64>,
+    /// Smallest stopping margin over the episodes, m (none as for the TTC).
+    #[serde(default)]
+    pub min_stop_margin_m: Option<f64>,
+    /// Share of episodes in which braking could have stopped the car short of every
+    /// collision course it was on.
+    #[serde(default)]
+    pub could_stop_rate: f64,
 }
 
 impl Aggregate {
@@ -56,6 +72,7 @@ impl Aggregate {
         let reasoning: u64 = results.iter().map(|r| u64::from(r.reasoning_ticks)).sum();
         let decide_ns: u64 = results.iter().map(|r| r.decide_ns).sum();
         let reasoning_ns: u64 = results.iter().map(|r| r.reasoning_ns).sum();
+        let least = |f: &dyn Fn(&EpisodeResult) -> Option<f64>| results.iter().filter_map(f).reduce(f64::min);
         Self {
             episodes: n,
             mean_reward: results.iter().map(|r| r.ret).sum::<f64>() / n as f64,
@@ -79,6 +96,10 @@ impl Aggregate {
             } else {
                 reasoning_ns as f64 / reasoning as f64 / 1e3
             },
+            min_clearance_m: least(&|r| r.min_clearance),
+            min_ttc_s: least(&|r| r.min_ttc),
+            min_stop_margin_m: least(&|r| r.min_stop_margin),
+            could_stop_rate: share(&|r| r.could_stop()),
         }
     }
 }
@@ -97,6 +118,7 @@ mod tests {
             red_lights: 1,
             decide_ns: 10_000,
             reasoning_ns: 9_000,
+            min_clearance: Some(1.5),
             ..Default::default()
         };
         let b = EpisodeResult {
@@ -105,6 +127,9 @@ mod tests {
             ticks: 4,
             reasoning_ticks: 0,
             decide_ns: 4_000,
+            min_clearance: Some(0.0),
+            min_ttc: Some(0.0),
+            min_stop_margin: Some(-2.0),
             ..Default::default()
         };
         let agg = Aggregate::of(&[a, b]);
@@ -118,6 +143,11 @@ mod tests {
         assert_eq!(agg.mean_ticks, 7.0);
         assert!((agg.us_per_tick - 1.0).abs() < 1e-12);
         assert!((agg.us_per_reasoning_tick - 1.8).abs() < 1e-12);
+        assert_eq!(
+            (agg.min_clearance_m, agg.min_ttc_s, agg.min_stop_margin_m),
+            (Some(0.0), Some(0.0), Some(-2.0))
+        );
+        assert_eq!(agg.could_stop_rate, 0.5);
         assert_eq!(Aggregate::of(&[]), Aggregate::default());
     }
 }

@@ -3,14 +3,28 @@
 //! per-state preferences, the survivability check, the evaluation of a method on a map,
 //! one traced episode, the test-time learning curves and the recording of reasoning ticks.
 
-pub mod evaluation;
-pub mod learning_curves;
-pub mod methods;
-pub mod metrics;
-pub mod protocol;
-pub mod reference;
-pub mod rewards;
-pub mod runner;
+pub(crate) mod evaluation;
+pub(crate) mod learning_curves;
+pub(crate) mod methods;
+pub(crate) mod metrics;
+pub(crate) mod protocol;
+pub(crate) mod reference;
+pub(crate) mod rewards;
+pub(crate) mod runner;
 pub mod survivability;
-pub mod tick_recording;
-pub mod trace;
+pub(crate) mod tick_recording;
+pub(crate) mod trace;
+
+pub use evaluation::{
+    EvalReport, MakeController, MakeControllerMut, MethodRow, eval_seeds, eval_seeds_named, evaluate_in_order,
+    evaluate_map, evaluate_scripted, evaluate_under, evaluate_with, method_row, run_controller,
+};
+pub use learning_curves::{LearnPoint, learn};
+pub use methods::{Method, PaperFigures, UnknownMethod, check_compatible, scaled_agent};
+pub use metrics::{Aggregate, efe_prefix_tree};
+pub use protocol::{Protocol, ProtocolChoice, UnknownProtocol};
+pub use reference::{BrakeOnPedestrian, NeverBrake, RedLightStop};
+pub use rewards::{crash_model, entered_bins, red_light_cost, state_rewards};
+pub use runner::{EpisodeResult, EpisodeSeeds, Tick, run_episode};
+pub use tick_recording::{RecordedEpisode, Recording, ReplayOutcome, TickTimes, TimeSummary, jaywalk_family, record};
+pub use trace::trace;

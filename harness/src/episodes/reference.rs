@@ -60,7 +60,7 @@ fn decision(action: Action) -> Decision {
 pub struct RedLightStop {
     /// The distance bin just before (farther from the goal than) the crosswalk's bins.
     pub approach: Option<usize>,
-    /// The distance bins that overlap the crosswalk ([`crate::episodes::rewards::crosswalk_bins`]).
+    /// The distance bins that overlap the crosswalk (`crosswalk_bins` in `episodes/rewards.rs`).
     pub crosswalk: Vec<usize>,
 }
 

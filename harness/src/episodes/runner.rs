@@ -65,6 +65,26 @@ pub struct EpisodeResult {
     /// Surprise (nats) on the first tick at which a pedestrian was on the crosswalk
     /// while the light was green, if any and if the method computes surprise.
     pub jaywalk_surprise: Option<f64>,
+    /// Smallest clearance between the car's collider and a pedestrian's, m (0 in a
+    /// collision; none when no pedestrian appeared; [`unforeseen_sim::margins`]).
+    #[serde(default)]
+    pub min_clearance: Option<f64>,
+    /// Smallest time-to-collision at constant velocities, s (none when the car was never
+    /// on a collision course).
+    #[serde(default)]
+    pub min_ttc: Option<f64>,
+    /// Smallest stopping margin on a collision course, m: the distance to the contact
+    /// less the stopping distance (negative: the car could no longer have stopped).
+    #[serde(default)]
+    pub min_stop_margin: Option<f64>,
+}
+
+impl EpisodeResult {
+    /// Whether braking could have stopped the car short of every collision course it
+    /// was on ([`unforeseen_sim::Margins::could_stop`]).
+    pub fn could_stop(&self) -> bool {
+        self.min_stop_margin.is_none_or(|m| m >= 0.0)
+    }
 }
 
 /// Seeds of one episode: the world's randomness and the controller's.
@@ -80,13 +100,14 @@ pub struct EpisodeSeeds {
 /// [`Env::step`]): the controller acts on the discrete observation's joint index (an env
 /// that observes kinematically also gives it the vector first,
 /// [`Controller::see_features`]). With `record`, every tick is returned, and the terminal
-/// frame after them.
+/// frame after them. The episode's margins are measured ([`Env::measure_margins`]).
 pub fn run_episode(
     env: &mut Env,
     controller: &mut dyn Controller,
     seeds: EpisodeSeeds,
     record: bool,
 ) -> Result<(EpisodeResult, Vec<Tick>), EpisodeError> {
+    env.measure_margins(true);
     let (mut obs, mut info) = env.reset(seeds.world);
     let mut index = obs.index().unwrap_or_else(|| env.discretizer().encode(info.observed));
     let mut result = EpisodeResult::default();
@@ -142,6 +163,9 @@ pub fn run_episode(
             result.collision = events.collision;
             result.success = events.goal && !events.collision;
             result.timeout = events.timeout;
+            if let Some(m) = env.margins() {
+                (result.min_clearance, result.min_ttc, result.min_stop_margin) = (m.clearance, m.ttc, m.stop_margin);
+            }
             if record {
                 // The terminal frame, for the filmstrip.
                 ticks.push(Tick {

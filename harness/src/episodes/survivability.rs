@@ -1,6 +1,6 @@
 //! Is a scenario a fair unforeseen test (§VI)? The jaywalk test means something only if
 //! a careful driver survives it and a careless one does not. Two scripted witnesses
-//! ([`crate::episodes::reference`]) answer that without any trained agent:
+//! ([`crate::episodes::BrakeOnPedestrian`], [`crate::episodes::NeverBrake`]) answer that without any trained agent:
 //!
 //! * **survivable**: [`Method::BrakeOnPedestrian`] succeeds in at least
 //!   [`SURVIVABLE_MIN_SUCCESS`] (99%) of the episodes, cruising at the car's top speed

@@ -33,10 +33,14 @@ pub enum Held {
     ResultLines,
     /// A search's candidates file (`{"search": ...}` first).
     Candidates,
+    /// An estimate's draws file (`{"estimate": ...}` first).
+    Estimates,
     /// The summary beside a batch's results file.
     BatchSummary,
     /// A search's `summary.json`.
     SearchSummary,
+    /// An estimate's `summary.json`.
+    EstimateSummary,
     /// `eval.json`.
     Evaluation,
     /// `compare.json`.
@@ -45,6 +49,8 @@ pub enum Held {
     LearningCurves,
     /// A planning model in the `inspect` layout (`export-model`).
     Model,
+    /// The summary of a gated agent's run on a model in pymdp's layout (`run-model`).
+    ModelRun,
     /// Another JSON document.
     Json,
     /// A CSV table (a header of names).
@@ -114,12 +120,15 @@ impl Held {
             Held::BatchRun => "a batch's results (its first line names the run)",
             Held::ResultLines => "result lines (as Python's `evaluate` writes them)",
             Held::Candidates => "a search's candidates",
+            Held::Estimates => "an estimate's draws",
             Held::BatchSummary => "a batch's summary",
             Held::SearchSummary => "a search's summary",
+            Held::EstimateSummary => "an estimate's summary",
             Held::Evaluation => "an evaluation (eval.json)",
             Held::Comparison => "a comparison (compare.json)",
             Held::LearningCurves => "learning curves (learn.json)",
             Held::Model => "a planning model (the `inspect` JSON layout)",
+            Held::ModelRun => "a gated run's summary (`run-model`)",
             Held::Json => "a JSON document",
             Held::Csv => "a CSV table",
             Held::Html => "an HTML page",
@@ -138,6 +147,9 @@ fn json_kind(path: &Path, body: &str) -> Held {
     }
     if first.starts_with("{\"search\":") {
         return Held::Candidates;
+    }
+    if first.starts_with("{\"estimate\":") {
+        return Held::Estimates;
     }
     let has = |v: &serde_json::Value, keys: &[&str]| keys.iter().all(|k| v.get(k).is_some());
     // A result line, whatever its keys' order and spacing (Python's `json.dumps`).
@@ -163,10 +175,14 @@ fn json_kind(path: &Path, body: &str) -> Held {
     }
     if has(&value, &["A", "B", "C", "D", "policy_len"]) {
         Held::Model
+    } else if has(&value, &["episodes", "mean_return", "planned_fraction"]) {
+        Held::ModelRun
     } else if has(&value, &["rows", "results", "run"]) {
         Held::BatchSummary
     } else if has(&value, &["counts", "fair_share", "space_file"]) {
         Held::SearchSummary
+    } else if has(&value, &["estimates", "failure_threshold", "space_file"]) {
+        Held::EstimateSummary
     } else if has(&value, &["protocols", "tables", "paper"]) {
         Held::Comparison
     } else if has(&value, &["method", "protocol", "computed_under", "episodes"]) {
@@ -247,6 +263,11 @@ mod tests {
         assert_eq!(held("// notes\nMap(base: \"x\")"), Held::Map);
         assert_eq!(held("{\"run\":{}}\n"), Held::BatchRun);
         assert_eq!(held("{\"search\":{}}\n"), Held::Candidates);
+        assert_eq!(held("{\"estimate\":{}}\n"), Held::Estimates);
+        assert_eq!(
+            held("{\"estimates\": {}, \"failure_threshold\": {}, \"space_file\": \"s.ron\"}"),
+            Held::EstimateSummary
+        );
         let line = "{\"method\": \"m\", \"param_set\": \"default\", \"protocol\": \"zero-shot\", \"scenario\": \"s\", \"unit\": 0}\n";
         assert_eq!(held(line), Held::ResultLines);
         assert_eq!(
@@ -256,6 +277,10 @@ mod tests {
         assert_eq!(
             held("{\"rows\": [], \"results\": \"r.jsonl\", \"run\": {}}"),
             Held::BatchSummary
+        );
+        assert_eq!(
+            held("{\"episodes\": [], \"mean_return\": 0.5, \"planned_fraction\": 1.0}"),
+            Held::ModelRun
         );
         assert_eq!(held("{\"x\": 1}"), Held::Json);
         assert_eq!(

@@ -154,7 +154,7 @@ fn missing_text(missing: &[usize], all: &[(Unit, UnitKey)], place: &str) -> Stri
 }
 
 /// What a reader of one results file checks before it reports on the run the file's
-/// identity names (`plot-sweep`): the units of that run missing from `lines` (a shard,
+/// identity names ([`read_run`]): the units of that run missing from `lines` (a shard,
 /// a run cut short), as `(missing, units of the run, text naming them)`; `None` when
 /// every unit is there.
 pub fn missing_units(identity: &RunIdentity, lines: &[ResultLine]) -> Result<Option<(usize, usize, String)>, String> {
@@ -172,6 +172,69 @@ pub fn missing_units(identity: &RunIdentity, lines: &[ResultLine]) -> Result<Opt
             missing_text(&missing, &all, "not in the file"),
         )
     }))
+}
+
+/// A results file as a reader that reports on the run its first line names sees it
+/// ([`read_run`]).
+#[derive(Debug, Clone, Default)]
+pub struct RunLines {
+    /// The result lines, each unit once (its first line).
+    pub lines: Vec<ResultLine>,
+    /// The number of the last line when it was cut (no newline: a killed run or a full
+    /// disk); it is not read.
+    pub cut_line: Option<usize>,
+    /// Lines left out because they repeat a unit read already.
+    pub repeated: usize,
+    /// When read with `partial`: which units of the run are missing (`N of the run's M
+    /// units are missing: ...`).
+    pub missing: Option<String>,
+}
+
+/// Reads the results file `path` for a reader that reports on the run its identity names
+/// (`plot-sweep`, Python's `summarize`): refuses a file holding two runs (two different
+/// `{"run": ...}` lines: concatenated results of different runs), and, unless `partial`,
+/// a file missing units of its run (a shard, a run cut short), listing them. Lines of
+/// no unit of the run (Python's `evaluate(append=True)` beside a batch run's) are read
+/// with the rest; a file without an identity (result lines alone) names no run and is
+/// read whole.
+pub fn read_run(path: &Path, partial: bool) -> Result<RunLines, Error> {
+    let file = read_results(path)?;
+    let bad = |problem: String| Error::Results {
+        path: path.to_path_buf(),
+        problem,
+    };
+    if let Some((first_line, first)) = file.identities.first()
+        && let Some((line, other)) = file.identities.iter().find(|(_, id)| id != first)
+    {
+        return Err(bad(format!(
+            "holds two runs (line {line} differs from line {first_line}: {}); read each run's results file on its own",
+            other.differences(first).join("; ")
+        )));
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    let mut run = RunLines {
+        cut_line: file.cut_line,
+        ..RunLines::default()
+    };
+    for l in file.lines {
+        if seen.insert((l.parsed.unit, l.parsed.key())) {
+            run.lines.push(l.parsed);
+        } else {
+            run.repeated += 1;
+        }
+    }
+    if let Some((_, identity)) = file.identities.first()
+        && let Some((n, total, text)) = missing_units(identity, &run.lines).map_err(bad)?
+    {
+        let what = format!("{n} of the run's {total} units are missing: {text}");
+        if !partial {
+            return Err(bad(format!(
+                "{what}; read the whole run (`unforeseen merge` its shards, or `unforeseen batch --resume`), or add --partial (partial=True) to read what is there"
+            )));
+        }
+        run.missing = Some(what);
+    }
+    Ok(run)
 }
 
 /// Reads the parts and merges them into the lines of their run, in canonical order.

@@ -13,9 +13,10 @@
 //! * takes an advisory lock (`OUT.lock` beside a results file, `OUT/.lock` in a folder)
 //!   that refuses a second writer until the [`Guarded`] is dropped;
 //! * once the run's own checks have passed ([`Guarded::clear_at_end`]), removes the
-//!   outputs of the set that the run rewrites at its end (a summary beside a results
-//!   file, a search's summary, figure and failure maps), so the set on disk is never one
-//!   run's file beside another run's; a refusal before that changes no file.
+//!   outputs of the set that the run rewrites at its end (the summary beside a results
+//!   file that is streamed in place), so the set on disk is never one run's file beside
+//!   another run's; a refusal before that changes no file. (A search streams to a part
+//!   and replaces its whole set at the end: it removes nothing before.)
 //!
 //! Names that become file names (a space's name, a map's name in a search's outputs)
 //! are checked by [`file_name`].
@@ -73,6 +74,10 @@ pub enum Own {
     BatchSummary,
     /// A search's `summary.json`.
     SearchSummary,
+    /// An estimate's draws file: its first line is `{"estimate": ...}`.
+    Estimates,
+    /// An estimate's `summary.json`.
+    EstimateSummary,
     /// `eval.json`.
     Evaluation,
     /// `compare.json`.
@@ -81,6 +86,8 @@ pub enum Own {
     LearningCurves,
     /// A planning model in the `inspect` layout (`export-model`).
     Model,
+    /// The summary of `run-model`.
+    ModelRun,
     /// An agent file (`train`, Python's `Agent.save`).
     Agent,
     /// A CSV table whose first line is a header of names.
@@ -103,10 +110,13 @@ impl Own {
             Own::Candidates => &[Held::Candidates],
             Own::BatchSummary => &[Held::BatchSummary],
             Own::SearchSummary => &[Held::SearchSummary],
+            Own::Estimates => &[Held::Estimates],
+            Own::EstimateSummary => &[Held::EstimateSummary],
             Own::Evaluation => &[Held::Evaluation],
             Own::Comparison => &[Held::Comparison],
             Own::LearningCurves => &[Held::LearningCurves],
             Own::Model => &[Held::Model],
+            Own::ModelRun => &[Held::ModelRun],
             Own::Agent => &[Held::Agent],
             Own::Csv => &[Held::Csv],
             Own::Svg => &[Held::Svg],
@@ -259,8 +269,8 @@ impl Outputs {
     }
 
     /// The files with extension `ext` in the output folder `dir` (a search's
-    /// `failures/*.ron`): each must be [`Own`] `own` (unless `force`); they are removed
-    /// when the guard is taken, as the run writes the set anew at its end.
+    /// `failures/*.ron`): each must be [`Own`] `own` (unless `force`); the run replaces
+    /// them as a set at its end.
     pub fn folder_files(mut self, flag: &str, dir: &Path, ext: &str, own: Own) -> Outputs {
         self.folders.push((flag.to_string(), dir.to_path_buf(), true));
         if let Ok(entries) = std::fs::read_dir(dir) {
@@ -275,7 +285,7 @@ impl Outputs {
                     flag: flag.to_string(),
                     path,
                     own,
-                    at_end: true,
+                    at_end: false,
                 });
             }
         }
@@ -392,8 +402,8 @@ impl Outputs {
 }
 
 impl Guarded {
-    /// Removes the outputs the run writes at its end (a summary beside a results file, a
-    /// search's summary, figure and failure maps), so that the set on disk never mixes
+    /// Removes the outputs the run writes at its end (the summary beside a results
+    /// file), so that the set on disk never mixes
     /// this run's streamed file with an earlier run's summary. Called once every check
     /// of the run has passed, just before it writes.
     pub fn clear_at_end(&self) -> Result<(), Error> {

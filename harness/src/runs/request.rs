@@ -10,28 +10,34 @@ use serde_json::{Map, Value};
 
 use crate::error::Error;
 
-/// The request `T` whose fields are `fields`, every other field at its default. An
-/// unknown field, or a value its field cannot take, is an [`Error::Request`] naming the
-/// field (`protocol: unknown variant ...`, `train_seeds: '3..1': the range runs
-/// backwards ...`).
+/// The request `T` whose fields are `fields`, every other field at its default, read in
+/// one pass (serde, with the path of a failing field kept). An unknown field, or a value
+/// its field cannot take, is an [`Error::Request`] naming the field (`protocol: unknown
+/// variant ...`, `train_seeds: '3..1': the range runs backwards ...`).
 pub fn from_fields<T: Serialize + DeserializeOwned + Default>(fields: Map<String, Value>) -> Result<T, Error> {
-    let defaults = serde_json::to_value(T::default())?;
-    let known: Vec<&String> = defaults.as_object().map(|o| o.keys().collect()).unwrap_or_default();
-    for (field, value) in &fields {
-        if !known.contains(&field) {
-            return Err(Error::request(
+    let given: Vec<String> = fields.keys().cloned().collect();
+    serde_path_to_error::deserialize(Value::Object(fields)).map_err(|e| {
+        // Only on the error path: the request's field names, to tell an unknown field.
+        let known = known_fields::<T>();
+        match given.iter().find(|k| !known.contains(k)) {
+            Some(field) => Error::request(
                 field.as_str(),
-                format!(
-                    "not a field of this request; its fields are {}",
-                    known.iter().map(|k| k.as_str()).collect::<Vec<_>>().join(", ")
-                ),
-            ));
+                format!("not a field of this request; its fields are {}", known.join(", ")),
+            ),
+            None => {
+                let field = e.path().iter().next().map(|s| s.to_string()).unwrap_or_default();
+                Error::request(field.as_str(), e.into_inner().to_string())
+            }
         }
-        // The field alone (the others at their defaults), so that its error is its own.
-        let alone = Map::from_iter([(field.clone(), value.clone())]);
-        serde_json::from_value::<T>(Value::Object(alone)).map_err(|e| Error::request(field.as_str(), e.to_string()))?;
+    })
+}
+
+/// The field names of request `T` (its defaults' keys), for the error on an unknown one.
+fn known_fields<T: Serialize + Default>() -> Vec<String> {
+    match serde_json::to_value(T::default()) {
+        Ok(Value::Object(o)) => o.keys().cloned().collect(),
+        _ => Vec::new(),
     }
-    Ok(serde_json::from_value(Value::Object(fields))?)
 }
 
 /// The fields of request `T` with their defaults, as a JSON object (for a front that

@@ -424,7 +424,7 @@ pub fn per_map(stream: &Stream, episodes: &[StreamEpisode]) -> Vec<StreamRow> {
 }
 
 /// The test-time learning curves of the scaled agent over `episodes` episodes of the
-/// stream ([`crate::episodes::learning_curves::learn_over`] on the stream's schedule): one agent
+/// stream (the learning curves of [`crate::episodes::learn`], `learn_over`, on the stream's schedule): one agent
 /// learning across the stream in order, each point naming its map.
 pub fn learn_stream(
     stream: &Stream,

@@ -1,11 +1,13 @@
 //! Training (§VI): Q-learning, the world model's Dirichlet counts and Bayesian RL all
 //! learn from the same episodes on the training map, driven by Q-learning's
-//! epsilon-greedy exploration. This file is the training loop; [`seed_agents`] trains one
-//! agent per training seed (in parallel, cached on disk) and [`agent_file`] reads and
+//! epsilon-greedy exploration. This file is the training loop; [`train_agents`] trains one
+//! agent per training seed (in parallel, cached on disk; `seed_agents.rs`) and [`agent_file`] reads and
 //! writes a trained agent.
 
 pub mod agent_file;
-pub mod seed_agents;
+pub(crate) mod seed_agents;
+
+pub use seed_agents::{Agent, DEFAULT_CACHE, MAX_TRAIN_SEEDS, TrainSeeds, train_agents};
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -5,8 +5,8 @@
 
 use unforeseen_agent::params::{CrashPlanning, ScaledParams};
 use unforeseen_discretizer::{Discretizer, State};
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::rewards::crash_model;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::crash_model;
 use unforeseen_harness::fixtures::bundle;
 
 /// Hazards of the default map by hand: speed bins [0, 0.5), [0.5, 4.5), [4.5, 7.5),

@@ -6,12 +6,12 @@ use unforeseen_harness::fixtures;
 
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_agent::persist::AgentBundle;
-use unforeseen_harness::episodes::evaluation::evaluate;
-use unforeseen_harness::episodes::learning_curves::learn;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::metrics::Aggregate;
-use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::episodes::trace::trace;
+use unforeseen_harness::episodes::Aggregate;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
+use unforeseen_harness::episodes::learn;
+use unforeseen_harness::episodes::run_controller;
+use unforeseen_harness::episodes::trace;
 use unforeseen_harness::progress::NoProgress;
 
 #[test]
@@ -65,7 +65,7 @@ fn test_time_learning_makes_the_jaywalk_familiar_without_a_crash() {
     let points = learn(bundle, &ScaledParams::default(), &jaywalk, 30, 3, &NoProgress).unwrap();
     let (first, last) = (&points[0], points.last().unwrap());
     assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
-    let surprise = |p: &unforeseen_harness::episodes::learning_curves::LearnPoint| p.event_surprise_bits.unwrap();
+    let surprise = |p: &unforeseen_harness::episodes::LearnPoint| p.event_surprise_bits.unwrap();
     assert!(surprise(last) < 0.5 * surprise(first), "surprise {first:?} -> {last:?}");
     assert!(last.p_pedestrian_green_d2.unwrap() > first.p_pedestrian_green_d2.unwrap() + 0.3);
     assert!(last.p_slow_down > first.p_slow_down, "habit {first:?} -> {last:?}");
@@ -82,7 +82,7 @@ fn over_a_few_episodes_scaled_beats_q_learning_on_the_jaywalk() {
     let params = ScaledParams::default();
     let run = |m: Method| {
         let mut c = m.controller(bundle, &params, &jaywalk).unwrap();
-        Aggregate::of(&evaluate(&jaywalk, c.as_mut(), m, 10, 5, &NoProgress).unwrap())
+        Aggregate::of(&run_controller(&jaywalk, c.as_mut(), m, 10, 5, &NoProgress).unwrap())
     };
     let q = run(Method::QLearning);
     let s = run(Method::Scaled);
@@ -100,7 +100,7 @@ fn a_traced_continual_episode_is_the_one_a_continual_run_meets() {
     let map = unforeseen_harness::maps::load("stop_midway").unwrap();
     let params = ScaledParams::default();
     let mut agent = Method::Scaled.controller(bundle, &params, &map).unwrap();
-    let run = evaluate(&map, agent.as_mut(), Method::Scaled, 4, 3, &NoProgress).unwrap();
+    let run = run_controller(&map, agent.as_mut(), Method::Scaled, 4, 3, &NoProgress).unwrap();
     let (traced, ticks) = trace(bundle, &params, Method::Scaled, &map, 3, Protocol::Continual, 3).unwrap();
     let last = &run[3];
     assert_eq!(
@@ -121,9 +121,7 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
     let reasoning = |params: &ScaledParams| {
         let points = learn(bundle, params, &map, 30, 3, &NoProgress).unwrap();
         assert!(points.iter().all(|p| p.success), "a crash while learning: {points:?}");
-        let ticks = |ps: &[unforeseen_harness::episodes::learning_curves::LearnPoint]| {
-            ps.iter().map(|p| p.reasoning_ticks).sum::<u32>()
-        };
+        let ticks = |ps: &[unforeseen_harness::episodes::LearnPoint]| ps.iter().map(|p| p.reasoning_ticks).sum::<u32>();
         (ticks(&points[..5]), ticks(&points[25..]))
     };
     let (first, last) = reasoning(&ScaledParams::default());
@@ -151,7 +149,7 @@ fn reasoning_fades_with_learning_where_the_event_is_uncertain() {
 fn scaled_waits_for_the_slow_walker() {
     let success = |bundle: &AgentBundle, map: &unforeseen_sim::Map, params: &ScaledParams| {
         let mut agent = Method::Scaled.controller(bundle, params, map).unwrap();
-        Aggregate::of(&evaluate(map, agent.as_mut(), Method::Scaled, 10, 7, &NoProgress).unwrap()).success_rate
+        Aggregate::of(&run_controller(map, agent.as_mut(), Method::Scaled, 10, 7, &NoProgress).unwrap()).success_rate
     };
     let map = unforeseen_harness::maps::load("slow_walker").unwrap();
     let mut states = ScaledParams::default();

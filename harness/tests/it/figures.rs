@@ -4,9 +4,9 @@
 //! the README's commands write are checked the same way in `readme`.
 
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::episodes::trace::trace;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
+use unforeseen_harness::episodes::trace;
 use unforeseen_harness::fixtures;
 use unforeseen_harness::reports::figures::{
     BarPanel, BarRow, Series, bar_key, filmstrip, grouped_bars, line_panels, theta_trace,

@@ -16,8 +16,8 @@ use std::path::Path;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_discretizer::Discretizer;
 use unforeseen_env::{Env, EnvConfig, ObservationForm};
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::runner::{EpisodeSeeds, run_episode};
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::{EpisodeSeeds, run_episode};
 use unforeseen_sim::{Action, Map};
 
 fn cases() -> usize {
@@ -161,11 +161,6 @@ fn mutate(text: &str, rng: &mut ChaCha8Rng) -> String {
     t
 }
 
-fn embedded(base: &str) -> Option<(String, String)> {
-    let name = base.strip_suffix(".ron").unwrap_or(base);
-    unforeseen_sim::embedded::source(name).map(|t| (format!("embedded:{name}"), t.to_string()))
-}
-
 #[test]
 fn mutated_maps_are_refused_or_run_within_the_limits() {
     let names = unforeseen_sim::embedded::names();
@@ -174,7 +169,7 @@ fn mutated_maps_are_refused_or_run_within_the_limits() {
     for case in 0..n {
         let name = names[case % names.len()];
         let text = mutate(unforeseen_sim::embedded::source(name).unwrap(), &mut rng);
-        let map = match Map::from_str_named("fuzz.ron", &text, &embedded) {
+        let map = match Map::from_str_named("fuzz.ron", &text, &unforeseen_sim::embedded::base) {
             Ok(map) => map,
             Err(e) => {
                 assert!(e.to_string().starts_with("fuzz.ron"), "case {case}: {e}");
@@ -237,7 +232,7 @@ fn mutated_agent_files_are_refused_or_drive_the_car() {
             }
         };
         accepted += 1;
-        if unforeseen_harness::episodes::methods::check_compatible(&bundle, &map).is_err() {
+        if unforeseen_harness::episodes::check_compatible(&bundle, &map).is_err() {
             continue;
         }
         for method in [

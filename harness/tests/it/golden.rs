@@ -12,10 +12,10 @@ use std::fmt::Write;
 use unforeseen_agent::params::{ActionSelection, CompetenceCheck, CrashPlanning, ScaledParams, TieBreak};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_env::seeds::content_hash;
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::episodes::runner::{EpisodeResult, Tick};
-use unforeseen_harness::episodes::trace::trace;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
+use unforeseen_harness::episodes::trace;
+use unforeseen_harness::episodes::{EpisodeResult, Tick};
 use unforeseen_harness::fixtures;
 use unforeseen_harness::training::{TimeoutAs, train};
 
@@ -110,11 +110,8 @@ fn episodes_digest(bundle: &AgentBundle, map: &unforeseen_sim::Map, params: &Sca
 /// with the paper's distance edges when `papers`.
 fn noisy_jaywalk(papers: bool) -> unforeseen_sim::Map {
     let text = "Map(base: \"jaywalk\", name: \"noisy_jaywalk\", bins: (observation_noise: 0.1))";
-    let embedded = |base: &str| {
-        let name = base.strip_suffix(".ron").unwrap_or(base);
-        unforeseen_sim::embedded::source(name).map(|t| (format!("embedded:{name}"), t.to_string()))
-    };
-    let mut map = unforeseen_sim::Map::from_str_named("noisy_jaywalk.ron", text, &embedded).expect("valid map");
+    let mut map = unforeseen_sim::Map::from_str_named("noisy_jaywalk.ron", text, &unforeseen_sim::embedded::base)
+        .expect("valid map");
     if papers {
         let papers = fixtures::papers_bins("jaywalk").bins;
         map.bins.distance_edges = papers.distance_edges;

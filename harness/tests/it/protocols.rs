@@ -5,10 +5,10 @@
 use unforeseen_harness::fixtures;
 
 use unforeseen_agent::params::ScaledParams;
-use unforeseen_harness::episodes::evaluation::{evaluate, evaluate_under};
-use unforeseen_harness::episodes::methods::Method;
-use unforeseen_harness::episodes::protocol::Protocol;
-use unforeseen_harness::episodes::runner::EpisodeResult;
+use unforeseen_harness::episodes::EpisodeResult;
+use unforeseen_harness::episodes::Method;
+use unforeseen_harness::episodes::Protocol;
+use unforeseen_harness::episodes::{evaluate_under, run_controller};
 use unforeseen_harness::progress::NoProgress;
 
 /// Results without the wall-clock fields.
@@ -51,7 +51,7 @@ fn methods_that_do_not_learn_across_episodes_give_the_same_results_under_both_pr
         assert!(!method.learns_across_episodes(&params));
         // The real continual loop: one controller, episodes in order.
         let mut controller = method.controller(fixtures::bundle(), &params, &jaywalk).unwrap();
-        let continual = untimed(evaluate(&jaywalk, controller.as_mut(), method, 4, 5, &NoProgress).unwrap());
+        let continual = untimed(run_controller(&jaywalk, controller.as_mut(), method, 4, 5, &NoProgress).unwrap());
         assert_eq!(continual, zero_shot(method, 2), "{method}");
     }
 }

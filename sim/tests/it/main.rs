@@ -4,8 +4,11 @@
 mod bad_maps;
 mod common;
 mod determinism;
+mod junction;
+mod margins;
 mod red_light;
 mod scenarios;
+mod traffic_behaviours;
 mod triggers;
 mod vehicle_forces;
 mod vehicle_kinematics;

@@ -160,14 +160,10 @@ fn other_unforeseen_scenarios() {
 /// loads to the same map, and as JSON its names are plain strings.
 #[test]
 fn maps_round_trip_through_ron() {
-    let embedded = |base: &str| {
-        let name = base.strip_suffix(".ron").unwrap_or(base);
-        unforeseen_sim::embedded::source(name).map(|t| (format!("embedded:{name}"), t.to_string()))
-    };
     for name in unforeseen_sim::embedded::names() {
         let map = unforeseen_sim::embedded::load(name).unwrap();
         let text = ron::to_string(&map).unwrap();
-        let again = unforeseen_sim::Map::from_str_named(&format!("{name}.ron"), &text, &embedded)
+        let again = unforeseen_sim::Map::from_str_named(&format!("{name}.ron"), &text, &unforeseen_sim::embedded::base)
             .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
         assert_eq!(again, map, "{name}");
         if let Some(e) = map.expect.first() {

@@ -15,7 +15,7 @@ use super::sweep::ParamSet;
 /// What determines agents trained on `train_map` with `config` and each of `seeds` (the
 /// config's seed replaced by each), for a run's identity: their cache keys (training map
 /// contents, episodes, seed, training configuration such as what a time-out is to the
-/// learners, version and training code; [`crate::training::seed_agents::cache_key`]).
+/// learners, version and training code; the agent cache's key, `cache_key` in `training/seed_agents.rs`).
 pub fn trained_agents_identity(
     train_map: &Map,
     seeds: &[Option<u64>],

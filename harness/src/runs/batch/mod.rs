@@ -29,22 +29,22 @@
 //! ([`BatchRequest::plan`]) gives the [`BatchJob`] that the command line, the Python
 //! package and the Ray driver all run.
 //!
-//! One module per part: [`request`], [`scenario`], [`sweep`](mod@sweep), [`units`](mod@units), [`expectations`],
-//! [`result_line`], [`plan`], [`identity`], [`run`](mod@run), [`results_file`] and [`summary`];
-//! the items callers use are re-exported here.
+//! One private file per part: `request.rs`, `scenario.rs`, `sweep.rs`, `units.rs`, `expectations.rs`,
+//! `result_line.rs`, `plan.rs`, `identity.rs`, `run.rs`, `results_file.rs`, `summary.rs` and
+//! `table.rs`; what callers use is re-exported here, the batch job's one face.
 
-pub mod expectations;
-pub mod identity;
-pub mod plan;
-pub mod request;
-pub mod result_line;
-pub mod results_file;
-pub mod run;
-pub mod scenario;
-pub mod summary;
-pub mod sweep;
-pub mod table;
-pub mod units;
+pub(crate) mod expectations;
+pub(crate) mod identity;
+pub(crate) mod plan;
+pub(crate) mod request;
+pub(crate) mod result_line;
+pub(crate) mod results_file;
+pub(crate) mod run;
+pub(crate) mod scenario;
+pub(crate) mod summary;
+pub(crate) mod sweep;
+pub(crate) mod table;
+pub(crate) mod units;
 
 pub use expectations::{Check, check_expectations};
 pub use identity::{RunIdentity, SCRIPTED_ONLY, agent_file_identity, trained_agents_identity};
@@ -56,4 +56,5 @@ pub use run::{run, run_plan, run_unit, run_unit_with};
 pub use scenario::{Scenario, ScenarioKind, load_scenarios, load_stream_scenario};
 pub use summary::{StreamLearning, SummaryCheck, SummaryRow, WorstLine, stream_learning, summarize};
 pub use sweep::{MAX_PARAM_SETS, ParamSet, checked_sweep, sweep};
+pub use table::{batch_summary, expectation_failures};
 pub use units::{DEFAULT_METHODS, Shard, Unit, units};

@@ -221,7 +221,14 @@ pub(crate) fn figures_problem(l: &ResultLine) -> Option<String> {
         [l.success_rate, l.collision_rate, l.timeout_rate, l.inference_rate],
         [l.efe_matvecs_per_tick, l.mean_ticks, l.timing_us_per_tick],
         l.mean_reward,
-    );
+    )
+    .or_else(|| {
+        margins_problem(
+            "",
+            [l.min_clearance_m, l.min_ttc_s, l.min_stop_margin_m],
+            l.could_stop_rate,
+        )
+    });
     if own.is_some() {
         return own;
     }
@@ -241,7 +248,32 @@ pub(crate) fn figures_problem(l: &ResultLine) -> Option<String> {
             [f.efe_matvecs_per_tick, f.mean_ticks, f.timing_us_per_tick],
             f.mean_reward,
         )
+        .or_else(|| {
+            margins_problem(
+                &format!("per_map {}: ", f.map),
+                [f.min_clearance_m, f.min_ttc_s, f.min_stop_margin_m],
+                f.could_stop_rate,
+            )
+        })
     })
+}
+
+/// What is wrong with a line's (or one of its maps', `prefix`) margins
+/// (docs/ARCHITECTURE.md §2, "Margins"): the clearance and the TTC, where given, outside
+/// [0, [`MAX_FIGURE`]], the stopping margin not finite within ±[`MAX_FIGURE`], or the
+/// share that could stop outside [0, 1].
+fn margins_problem(prefix: &str, [clearance, ttc, stop]: [Option<f64>; 3], could_stop: f64) -> Option<String> {
+    for (name, x) in [("min_clearance_m", clearance), ("min_ttc_s", ttc)] {
+        if let Some(x) = x.filter(|x| !(0.0..=MAX_FIGURE).contains(x)) {
+            return Some(format!("has {prefix}{name} {x}, outside [0, {MAX_FIGURE:e}]"));
+        }
+    }
+    if let Some(x) = stop.filter(|x| !(x.is_finite() && x.abs() <= MAX_FIGURE)) {
+        return Some(format!(
+            "has {prefix}min_stop_margin_m {x}, not finite within ±{MAX_FIGURE:e}"
+        ));
+    }
+    (!(0.0..=1.0).contains(&could_stop)).then(|| format!("has {prefix}could_stop_rate {could_stop}, outside [0, 1]"))
 }
 
 /// What is wrong with a line's (or one of its maps', `prefix`) figures: the rates
@@ -266,4 +298,20 @@ fn figure_problem(prefix: &str, rates: [f64; 4], counts: [f64; 3], reward: f64) 
         ));
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn margins_out_of_their_ranges_are_named() {
+        assert_eq!(margins_problem("", [Some(2.3), None, Some(-4.0)], 0.5), None);
+        assert_eq!(margins_problem("", [None, None, None], 1.0), None);
+        let named = |m: [Option<f64>; 3], share: f64| margins_problem("p: ", m, share).unwrap_or_default();
+        assert!(named([Some(-0.1), None, None], 1.0).contains("p: min_clearance_m -0.1"));
+        assert!(named([None, Some(f64::NAN), None], 1.0).contains("min_ttc_s NaN"));
+        assert!(named([None, None, Some(f64::INFINITY)], 1.0).contains("min_stop_margin_m inf"));
+        assert!(named([None, None, None], 1.5).contains("could_stop_rate 1.5"));
+    }
 }

@@ -110,7 +110,7 @@ pub fn checked_sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
 impl ParamSet {
     /// The scaled agent's parameters with these overrides applied (checked).
     pub fn scaled_params(&self) -> Result<ScaledParams, Error> {
-        let sets: Vec<String> = self.0.iter().map(|(k, v)| format!("{k}={v}")).collect();
-        crate::overrides::apply(ScaledParams::default(), &sets)
+        let pairs = self.0.iter().map(|(k, v)| (k.as_str(), v.as_str()));
+        crate::overrides::apply_pairs(ScaledParams::default(), pairs)
     }
 }

@@ -2,15 +2,16 @@
 //! counterpart (Fig. 9 setting), every method with every trained agent (training seed)
 //! under every protocol asked, summarized over agents as a mean with a 95% interval,
 //! the range and the worst seed. The per-agent rows are kept. A study is asked for by
-//! one [`CompareRequest`] ([`request`]) from every front, and writes its files
-//! ([`files`]).
+//! one [`CompareRequest`] from every front, and writes its files
+//! ([`COMPARE_FILES`]).
 
-pub mod files;
-pub mod request;
-pub mod table;
+pub(crate) mod files;
+pub(crate) mod request;
+pub(crate) mod table;
 
 pub use files::COMPARE_FILES;
 pub use request::{CompareJob, CompareRequest};
+pub use table::compare_table;
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -208,7 +209,7 @@ pub struct CompareReport {
     /// The reward settings of both maps (`train_map`, `test_map`).
     pub reward: RewardPair,
     /// Each map's reward in words (`rewards::describe`: training map, test map), as the
-    /// printed tables give it ([`crate::runs::compare::table::compare`]); not in the file.
+    /// printed tables give it ([`crate::runs::compare::compare_table`]); not in the file.
     #[serde(skip)]
     pub reward_described: (String, String),
     /// Evaluation seed (episode seeds derive from it, the same for every agent).

@@ -204,7 +204,7 @@ impl CompareJob {
     }
 
     /// Writes the report's files into the request's `out` folder, all four or none
-    /// ([`super::files::write`]); the paths written, none without an `out`.
+    /// (`files.rs`); the paths written, none without an `out`.
     pub fn write(&self, report: &CompareReport) -> Result<Vec<PathBuf>, Error> {
         match &self.request.out {
             Some(dir) => super::files::write(dir, report),

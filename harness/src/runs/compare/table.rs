@@ -33,7 +33,7 @@ fn agents_line(m: &MethodSummary) -> String {
 /// `compare`'s tables (§VI, Fig. 8), one per protocol: the figures (the paper's in
 /// parentheses under zero-shot), then, over several agents, their range and the worst
 /// seed. A second header line names the map each column was measured on.
-pub fn compare(report: &CompareReport) -> Document {
+pub fn compare_table(report: &CompareReport) -> Document {
     let mut doc = Document::default();
     for table in &report.tables {
         protocol_table(&mut doc, report, table);

@@ -107,9 +107,26 @@ pub struct CandidateLine {
     pub fairness: Fairness,
     /// For the method's line: the candidate is fair and this agent's success is under 50%.
     pub fails: bool,
+    /// The careful cruise that decided whether the candidate is survivable: the one where
+    /// brake-on-pedestrian did worst (the survivable witness's line holds its figures).
+    /// Absent from lines written before it was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub careful_cruise: Option<CarefulCruise>,
     /// The evaluation, as a batch line.
     #[serde(flatten)]
     pub result: ResultLine,
+}
+
+/// The careful cruise that decided a candidate's survivability
+/// ([`careful_witness`](crate::episodes::survivability::careful_witness): the worst of them).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CarefulCruise {
+    /// The cruise, as a fraction of the car's top speed.
+    pub fraction: f64,
+    /// The top speed brake-on-pedestrian drove at there, m/s.
+    pub speed_mps: f64,
+    /// brake-on-pedestrian's success rate at that cruise.
+    pub success_rate: f64,
 }
 
 /// One evaluated candidate.

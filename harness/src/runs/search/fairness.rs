@@ -53,6 +53,47 @@ impl Fairness {
     }
 }
 
+/// When a run counted a failure and a scenario fair, as its `summary.json` states it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailureThreshold {
+    /// What a failure is.
+    pub fails: String,
+    /// The success rate under which an agent fails a fair scenario (a search's), if one.
+    pub failure_success: Option<f64>,
+    /// The careful witness's least success for a survivable scenario (at every careful cruise).
+    pub survivable_min_success: f64,
+    /// The careless witness's largest success for a dangerous scenario.
+    pub dangerous_max_success: f64,
+    /// Episodes per witness (and per careful cruise) deciding fairness.
+    pub witness_episodes: u64,
+}
+
+impl FailureThreshold {
+    /// A search's: an agent fails a fair candidate when its success is under
+    /// `FAILURE_SUCCESS` (50%), over `episodes` episodes per witness.
+    pub fn search(episodes: u64) -> FailureThreshold {
+        FailureThreshold {
+            fails: format!(
+                "a fair candidate where an agent (training seed) succeeds in under {:.0}% of its episodes",
+                100.0 * FAILURE_SUCCESS
+            ),
+            failure_success: Some(FAILURE_SUCCESS),
+            ..FailureThreshold::episode(episodes)
+        }
+    }
+
+    /// An estimate's: an episode fails when it does not succeed.
+    pub fn episode(episodes: u64) -> FailureThreshold {
+        FailureThreshold {
+            fails: "an episode that does not succeed: a collision or a time-out".into(),
+            failure_success: None,
+            survivable_min_success: SURVIVABLE_MIN_SUCCESS,
+            dangerous_max_success: DANGEROUS_MAX_SUCCESS,
+            witness_episodes: episodes,
+        }
+    }
+}
+
 /// Whether a success rate is a failure ([`FAILURE_SUCCESS`]).
 pub fn fails(success_rate: f64) -> bool {
     success_rate < FAILURE_SUCCESS

@@ -2,7 +2,7 @@
 //! where a method fails (the paper's subject is what nobody foresaw; safety engineers
 //! search for it: adaptive stress testing, falsification).
 //!
-//! A [`Space`] names which fields of a base map vary and over what ([`space`]). The
+//! A [`Space`] names which fields of a base map vary and over what (`space.rs`). The
 //! search evaluates *candidates*, points of the space laid over the base map, each with
 //! K episodes of the two fairness witnesses (brake-on-pedestrian's line is the worst of
 //! its careful cruises, [`careful_witness`]) and of the method (for each training seed),
@@ -12,13 +12,13 @@
 //!
 //!
 //! 1. **Sobol stage** (candidates `0..n1`, `n1 = ceil(budget × sobol_share)`): points of
-//!    a scrambled Sobol sequence ([`sampler`]), uniform on the unit cube, so the share of
+//!    a scrambled Sobol sequence (`sampler.rs`), uniform on the unit cube, so the share of
 //!    its fair candidates the method fails is an unbiased estimate of
 //!    P(the method fails | the candidate is fair), reported with a 95% Wilson interval
-//!    per training seed, with the share of the space that is fair ([`fairness`]).
+//!    per training seed, with the share of the space that is fair ([`Fairness`]).
 //! 2. **Adaptive stage** (candidates `n1..budget`, in [`SearchConfig::rounds`] rounds):
-//!    the cross-entropy method ([`adaptive`]) fitted to the fair failures found so far.
-//! 3. **Minimisation** ([`minimise`]): each of the best failures (up to
+//!    the cross-entropy method (`adaptive.rs`) fitted to the fair failures found so far.
+//! 3. **Minimisation** (`minimise.rs`): each of the best failures (up to
 //!    [`SearchConfig::max_failures`], distinct by which parameters they change) is moved
 //!    back toward the base map, one parameter at a time, while it still fails fairly.
 //!
@@ -41,27 +41,26 @@
 //! ([`SearchRequest::plan`]) is shared by the command line, the Python package and the
 //! Ray driver.
 //!
-//! Outputs ([`output`]): `candidates.jsonl`, `failures/NAME.ron`, `summary.json` and
+//! Outputs ([`Summary`], `output.rs`): `candidates.jsonl`, `failures/NAME.ron`, `summary.json` and
 //! `search.svg`.
 
-pub mod adaptive;
+pub(crate) mod adaptive;
 mod candidates;
 mod config;
-pub mod fairness;
+pub(crate) mod fairness;
 mod identity;
-pub mod minimise;
-pub mod output;
-pub mod request;
+pub(crate) mod minimise;
+pub(crate) mod output;
+pub(crate) mod request;
 mod resume;
 mod runner;
-pub mod sampler;
-pub mod space;
+pub(crate) mod sampler;
+pub(crate) mod space;
 mod wire;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
 use unforeseen_agent::params::ScaledParams;
@@ -71,21 +70,23 @@ use crate::episodes::evaluation::{evaluate_scripted, evaluate_under};
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::{Protocol, covered};
-use crate::episodes::survivability::careful_witness;
+use crate::episodes::survivability::{at_cruise, careful_witness};
 use crate::error::Error;
 use crate::progress::{CancelOnly, NoProgress, Progress};
 use crate::runs::batch::{ResultLine, Shard, UnitLabel};
 use crate::runs::outputs::Guarded;
 use crate::training::seed_agents::Agent;
 
-pub use candidates::{Candidate, CandidateLine, Evaluated, Role, Stage, candidate_name, sobol_candidates};
+pub use candidates::{
+    Candidate, CandidateLine, CarefulCruise, Evaluated, Role, Stage, candidate_name, sobol_candidates,
+};
 pub use config::{DEFAULT_MAX_FAILURES, DEFAULT_ROUNDS, DEFAULT_SOBOL_SHARE, MAX_BUDGET, SearchConfig};
-pub use fairness::Fairness;
+pub use fairness::{FailureThreshold, Fairness};
 pub use identity::SearchIdentity;
-pub use output::Summary;
+pub use output::{MAX_LISTED_REJECTIONS, Summary, read_result_lines};
 pub use request::{SearchJob, SearchRequest, SearchSetup};
-pub use runner::evaluate;
-pub use space::{Space, Value};
+pub use runner::evaluate_candidate;
+pub use space::{Space, Value, map_ron};
 pub use wire::{CandidateWire, Evaluator, evaluate_wire, evaluate_wire_with};
 
 use candidates::RawLine;
@@ -106,8 +107,14 @@ pub struct Outcome {
 /// Runs the search into folder `out` (`candidates.jsonl`, `failures/`, `summary.json`,
 /// `search.svg`); with `resume`, completes the search a file there holds. Progress: one
 /// phase per stage (`search sobol`, `search adaptive N`, `search minimise`). `guard` is
-/// the job's output guard: the earlier search's summary, figure and failure maps are
-/// removed once the kept lines are checked ([`Guarded::clear_at_end`]).
+/// the job's output guard, held while the run writes.
+///
+/// The candidates are streamed to `candidates.jsonl.part` (`output::CANDIDATES_PART`)
+/// as they are evaluated, and the set (candidates, failure maps, summary, figure) is
+/// committed as one at the end ([`crate::files::all_or_none`]), the part removed with
+/// it: a run that fails or is killed partway leaves the earlier search's set as it was,
+/// and the part for `--resume`, which reads the part when there is one (the latest run
+/// into the folder) and `candidates.jsonl` otherwise.
 pub fn run(
     cfg: &SearchConfig<'_>,
     out: &Path,
@@ -126,31 +133,28 @@ pub fn run_with(
     cfg: &SearchConfig<'_>,
     out: &Path,
     resume: bool,
-    guard: &Guarded,
+    _guard: &Guarded,
     progress: &dyn Progress,
     remote: Option<&dyn Evaluator>,
 ) -> Result<Summary, Error> {
     cfg.check()?;
     std::fs::create_dir_all(out).map_err(|e| Error::io("create folder", out, e))?;
     let file = out.join(output::CANDIDATES);
+    let part = out.join(output::CANDIDATES_PART);
+    let read = if part.is_file() { &part } else { &file };
     let kept = if resume {
-        resume_lines(cfg, &file)?
+        resume_lines(cfg, read)?
     } else {
         BTreeMap::new()
     };
-    guard.clear_at_end()?;
     let head: String = std::iter::once(output::identity_line(&cfg.identity()))
         .chain(kept.values().flatten().map(|l| l.raw.clone()))
         .collect();
-    crate::files::write_atomic(&file, head.as_bytes())?;
-    let sink = std::fs::OpenOptions::new()
-        .append(true)
-        .open(&file)
-        .map_err(|e| Error::io("append to", &file, e))?;
+    let sink = crate::files::Streamed::create(&part, head.as_bytes())?;
     let runner = Runner {
         cfg,
         sink: Mutex::new(sink),
-        out: &file,
+        out: read,
         kept,
         written: Mutex::new(BTreeMap::new()),
         progress,
@@ -164,10 +168,13 @@ pub fn run_with(
     let text: String = std::iter::once(output::identity_line(&cfg.identity()))
         .chain(written.values().flatten().map(|l| l.raw.clone()))
         .collect();
-    // The candidates, failure maps, summary and figure appear together or not at all.
+    // The candidates, failure maps, summary and figure appear together or not at all;
+    // the part goes with them.
     crate::files::all_or_none(|| {
         crate::files::write_atomic(&file, text.as_bytes())?;
-        output::write_all(cfg, out, &outcome)
+        let summary = output::write_all(cfg, out, &outcome)?;
+        crate::files::remove_with_set(&part)?;
+        Ok(summary)
     })
 }
 

@@ -23,7 +23,7 @@ use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-use super::fairness::Fairness;
+use super::fairness::{FailureThreshold, Fairness};
 use super::minimise::Minimised;
 use super::space::{Domain, Value, map_ron};
 use super::{Evaluated, Outcome, Role, SearchConfig, SearchIdentity, Stage};
@@ -35,6 +35,9 @@ use crate::stats::Stat;
 
 /// The candidates file's name.
 pub const CANDIDATES: &str = "candidates.jsonl";
+/// The candidates a run streams while it lasts, committed into [`CANDIDATES`] with the
+/// rest of the set at its end (what `--resume` reads after a kill or a failure).
+pub const CANDIDATES_PART: &str = "candidates.jsonl.part";
 /// The summary's name.
 pub const SUMMARY: &str = "summary.json";
 /// The figure's name.
@@ -46,15 +49,16 @@ pub const MAX_LISTED_REJECTIONS: usize = 20;
 
 /// The output guard of a search into the folder `out` (the front adds the inputs: the
 /// space file, the base map, the agent file): every file in it is the search's, the
-/// candidates are a search's, and the summary, the figure and the failure maps
-/// (`failures/*.ron`, each a map an earlier search wrote) are removed when the guard is
-/// taken, as the search writes them anew at its end.
+/// candidates (and their part) are a search's, the summary, the figure and the failure
+/// maps (`failures/*.ron`, each a map an earlier search wrote) too. The run replaces
+/// them as one set at its end ([`super::run`]).
 pub fn outputs(out: &Path) -> Outputs {
     Outputs::new()
         .folder("out", out)
         .file("out", out.join(CANDIDATES), Own::Candidates)
-        .file_at_end("out", out.join(SUMMARY), Own::SearchSummary)
-        .file_at_end("out", out.join(FIGURE), Own::Svg)
+        .file("out", out.join(CANDIDATES_PART), Own::Candidates)
+        .file("out", out.join(SUMMARY), Own::SearchSummary)
+        .file("out", out.join(FIGURE), Own::Svg)
         .folder_files("out", &out.join(FAILURES), "ron", Own::FailureMap)
 }
 
@@ -205,6 +209,8 @@ pub struct Summary {
     pub shard: Option<String>,
     /// The space's file.
     pub space_file: String,
+    /// When an agent fails a candidate and a candidate is fair.
+    pub failure_threshold: FailureThreshold,
     /// Counts.
     pub counts: Counts,
     /// Share of evaluated Sobol candidates that are fair (the fair part of the space).
@@ -225,16 +231,23 @@ pub struct Summary {
     pub rejected: Vec<RejectedPoint>,
 }
 
-/// Writes `failures/`, `summary.json` and `search.svg` for `outcome`; returns the summary.
+/// Writes `failures/`, `summary.json` and `search.svg` for `outcome` (within the run's
+/// set, [`crate::files::all_or_none`]); returns the summary.
 pub(super) fn write_all(cfg: &SearchConfig<'_>, out: &Path, outcome: &Outcome) -> Result<Summary, Error> {
     let space = cfg.space;
     let dir = out.join(FAILURES);
-    // The folder holds this run's failures only: the guard ([`outputs`]) removed the
-    // maps of an earlier search.
     std::fs::create_dir_all(&dir).map_err(|e| Error::io("create folder", &dir, e))?;
     let mut failures = Vec::new();
     for m in &outcome.failures {
         failures.push(write_failure(cfg, &dir, m)?);
+    }
+    // The folder holds this run's failures only: an earlier search's other maps (which
+    // the guard, [`outputs`], checked are failure maps) go with the set.
+    let earlier = std::fs::read_dir(&dir).map_err(|e| Error::io("read folder", &dir, e))?;
+    for path in earlier.flatten().map(|e| e.path()) {
+        if path.extension().is_some_and(|x| x == "ron") && !failures.iter().any(|f| f.file == path) {
+            crate::files::remove_with_set(&path)?;
+        }
     }
     let sobol: Vec<&Evaluated> = outcome
         .candidates
@@ -306,6 +319,7 @@ pub(super) fn write_all(cfg: &SearchConfig<'_>, out: &Path, outcome: &Outcome) -
         run: cfg.identity(),
         shard: cfg.shard.map(|s| format!("{}/{}", s.index, s.count)),
         space_file: space.source.clone(),
+        failure_threshold: FailureThreshold::search(cfg.episodes),
         counts,
         fair_share: Proportion::wilson(fair_sobol.len(), evaluated_sobol),
         failure_probability_any_seed: Proportion::wilson(

@@ -3,10 +3,12 @@
 
 use super::*;
 
-/// The shared state of a running search: the file being appended and the lines kept.
+/// The shared state of a running search: the part being appended, the file resumed
+/// and the lines kept.
 pub(super) struct Runner<'a, 'b> {
     pub(super) cfg: &'a SearchConfig<'b>,
-    pub(super) sink: Mutex<std::fs::File>,
+    pub(super) sink: Mutex<crate::files::Streamed>,
+    /// The file `--resume` read (or the candidates file), for errors.
     pub(super) out: &'a Path,
     pub(super) kept: BTreeMap<usize, Vec<RawLine>>,
     pub(super) written: Mutex<BTreeMap<usize, Vec<RawLine>>>,
@@ -98,7 +100,7 @@ impl Runner<'_, '_> {
             }
             return self.write(candidate, raws, advance);
         }
-        let lines = evaluate(self.cfg, &candidate, map, named, self.progress)?;
+        let lines = evaluate_candidate(self.cfg, &candidate, map, named, self.progress)?;
         let raws: Vec<RawLine> = lines
             .iter()
             .map(|l| {
@@ -110,16 +112,11 @@ impl Runner<'_, '_> {
         self.write(candidate, raws, advance)
     }
 
-    /// Appends a candidate's fresh lines to the file and keeps them.
+    /// Appends a candidate's fresh lines to the part and keeps them.
     pub(super) fn write(&self, candidate: Candidate, raws: Vec<RawLine>, advance: bool) -> Result<Evaluated, Error> {
         let lines = raws.iter().map(|r| r.parsed.clone()).collect();
         let text: String = raws.iter().map(|r| r.raw.as_str()).collect();
-        {
-            let mut f = self.sink.lock().expect("file lock");
-            f.write_all(text.as_bytes())
-                .and_then(|()| f.flush())
-                .map_err(|e| Error::io("write", self.out, e))?;
-        }
+        self.sink.lock().expect("file lock").append(text.as_bytes())?;
         self.written.lock().expect("lines lock").insert(candidate.index, raws);
         if advance {
             crate::progress::step(self.progress)?;
@@ -191,7 +188,7 @@ type Run<'a> = (Role, Method, Option<&'a Agent>, Option<u64>, Aggregate);
 /// seed, `episodes` episodes each; its lines carry the fairness and failure verdicts.
 /// Stops between episodes ([`Error::Interrupted`]) when `cancel` asks; its phase is not
 /// advanced.
-pub fn evaluate(
+pub fn evaluate_candidate(
     cfg: &SearchConfig<'_>,
     candidate: &Candidate,
     map: &Map,
@@ -209,7 +206,12 @@ pub fn evaluate(
             &cancel,
         )?))
     };
-    let (_, brake) = careful_witness(map, cfg.episodes, cfg.seed, &cancel)?;
+    let (careful, brake) = careful_witness(map, cfg.episodes, cfg.seed, &cancel)?;
+    let careful_cruise = CarefulCruise {
+        fraction: careful.cruise,
+        speed_mps: at_cruise(map, careful.cruise).vehicle.max_speed,
+        success_rate: careful.success_rate,
+    };
     let never = scripted(Method::NeverBrake)?;
     let fair = Fairness::of(brake.success_rate, never.success_rate);
     let mut runs: Vec<Run<'_>> = vec![
@@ -250,6 +252,7 @@ pub fn evaluate(
                 values: values.clone(),
                 fairness: fair,
                 fails: role == Role::Method && fair.is_fair() && fairness::fails(agg.success_rate),
+                careful_cruise: Some(careful_cruise),
                 result,
             }
         })

@@ -4,8 +4,8 @@
 use super::*;
 
 /// Evaluates candidates somewhere else than in this process (e.g. as tasks of a
-/// cluster): what [`run_with`] calls in place of [`evaluate`]. Each candidate's lines
-/// must be what [`evaluate`] gives for it (JSON text, one line each, ending in `\n`), in
+/// cluster): what [`run_with`] calls in place of [`evaluate_candidate`]. Each candidate's lines
+/// must be what [`evaluate_candidate`] gives for it (JSON text, one line each, ending in `\n`), in
 /// the same order as the candidates given; [`CandidateWire`] is what to send of a
 /// candidate, and [`evaluate_wire`] what to run with it where the lines are made.
 pub trait Evaluator: Sync {
@@ -26,7 +26,7 @@ pub struct CandidateWire {
 }
 
 impl CandidateWire {
-    pub(super) fn of(c: &Candidate) -> Self {
+    pub(crate) fn of(c: &Candidate) -> Self {
         CandidateWire {
             index: c.index,
             stage: c.stage,
@@ -35,7 +35,7 @@ impl CandidateWire {
     }
 }
 
-/// The lines of a candidate sent as a [`CandidateWire`]: what [`evaluate`] writes for
+/// The lines of a candidate sent as a [`CandidateWire`]: what [`evaluate_candidate`] writes for
 /// it, as JSON text (one line each, with its `\n`); an error when its map is not valid.
 pub fn evaluate_wire(cfg: &SearchConfig<'_>, wire: &CandidateWire) -> Result<Vec<String>, Error> {
     evaluate_wire_with(cfg, wire, &NoProgress)
@@ -54,7 +54,7 @@ pub fn evaluate_wire_with(
         problem: format!("candidate {}: not a valid map ({r:?})", wire.index),
     })?;
     let named = c.named_values(cfg.space);
-    evaluate(cfg, &c, map, named, cancel)?
+    evaluate_candidate(cfg, &c, map, named, cancel)?
         .iter()
         .map(|l| {
             let mut raw = serde_json::to_string(l)?;

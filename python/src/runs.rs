@@ -10,7 +10,7 @@ use pyo3::types::PyDict;
 use unforeseen_harness::runs::batch::{BatchRequest, ResultLine};
 use unforeseen_harness::runs::compare::CompareRequest;
 use unforeseen_harness::runs::outputs::{Guarded, Outputs, Own};
-use unforeseen_harness::training::seed_agents::Agent;
+use unforeseen_harness::training::Agent;
 
 use crate::agent::PyAgent;
 use crate::errors;

@@ -1,0 +1,75 @@
+//! The surprise gate on a general model (`unforeseen_agent::aif::gate`), in pymdp's
+//! T-maze (the model of `tests/data/pymdp/tmaze.json`, which is also the world).
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde_json::Value;
+use unforeseen_agent::aif::agent::{Agent, AgentParams};
+use unforeseen_agent::aif::gate::{GatedAgent, Habit};
+use unforeseen_agent::aif::model::Model;
+use unforeseen_agent::aif::process::Process;
+use unforeseen_agent::aif::run::{RunConfig, run};
+
+fn tmaze() -> (Model, AgentParams) {
+    let v: Value = serde_json::from_str(include_str!("../data/pymdp/tmaze.json")).unwrap();
+    let params = AgentParams {
+        policy_len: v["model"]["policy_len"].as_u64().unwrap() as usize,
+        ..AgentParams::default()
+    };
+    (Model::from_json(&v["model"]).unwrap(), params)
+}
+
+const CFG: RunConfig = RunConfig {
+    episodes: 6,
+    steps: 10,
+    seed: 7,
+    learn: false,
+};
+
+/// With ε < 0 the gate is open on every tick and the gated agent acts as the plain one.
+#[test]
+fn an_open_gate_plans_every_tick_as_pymdp_does() {
+    let (model, params) = tmaze();
+    let agent = Agent::new(model.clone(), params, None).unwrap();
+    let mut gated = GatedAgent::new(agent.clone(), -1.0, Habit::Learned).unwrap();
+    let mut world = Process::new(model);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let mut obs = world.reset(&mut rng);
+    let mut prior = agent.initial_prior();
+    for _ in 0..10 {
+        let (tick, qs) = gated.step(&obs, &mut rng).unwrap();
+        assert!(tick.planned);
+        let plain_qs = agent.infer_states(&obs, &prior).unwrap();
+        assert_eq!(qs, plain_qs);
+        let post = agent.infer_policies(&plain_qs);
+        assert_eq!(tick.q_pi.as_ref(), Some(&post.q_pi));
+        assert_eq!(
+            tick.action,
+            agent.sample_action(&post.q_pi, &mut ChaCha8Rng::seed_from_u64(0))
+        );
+        prior = agent.update_empirical_prior(&tick.action, &plain_qs).unwrap();
+        obs = world.step(&tick.action, &mut rng).unwrap();
+    }
+}
+
+/// A closed gate (ε above every surprise) with the learned habit plans only in states it
+/// has never planned in, so it plans less; the same seed gives the same run.
+#[test]
+fn a_gate_plans_less_and_is_deterministic() {
+    let (model, params) = tmaze();
+    let go = |eps: f64| {
+        let agent = Agent::new(model.clone(), params, None).unwrap();
+        let mut gated = GatedAgent::new(agent, eps, Habit::Learned).unwrap();
+        run(&mut gated, &mut Process::new(model.clone()), CFG).unwrap()
+    };
+    let open = go(-1.0);
+    assert_eq!(open.planned_fraction, 1.0);
+    let shut = go(1e6);
+    assert!(shut.planned_fraction < 0.5, "planned {}", shut.planned_fraction);
+    assert!(shut.planned_fraction > 0.0);
+    assert_eq!(go(1e6), shut);
+    // The prior habit needs an E.
+    let agent = Agent::new(model, params, None).unwrap();
+    let e = GatedAgent::new(agent, 1.0, Habit::Prior).unwrap_err().to_string();
+    assert!(e.contains("no E"), "{e}");
+}

@@ -1,0 +1,152 @@
+//! What an estimate writes into its folder, together at the end of the run:
+//!
+//! * `estimate.jsonl`: the run's identity (`{"estimate": {...}}`), then one line per draw
+//!   ([`Draw`]) in order: its stage, point, parameter values, proposal density, fairness,
+//!   the method's episodes and failures, and their smallest margins;
+//! * `summary.json` ([`Summary`]): the estimand and the failure threshold, the three
+//!   estimates with their intervals and diagnostics, the evaluations, whether the target
+//!   was reached, the final proposal, and the estimates after each block (`checkpoints`).
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+use super::{Checkpoint, Draw, EstimateRequest, Estimates, Estimator, Outcome, Proposal};
+use crate::episodes::Protocol;
+use crate::error::Error;
+use crate::runs::outputs::{Outputs, Own};
+use crate::runs::search::{FailureThreshold, SearchConfig};
+
+/// The draws file's name.
+pub const DRAWS: &str = "estimate.jsonl";
+/// The summary's name.
+pub const SUMMARY: &str = "summary.json";
+
+/// The output guard of an estimate into the folder `out` (the front adds the inputs):
+/// the draws are an estimate's, and the summary, written at the end, is removed when the
+/// run starts.
+pub fn outputs(out: &Path) -> Outputs {
+    Outputs::new()
+        .folder("out", out)
+        .file("out", out.join(DRAWS), Own::Estimates)
+        .file_at_end("out", out.join(SUMMARY), Own::EstimateSummary)
+}
+
+/// What determines an estimate's results (the first line of `estimate.jsonl`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EstimateIdentity {
+    /// Program version and code fingerprint.
+    pub program: String,
+    /// The space: name and a hash of its file.
+    pub space: (String, String),
+    /// The base map: name and a hash of its contents.
+    pub base: (String, String),
+    /// The method.
+    pub method: String,
+    /// The agents.
+    pub agents: String,
+    /// Training seeds.
+    pub train_seeds: Vec<Option<u64>>,
+    /// Protocol.
+    pub protocol: Protocol,
+    /// The estimator.
+    pub estimator: Estimator,
+    /// The target relative half-width.
+    pub target_rel_error: f64,
+    /// Most draws.
+    pub budget: usize,
+    /// Episodes per draw, for each witness and for the method (per training seed).
+    pub episodes: u64,
+    /// Seed.
+    pub seed: u64,
+}
+
+/// `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Format version.
+    pub schema: u32,
+    /// The run.
+    pub run: EstimateIdentity,
+    /// The space's file.
+    pub space_file: String,
+    /// What is estimated.
+    pub estimand: String,
+    /// When an episode fails and a scenario is fair.
+    pub failure_threshold: FailureThreshold,
+    /// The estimates.
+    pub estimates: Estimates,
+    /// Draws evaluated (points of the space, the cross-entropy rounds' included).
+    pub evaluations: usize,
+    /// Of them, those that were no valid map.
+    pub rejected: usize,
+    /// Draws the estimates are over (the final stage's for `is`, all for `mc`).
+    pub estimate_draws: usize,
+    /// Episodes of the method run, over all draws (the witnesses' come on top).
+    pub method_episodes: u64,
+    /// Whether both probabilities reached the target (else the budget was spent).
+    pub target_reached: bool,
+    /// The proposal the estimates' draws came from.
+    pub proposal: Proposal,
+    /// The estimates after each block of the estimating stage.
+    pub checkpoints: Vec<Checkpoint>,
+}
+
+/// The run's identity (the first line of `estimate.jsonl`).
+pub fn identity(cfg: &SearchConfig<'_>, r: &EstimateRequest) -> EstimateIdentity {
+    let search = cfg.identity();
+    EstimateIdentity {
+        program: search.program,
+        space: search.space,
+        base: search.base,
+        method: search.method,
+        agents: search.agents,
+        train_seeds: search.train_seeds,
+        protocol: search.protocol,
+        estimator: r.estimator,
+        target_rel_error: r.target_rel_error,
+        budget: r.budget,
+        episodes: r.episodes,
+        seed: r.seed,
+    }
+}
+
+/// Writes `estimate.jsonl` and `summary.json` for `outcome` (in the caller's
+/// all-or-none set); returns the summary.
+pub(super) fn write_all(
+    cfg: &SearchConfig<'_>,
+    r: &EstimateRequest,
+    out: &Path,
+    outcome: &Outcome,
+) -> Result<Summary, Error> {
+    let run = identity(cfg, r);
+    let mut text = serde_json::json!({ "estimate": run }).to_string();
+    text.push('\n');
+    for d in &outcome.draws {
+        text.push_str(&serde_json::to_string(d)?);
+        text.push('\n');
+    }
+    crate::files::write_atomic(&out.join(DRAWS), text.as_bytes())?;
+    let counted = |d: &&Draw| r.estimator == Estimator::Mc || d.stage == super::DrawStage::Final;
+    let summary = Summary {
+        schema: 1,
+        run,
+        space_file: cfg.space.source.clone(),
+        estimand: format!(
+            "P(an episode of {} fails) with the scenario drawn uniformly from the space's unit cube (conditioned on a \
+             valid map) and each episode's randomness from its seed; P(fails | fair) = P(fails and fair) / P(fair); \
+             the method's agents (training seeds) weigh evenly",
+            cfg.method.name()
+        ),
+        failure_threshold: FailureThreshold::episode(r.episodes),
+        estimates: outcome.estimates.clone(),
+        evaluations: outcome.draws.len(),
+        rejected: outcome.draws.iter().filter(|d| d.rejected.is_some()).count(),
+        estimate_draws: outcome.draws.iter().filter(counted).count(),
+        method_episodes: outcome.draws.iter().map(|d| d.episodes).sum(),
+        target_reached: outcome.reached,
+        proposal: outcome.proposal.clone(),
+        checkpoints: outcome.checkpoints.clone(),
+    };
+    crate::files::write_json(&out.join(SUMMARY), &summary)?;
+    Ok(summary)
+}

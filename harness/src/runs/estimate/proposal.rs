@@ -1,0 +1,229 @@
+//! The importance-sampling proposal over the space's unit cube: the uniform cube at
+//! first, then a defensive mixture (Hesterberg 1995) `q = α + (1 − α) ∏ f_d`, `α =`
+//! [`DEFENSIVE`], of one marginal per parameter (a normal truncated to [0, 1] for a range,
+//! cell probabilities spread evenly within each cell for a count or a choice), refitted
+//! by the cross-entropy method (Rubinstein 1999) to the draws with the smallest margins.
+//! The uniform part keeps every point of the cube in the proposal's support and bounds
+//! every weight `1/q` by `1/α`.
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{Continuous, ContinuousCDF, Normal};
+
+use crate::runs::search::Space;
+use crate::runs::search::space::Domain;
+use unforeseen_env::seeds::episode_seed;
+
+/// The uniform share of a fitted proposal.
+pub const DEFENSIVE: f64 = 0.2;
+/// Share of the scored draws that form the elite.
+pub const ELITE_SHARE: f64 = 0.1;
+/// Fewest elite draws (a refit waits until it has them).
+pub const MIN_ELITE: usize = 10;
+/// How far a refit moves each marginal toward the elite's (1 = all the way).
+pub const SMOOTHING: f64 = 0.7;
+/// Smallest standard deviation of a range's normal, on the unit interval.
+pub const MIN_SD: f64 = 0.05;
+/// Smallest probability of a cell.
+pub const MIN_CELL: f64 = 0.02;
+
+/// One parameter's part of a fitted proposal.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Marginal {
+    /// A normal (mean, standard deviation) truncated to [0, 1].
+    Normal {
+        /// Mean, on the unit interval.
+        mean: f64,
+        /// Standard deviation, on the unit interval.
+        sd: f64,
+    },
+    /// The cells' probabilities (each spread evenly over its cell).
+    Cells(Vec<f64>),
+}
+
+/// The proposal: the uniform cube, or a fitted defensive mixture.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Proposal {
+    /// The fitted marginals (none: the uniform cube).
+    pub marginals: Option<Vec<Marginal>>,
+}
+
+/// A point to refit on: its coordinates, its weight (target over proposal density) and
+/// its score (lower is nearer a failure; infinite never counts).
+pub type Scored<'a> = (&'a [f64], f64, f64);
+
+impl Proposal {
+    /// The uniform cube.
+    pub fn uniform() -> Proposal {
+        Proposal { marginals: None }
+    }
+
+    /// The density at `x` (1 for the uniform cube).
+    pub fn density(&self, x: &[f64]) -> f64 {
+        let Some(marginals) = &self.marginals else { return 1.0 };
+        let product: f64 = marginals.iter().zip(x).map(|(m, &u)| marginal_density(m, u)).product();
+        DEFENSIVE + (1.0 - DEFENSIVE) * product
+    }
+
+    /// Draw `index` of the stream `stream` of run seed `seed`, with `dims` coordinates:
+    /// its own generator, so that draws do not depend on each other's order.
+    pub fn draw(&self, seed: u64, stream: &str, index: usize, dims: usize) -> Vec<f64> {
+        let mut rng = ChaCha8Rng::seed_from_u64(episode_seed(seed, stream, index as u64));
+        let fitted = self
+            .marginals
+            .as_ref()
+            .filter(|_| rng.random_range(0.0..1.0) >= DEFENSIVE);
+        match fitted {
+            None => (0..dims).map(|_| rng.random_range(0.0..1.0)).collect(),
+            Some(ms) => ms.iter().map(|m| marginal_draw(m, &mut rng)).collect(),
+        }
+    }
+
+    /// The cross-entropy refit to the elite of `scored`: the [`ELITE_SHARE`] of the draws
+    /// with a finite score (at least [`MIN_ELITE`]; fewer: no refit), lowest first, ties
+    /// by order; each marginal moves [`SMOOTHING`] of the way to the elite's weighted
+    /// mean and standard deviation (or cell frequencies), floored at [`MIN_SD`] (or
+    /// [`MIN_CELL`]).
+    pub fn refit(&self, space: &Space, scored: &[Scored<'_>]) -> Proposal {
+        let mut order: Vec<usize> = (0..scored.len()).filter(|&i| scored[i].2.is_finite()).collect();
+        if order.len() < MIN_ELITE {
+            return self.clone();
+        }
+        order.sort_by(|&a, &b| scored[a].2.total_cmp(&scored[b].2).then(a.cmp(&b)));
+        let n = ((order.len() as f64 * ELITE_SHARE).ceil() as usize).max(MIN_ELITE);
+        let elite: Vec<(&[f64], f64)> = order[..n].iter().map(|&i| (scored[i].0, scored[i].1)).collect();
+        let total: f64 = elite.iter().map(|e| e.1).sum();
+        let before = self.marginals.clone().unwrap_or_else(|| uniform_marginals(space));
+        let marginals = before
+            .into_iter()
+            .enumerate()
+            .map(|(d, m)| match m {
+                Marginal::Normal { mean, sd } => {
+                    let mu = elite.iter().map(|(x, w)| w * x[d]).sum::<f64>() / total;
+                    let var = elite.iter().map(|(x, w)| w * (x[d] - mu).powi(2)).sum::<f64>() / total;
+                    Marginal::Normal {
+                        mean: SMOOTHING * mu + (1.0 - SMOOTHING) * mean,
+                        sd: (SMOOTHING * var.sqrt() + (1.0 - SMOOTHING) * sd).max(MIN_SD),
+                    }
+                }
+                Marginal::Cells(p) => {
+                    let k = p.len();
+                    let mut freq = vec![0.0; k];
+                    for (x, w) in &elite {
+                        freq[cell(x[d], k)] += w / total;
+                    }
+                    let p: Vec<f64> = p
+                        .iter()
+                        .zip(freq)
+                        .map(|(pi, f)| (SMOOTHING * f + (1.0 - SMOOTHING) * pi).max(MIN_CELL))
+                        .collect();
+                    let sum: f64 = p.iter().sum();
+                    Marginal::Cells(p.into_iter().map(|x| x / sum).collect())
+                }
+            })
+            .collect();
+        Proposal {
+            marginals: Some(marginals),
+        }
+    }
+}
+
+/// The marginals that start a refit: the uniform interval's mean and standard deviation
+/// for a range, even cells for a count or a choice.
+fn uniform_marginals(space: &Space) -> Vec<Marginal> {
+    space
+        .params
+        .iter()
+        .map(|p| match p.domain {
+            Domain::Range(..) => Marginal::Normal {
+                mean: 0.5,
+                sd: (1.0f64 / 12.0).sqrt(),
+            },
+            _ => {
+                let k = p.cells().unwrap_or(1);
+                Marginal::Cells(vec![1.0 / k as f64; k])
+            }
+        })
+        .collect()
+}
+
+/// The cell of coordinate `u` among `k`.
+fn cell(u: f64, k: usize) -> usize {
+    ((u * k as f64).floor().max(0.0) as usize).min(k - 1)
+}
+
+/// The truncated normal of (mean, sd), and its mass in [0, 1].
+fn truncated(mean: f64, sd: f64) -> (Normal, f64, f64) {
+    let n = Normal::new(mean, sd).expect("a finite mean and sd >= MIN_SD");
+    let (lo, hi) = (n.cdf(0.0), n.cdf(1.0));
+    (n, lo, hi - lo)
+}
+
+fn marginal_density(m: &Marginal, u: f64) -> f64 {
+    match m {
+        Marginal::Normal { mean, sd } => {
+            let (n, _, mass) = truncated(*mean, *sd);
+            n.pdf(u) / mass
+        }
+        Marginal::Cells(p) => p[cell(u, p.len())] * p.len() as f64,
+    }
+}
+
+fn marginal_draw(m: &Marginal, rng: &mut ChaCha8Rng) -> f64 {
+    let u: f64 = rng.random_range(0.0..1.0);
+    let x = match m {
+        // Inverse CDF within [0, 1].
+        Marginal::Normal { mean, sd } => {
+            let (n, lo, mass) = truncated(*mean, *sd);
+            n.inverse_cdf(lo + u * mass)
+        }
+        Marginal::Cells(p) => {
+            let k = p.len();
+            let mut acc = 0.0;
+            let c = p
+                .iter()
+                .position(|pi| {
+                    acc += pi;
+                    u < acc
+                })
+                .unwrap_or(k - 1);
+            (c as f64 + rng.random_range(0.0..1.0)) / k as f64
+        }
+    };
+    x.clamp(0.0, 1.0 - f64::EPSILON)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The density integrates to 1 over the cube and the draws follow it.
+    #[test]
+    fn a_fitted_proposal_is_a_density_its_draws_follow() {
+        let q = Proposal {
+            marginals: Some(vec![
+                Marginal::Normal { mean: 0.8, sd: 0.1 },
+                Marginal::Cells(vec![0.1, 0.2, 0.7]),
+            ]),
+        };
+        let grid = 300;
+        let mut integral = 0.0;
+        for i in 0..grid {
+            for j in 0..grid {
+                let x = [(i as f64 + 0.5) / grid as f64, (j as f64 + 0.5) / grid as f64];
+                integral += q.density(&x) / (grid * grid) as f64;
+            }
+        }
+        assert!((integral - 1.0).abs() < 1e-3, "integral {integral}");
+        let draws: Vec<Vec<f64>> = (0..4000).map(|i| q.draw(7, "test", i, 2)).collect();
+        let in_last_cell = draws.iter().filter(|x| x[1] >= 2.0 / 3.0).count() as f64 / 4000.0;
+        // 0.2/3 + 0.8 × 0.7.
+        assert!((in_last_cell - (0.2 / 3.0 + 0.56)).abs() < 0.03, "{in_last_cell}");
+        // Importance weights 1/q of draws from q average to 1 (the cube's volume).
+        let mean_weight = draws.iter().map(|x| 1.0 / q.density(x)).sum::<f64>() / 4000.0;
+        assert!((mean_weight - 1.0).abs() < 0.05, "{mean_weight}");
+        assert_eq!(q.draw(7, "test", 3, 2), draws[3]);
+    }
+}

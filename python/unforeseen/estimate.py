@@ -1,0 +1,55 @@
+"""``unforeseen estimate`` in this process: how rare a method's failures are on a space of
+map variations (README, "How rare is a failure"), P(an episode fails) and P(fails | fair)
+with their intervals, with the arguments of the library's estimate request and the same
+folder of outputs (``estimate.jsonl``, ``summary.json``), byte for byte, as the command
+line writes them. The request is planned, its agents trained and the estimate run by
+the library (``unforeseen_harness::runs::estimate``)."""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Iterable
+from typing import Any
+
+from . import _unforeseen
+
+
+def estimate(
+    space: str | os.PathLike[str] | None = None,
+    *,
+    map: str | os.PathLike[str] = "jaywalk",
+    method: str = "scaled",
+    protocol: str = "zero-shot",
+    estimator: str = "mc",
+    target_rel_error: float = 0.3,
+    budget: int = 2000,
+    episodes: int = 4,
+    seed: int = 7,
+    jobs: int | None = None,
+    out: str | os.PathLike[str] = "out/estimate",
+    force: bool = False,
+    agent: str | os.PathLike[str] | None = None,
+    train_seeds: Iterable[int] | str | None = None,
+    train_episodes: int = 6000,
+    timeout_as: str = "truncation",
+    cache: str | os.PathLike[str] | None = None,
+) -> dict[str, Any]:
+    """Estimates P(an episode of ``method`` fails) and P(fails | fair) when the scenario is
+    drawn uniformly from ``space`` (a space file over the base ``map``), as ``unforeseen
+    estimate`` does: by ``estimator`` (``"mc"``, plain Monte Carlo with the Wilson
+    interval, or ``"is"``, cross-entropy importance sampling with a weighted interval), at
+    most ``budget`` draws of ``episodes`` episodes each, stopping once both relative
+    half-widths are at most ``target_rel_error``. Agents: ``agent`` (an agent file), one
+    per training seed (``train_seeds``, trained on the intersection for
+    ``train_episodes`` and kept in ``cache`` when given), or, with neither, one trained
+    with ``seed``. ``jobs`` threads (None: every core; the results do not depend on it);
+    ``force`` replaces files in ``out`` an estimate did not write.
+
+    Writes the folder ``out`` and returns ``summary.json``'s contents. ``ValueError``
+    names a bad argument (``target_rel_error: ...``), map or space before any work;
+    Ctrl-C raises ``KeyboardInterrupt``."""
+    fields = dict(locals())
+    if space is None:
+        fields.pop("space")
+    return json.loads(_unforeseen.estimate(fields))
