@@ -6,7 +6,7 @@
 //!
 //! Functions that run a whole phase (training several agents, a study, a batch, learning
 //! curves) announce it and finish it; the building blocks they share
-//! ([`crate::training::train_with_progress`], [`crate::episodes::evaluation::evaluate_under`] and
+//! ([`crate::training::train_with_progress`], [`crate::episodes::evaluation::run_agent_episodes`] and
 //! its siblings) only advance, so several of them running in parallel share one phase.
 
 use crate::error::Error;

@@ -197,11 +197,11 @@ fn batch_warns_from_its_reference_units_and_eval_needs_no_agent() {
 /// same map, `red_light: 0`) the witness ignores the light, as before.
 #[test]
 fn brake_on_pedestrian_stops_for_red_where_the_map_has_the_rule() {
-    use unforeseen_harness::episodes::evaluate_scripted;
+    use unforeseen_harness::episodes::run_scripted_episodes;
     let mut map = unforeseen_harness::maps::load(&shipped("red_light/red_on_approach.ron")).unwrap();
     assert_eq!(map.reward.red_light, -100.0);
     let run = |map: &unforeseen_sim::Map, method| {
-        Aggregate::of(&evaluate_scripted(map, method, EPISODES, 7, &NoProgress).unwrap())
+        Aggregate::of(&run_scripted_episodes(map, method, EPISODES, 7, &NoProgress).unwrap())
     };
     let careful = run(&map, Method::BrakeOnPedestrian);
     assert_eq!(

@@ -245,7 +245,7 @@ fn one_and_two_jobs_write_identical_outputs_and_minimised_failures_fail() {
         assert!(f.method_success.iter().all(|&(_, s)| s < 0.5), "{f:?}");
         // The written map is that scenario: re-run as batch would, it fails again.
         let map = unforeseen_harness::maps::load_file(&f.file).expect("a valid map file");
-        let results = unforeseen_harness::episodes::evaluate_under(
+        let results = unforeseen_harness::episodes::run_agent_episodes(
             Protocol::ZeroShot,
             &map,
             bundle(),

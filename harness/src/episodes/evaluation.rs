@@ -67,7 +67,7 @@ pub fn run_controller(
 /// Seeds derive from (seed, map, method, episode), so results do not depend on the
 /// number of threads.
 #[allow(clippy::too_many_arguments)]
-pub fn evaluate_under(
+pub fn run_agent_episodes(
     protocol: Protocol,
     map: &Map,
     bundle: &AgentBundle,
@@ -79,16 +79,16 @@ pub fn evaluate_under(
 ) -> Result<Vec<EpisodeResult>, Error> {
     check_compatible(bundle, map)?;
     let make = || method.controller(bundle, params, map);
-    evaluate_with(protocol, map, method, params, &make, episodes, seed, progress)
+    run_episodes_with(protocol, map, method, params, &make, episodes, seed, progress)
 }
 
 /// Makes a fresh controller of the method being evaluated.
 pub type MakeController<'a> = dyn Fn() -> Result<Box<dyn Controller>, Error> + Sync + 'a;
 
-/// [`evaluate_under`] with the controllers made by `make` (e.g. a scripted reference,
+/// [`run_agent_episodes`] with the controllers made by `make` (e.g. a scripted reference,
 /// which needs no trained agent).
 #[allow(clippy::too_many_arguments)]
-pub fn evaluate_with(
+pub fn run_episodes_with(
     protocol: Protocol,
     map: &Map,
     method: Method,
@@ -120,7 +120,7 @@ pub fn evaluate_with(
     }
 }
 
-/// Makes a fresh controller, for [`evaluate_in_order`] (it may borrow, and need not be `Sync`).
+/// Makes a fresh controller, for [`run_episodes_in_order`] (it may borrow, and need not be `Sync`).
 pub type MakeControllerMut<'a, 'c> = dyn FnMut() -> Result<Box<dyn Controller + 'c>, Error> + 'a;
 
 /// Runs `episodes` evaluation episodes of the method named `method` on `map` under
@@ -128,10 +128,10 @@ pub type MakeControllerMut<'a, 'c> = dyn FnMut() -> Result<Box<dyn Controller + 
 /// seeds of that name ([`eval_seeds_named`]), advancing `progress` by one per episode.
 /// Zero-shot: a fresh controller from `make` per episode; continual: one controller
 /// throughout. For controllers that must not run on several threads at once (a policy
-/// given from Python: [`evaluate_with`] runs zero-shot episodes in parallel); the results
-/// are those [`evaluate_with`] gives for the same controllers and name.
+/// given from Python: [`run_episodes_with`] runs zero-shot episodes in parallel); the results
+/// are those [`run_episodes_with`] gives for the same controllers and name.
 #[allow(clippy::too_many_arguments)]
-pub fn evaluate_in_order(
+pub fn run_episodes_in_order(
     protocol: Protocol,
     map: &Map,
     config: EnvConfig,
@@ -163,7 +163,7 @@ pub fn evaluate_in_order(
 
 /// Runs `episodes` episodes of a scripted reference `method` ([`Method::REFERENCE`]) on
 /// `map`; it needs no trained agent and does not learn, so every protocol is zero-shot.
-pub fn evaluate_scripted(
+pub fn run_scripted_episodes(
     map: &Map,
     method: Method,
     episodes: u64,
@@ -178,7 +178,7 @@ pub fn evaluate_scripted(
                 method: method.to_string(),
             })
     };
-    evaluate_with(
+    run_episodes_with(
         Protocol::ZeroShot,
         map,
         method,
@@ -290,9 +290,9 @@ pub fn evaluate_map(
     progress: &dyn Progress,
 ) -> Result<EvalReport, Error> {
     let (results, train_seed) = match (method.is_scripted(), bundle) {
-        (true, _) => (evaluate_scripted(map, method, episodes, seed, progress)?, None),
+        (true, _) => (run_scripted_episodes(map, method, episodes, seed, progress)?, None),
         (false, Some(b)) => (
-            evaluate_under(protocol, map, b, params, method, episodes, seed, progress)?,
+            run_agent_episodes(protocol, map, b, params, method, episodes, seed, progress)?,
             b.meta.get("seed").cloned(),
         ),
         (false, None) => {

@@ -16,8 +16,8 @@ pub(crate) mod tick_recording;
 pub(crate) mod trace;
 
 pub use evaluation::{
-    EvalReport, MakeController, MakeControllerMut, MethodRow, eval_seeds, eval_seeds_named, evaluate_in_order,
-    evaluate_map, evaluate_scripted, evaluate_under, evaluate_with, method_row, run_controller,
+    EvalReport, MakeController, MakeControllerMut, MethodRow, eval_seeds, eval_seeds_named, evaluate_map, method_row,
+    run_agent_episodes, run_controller, run_episodes_in_order, run_episodes_with, run_scripted_episodes,
 };
 pub use learning_curves::{LearnPoint, learn};
 pub use methods::{Method, PaperFigures, UnknownMethod, check_compatible, scaled_agent};

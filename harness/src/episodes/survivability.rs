@@ -29,7 +29,7 @@
 
 use unforeseen_sim::Map;
 
-use crate::episodes::evaluation::evaluate_scripted;
+use crate::episodes::evaluation::run_scripted_episodes;
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::error::Error;
@@ -117,7 +117,7 @@ impl Witness {
 /// Runs `episodes` episodes of a scripted `method` on `map` (in parallel; seeded by
 /// [`crate::episodes::evaluation::eval_seeds`], so the result does not depend on the number of threads).
 pub fn witness(map: &Map, method: Method, episodes: u64, seed: u64) -> Result<Witness, Error> {
-    let results = evaluate_scripted(map, method, episodes, seed, &NoProgress)?;
+    let results = run_scripted_episodes(map, method, episodes, seed, &NoProgress)?;
     Ok(Witness::of(&Aggregate::of(&results)))
 }
 
@@ -144,7 +144,7 @@ pub fn careful_witness(
 ) -> Result<(Witness, Aggregate), Error> {
     let mut worst: Option<(Witness, Aggregate)> = None;
     for fraction in careful_cruises(map) {
-        let agg = Aggregate::of(&evaluate_scripted(
+        let agg = Aggregate::of(&run_scripted_episodes(
             &at_cruise(map, fraction),
             Method::BrakeOnPedestrian,
             episodes,

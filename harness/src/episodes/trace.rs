@@ -12,7 +12,7 @@ use crate::episodes::protocol::Protocol;
 use crate::episodes::runner::{EpisodeResult, Tick, run_episode};
 use crate::error::Error;
 
-/// Runs evaluation episode `episode` of `method` (seeded as in [`evaluate_under`](crate::episodes::evaluation::evaluate_under)) with
+/// Runs evaluation episode `episode` of `method` (seeded as in [`run_agent_episodes`](crate::episodes::evaluation::run_agent_episodes)) with
 /// its ticks recorded, and returns its result and ticks. Under the continual protocol the
 /// controller first runs evaluation episodes `0..episode` in order and learns from them,
 /// so the traced episode is exactly the one a continual evaluation meets at that index.

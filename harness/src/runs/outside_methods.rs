@@ -1,6 +1,6 @@
 //! Methods given from outside the library (a Python policy, or the scaled agent around a
 //! Python habit): evaluated by the episode runner the built-in methods use
-//! ([`evaluate_in_order`]), their figures from [`Aggregate`], and reported as the batch's
+//! ([`run_episodes_in_order`]), their figures from [`Aggregate`], and reported as the batch's
 //! result lines ([`ResultLine`]), so that they sit in a results file beside the built-in
 //! methods and the batch summary reads them alike. The fronts only make the controller.
 //!
@@ -15,7 +15,7 @@
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_env::EnvConfig;
 
-use crate::episodes::evaluation::{MakeControllerMut, evaluate_in_order};
+use crate::episodes::evaluation::{MakeControllerMut, run_episodes_in_order};
 use crate::episodes::metrics::{Aggregate, efe_prefix_tree};
 use crate::episodes::protocol::Protocol;
 use crate::episodes::runner::EpisodeResult;
@@ -63,7 +63,7 @@ pub struct ExternalRun {
 
 /// Evaluates `method` on the map of `scenario` under `protocols` (once per protocol if it
 /// learns across episodes, else once for all: [`ExternalMethod::learns`]), `episodes`
-/// episodes from `seed` each, in order on the calling thread ([`evaluate_in_order`]:
+/// episodes from `seed` each, in order on the calling thread ([`run_episodes_in_order`]:
 /// zero-shot makes a fresh controller per episode, continual one throughout), and reports
 /// each run as a result line placed at `place`. A stream scenario, or no protocol, is an
 /// [`Error::OutOfRange`].
@@ -101,7 +101,7 @@ pub fn evaluate_external(
         // A method that does not learn runs as zero-shot (a fresh controller per episode),
         // whatever protocol its line names first, as the batch runs built-in methods.
         let mode = if method.learns { protocol } else { Protocol::ZeroShot };
-        let results = evaluate_in_order(
+        let results = run_episodes_in_order(
             mode,
             map,
             method.config.clone(),
@@ -137,7 +137,7 @@ pub fn evaluate_external(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::episodes::evaluation::evaluate_scripted;
+    use crate::episodes::evaluation::run_scripted_episodes;
     use crate::episodes::methods::Method;
     use crate::episodes::reference::NeverBrake;
     use crate::progress::NoProgress;
@@ -184,7 +184,7 @@ mod tests {
         assert_eq!((run.line.unit, run.line.protocol), (4, Protocol::Continual));
         assert_eq!(run.line.covers, protocols);
         let map = scenario.map().unwrap();
-        let built_in = evaluate_scripted(map, Method::NeverBrake, 6, 3, &NoProgress).unwrap();
+        let built_in = run_scripted_episodes(map, Method::NeverBrake, 6, 3, &NoProgress).unwrap();
         assert_eq!(untimed(run.episodes.clone()), untimed(built_in.clone()));
         let agg = Aggregate::of(&built_in);
         assert_eq!(run.line.collision_rate, agg.collision_rate);

@@ -8,7 +8,7 @@ use unforeseen_agent::params::ScaledParams;
 use unforeseen_harness::episodes::EpisodeResult;
 use unforeseen_harness::episodes::Method;
 use unforeseen_harness::episodes::Protocol;
-use unforeseen_harness::episodes::{evaluate_under, run_controller};
+use unforeseen_harness::episodes::{run_agent_episodes, run_controller};
 use unforeseen_harness::progress::NoProgress;
 
 /// Results without the wall-clock fields.
@@ -29,7 +29,7 @@ fn zero_shot(method: Method, threads: usize) -> Vec<EpisodeResult> {
     let params = ScaledParams::default();
     let hidden = NoProgress;
     untimed(pool.install(|| {
-        evaluate_under(
+        run_agent_episodes(
             Protocol::ZeroShot,
             &jaywalk,
             fixtures::bundle(),

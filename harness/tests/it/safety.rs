@@ -20,7 +20,7 @@ use unforeseen_env::{Env, EnvConfig};
 use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::episodes::{EpisodeResult, run_episode};
 use unforeseen_harness::episodes::{Method, scaled_agent};
-use unforeseen_harness::episodes::{eval_seeds, evaluate_under};
+use unforeseen_harness::episodes::{eval_seeds, run_agent_episodes};
 use unforeseen_harness::fixtures;
 use unforeseen_harness::progress::NoProgress;
 use unforeseen_harness::training::{DEFAULT_TRAIN_EPISODES, TrainConfig, train};
@@ -43,7 +43,7 @@ fn crowd() -> unforeseen_sim::Map {
 }
 
 fn run(bundle: &AgentBundle, method: Method, protocol: Protocol, params: &ScaledParams) -> Vec<EpisodeResult> {
-    evaluate_under(protocol, &crowd(), bundle, params, method, EPISODES, 7, &NoProgress).unwrap()
+    run_agent_episodes(protocol, &crowd(), bundle, params, method, EPISODES, 7, &NoProgress).unwrap()
 }
 
 /// Episodes the agent without learning survives and `learning` loses (both meet the same

@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
 
-use crate::episodes::evaluation::{evaluate_scripted, evaluate_under};
+use crate::episodes::evaluation::{run_agent_episodes, run_scripted_episodes};
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::runner::EpisodeResult;
 use crate::error::Error;
@@ -21,7 +21,7 @@ use super::scenario::ScenarioKind;
 use super::units::Unit;
 
 /// Runs one unit: `episodes` episodes of its method on its scenario with its agent,
-/// under its protocol. A map: [`evaluate_under`] (zero-shot episodes in parallel, each
+/// under its protocol. A map: [`run_agent_episodes`] (zero-shot episodes in parallel, each
 /// from a fresh controller; continual ones in order on one controller). A stream:
 /// [`evaluate_stream`] (the same, over the stream's maps), and the line adds the figures
 /// per map within the stream ([`per_map`]).
@@ -46,7 +46,7 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
     let (agg, per_map_figures) = match &scenario.kind {
         ScenarioKind::Map(map) => {
             let results = match bundle {
-                Some(bundle) => evaluate_under(
+                Some(bundle) => run_agent_episodes(
                     unit.protocol,
                     map,
                     bundle,
@@ -56,7 +56,7 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
                     cfg.seed,
                     &CancelOnly(cancel),
                 )?,
-                None => evaluate_scripted(map, unit.method, cfg.episodes, cfg.seed, &CancelOnly(cancel))?,
+                None => run_scripted_episodes(map, unit.method, cfg.episodes, cfg.seed, &CancelOnly(cancel))?,
             };
             (Aggregate::of(&results), Vec::new())
         }

@@ -19,7 +19,7 @@ use std::collections::BTreeMap;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::{Map, Reward};
 
-use crate::episodes::evaluation::{MethodRow, evaluate_under, method_row};
+use crate::episodes::evaluation::{MethodRow, method_row, run_agent_episodes};
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::Protocol;
@@ -326,7 +326,7 @@ pub fn run_study(
     let aggregates = jobs
         .par_iter()
         .map(|&(agent, method, protocol, map)| {
-            let results = evaluate_under(
+            let results = run_agent_episodes(
                 protocol,
                 maps[map],
                 &agents[agent].bundle,

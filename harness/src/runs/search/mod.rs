@@ -66,7 +66,7 @@ use std::sync::Mutex;
 use unforeseen_agent::params::ScaledParams;
 use unforeseen_sim::Map;
 
-use crate::episodes::evaluation::{evaluate_scripted, evaluate_under};
+use crate::episodes::evaluation::{run_agent_episodes, run_scripted_episodes};
 use crate::episodes::methods::Method;
 use crate::episodes::metrics::Aggregate;
 use crate::episodes::protocol::{Protocol, covered};

@@ -198,7 +198,7 @@ pub fn evaluate_candidate(
     let cancel = CancelOnly(cancel);
     let params = ScaledParams::default();
     let scripted = |m: Method| -> Result<Aggregate, Error> {
-        Ok(Aggregate::of(&evaluate_scripted(
+        Ok(Aggregate::of(&run_scripted_episodes(
             map,
             m,
             cfg.episodes,
@@ -227,7 +227,7 @@ pub fn evaluate_candidate(
                 .iter()
                 .find(|a| a.train_seed == seed)
                 .ok_or(Error::MissingAgent { train_seed: seed })?;
-            let results = evaluate_under(
+            let results = run_agent_episodes(
                 cfg.protocol,
                 map,
                 &agent.bundle,
