@@ -484,3 +484,54 @@ fn the_dynamics_space_sets_surface_and_brakes() {
     .to_string();
     assert!(err.contains("1 surface patch(es), not 2"), "{err}");
 }
+
+/// `maps/spaces/junction.ron` on the red-runner junction varies the base's vehicle and a
+/// space's own: the lowest corner gives the base's runner a route from the south that
+/// runs the red at the lowest timing, speed and start, and no second vehicle; the highest
+/// corner one stalled car from the south arm's opposite side and a careful oncoming
+/// left-turner; a traffic rule the base and the space do not have is an error.
+#[test]
+fn the_junction_space_sets_the_vehicle_rules() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = Map::load(&root.join("maps/junction/red_runner.ron")).unwrap();
+    let n = base.traffic.len();
+    let space = Space::load(&root.join("maps/spaces/junction.ron"), &base).expect("valid");
+    let low = space
+        .apply(&space.values_at(&vec![0.0; space.params.len()]), "low")
+        .expect("the lowest corner is a valid map");
+    assert_eq!(low.traffic.len(), n, "no copy of the space's vehicle at copies 0");
+    let runner = low.traffic[n - 1];
+    assert_eq!(runner.route, unforeseen_sim::Route::FromSouth);
+    assert_eq!(runner.behaviour, unforeseen_sim::Behaviour::RunsRed);
+    assert_eq!(runner.trigger, unforeseen_sim::Trigger::CarArrivesWithin(2.0));
+    assert_eq!((runner.speed.0, runner.start), (6.0, 20.0));
+    let high = space
+        .apply(&space.values_at(&vec![0.999; space.params.len()]), "high")
+        .expect("the highest corner is a valid map");
+    assert_eq!(high.traffic.len(), n + 1, "one copy of the space's vehicle");
+    assert_eq!(high.traffic[n - 1].route, unforeseen_sim::Route::OncomingLeft);
+    assert!(
+        matches!(high.traffic[n - 1].behaviour, unforeseen_sim::Behaviour::Stalls { at, .. } if (at - 7.992).abs() < 1e-9),
+        "{:?}",
+        high.traffic[n - 1].behaviour
+    );
+    let second = high.traffic[n];
+    assert_eq!(second.route, unforeseen_sim::Route::OncomingLeft);
+    assert_eq!(second.behaviour, unforeseen_sim::Behaviour::Careful);
+    let err = Space::parse(
+        "bad.ron",
+        "Space(params: [(field: \"traffic[9].speed\", range: (5.0, 6.0))])",
+        &base,
+    )
+    .expect_err("the base has fewer traffic rules")
+    .to_string();
+    assert!(err.contains(&format!("the base map has {n} traffic rule(s)")), "{err}");
+    let err = Space::parse(
+        "bad.ron",
+        "Space(params: [(field: \"traffic[0].behaviour\", choose: [\"Reckless\"])])",
+        &base,
+    )
+    .expect_err("no such behaviour")
+    .to_string();
+    assert!(err.contains("the choices are Careful, RunsRed"), "{err}");
+}

@@ -11,7 +11,9 @@
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
-use unforeseen_sim::{Diagnostic, LightCondition, Map, MapError, Offset, Pause, Side, SpawnRule, Trigger};
+use unforeseen_sim::{
+    Behaviour, Diagnostic, LightCondition, Map, MapError, Offset, Pause, Route, Side, SpawnRule, TrafficRule, Trigger,
+};
 
 /// Most parameters one space may have (dimensions of the scrambled Sobol sequence).
 pub const MAX_PARAMS: usize = 64;
@@ -40,6 +42,11 @@ pub struct SpaceFile {
     /// `pedestrians[N + j]` for a base with N rules.
     #[serde(default)]
     pub rules: Vec<SpawnRule>,
+    /// Traffic rules added after the base map's own (absent from the base: their
+    /// `copies` default to 0, the base's rules' to 1). Refer to them as `traffic[N + j]`
+    /// for a base with N traffic rules.
+    #[serde(default)]
+    pub traffic: Vec<TrafficRule>,
     /// The parameters, in order (the order of the point's coordinates).
     pub params: Vec<ParamSpec>,
 }
@@ -91,7 +98,58 @@ pub enum Field {
     BrakeForce,
     /// A field of the base map's surface patch `i` (`road.surface[i]`).
     Surface(usize, SurfaceField),
+    /// A field of traffic rule `rule` (base rules first, then the space's `traffic`).
+    Traffic(usize, TrafficField),
 }
+
+/// A field of one traffic rule (sim's `TrafficRule`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrafficField {
+    /// Where it drives: `Lead`, `Oncoming`, `FromSouth`, `FromNorth` or `OncomingLeft`.
+    Route,
+    /// How it deviates from a careful driver: `Careful`, `RunsRed`, `DoesNotYield`,
+    /// `Stalls` or `BrakesHard` (a variant's numbers from the rule if it has that
+    /// variant, else [`DEFAULT_STALL`] and [`DEFAULT_BRAKES_HARD`]).
+    Behaviour,
+    /// The trigger's number, as for pedestrian rules.
+    TriggerValue,
+    /// The trigger's kind, as for pedestrian rules.
+    TriggerKind,
+    /// The car's signal required when it fires: `Any`, `Green` or `Red`.
+    Light,
+    /// The desired speed's low end, m/s (the rule's width kept).
+    Speed,
+    /// The delay's low end, s (width kept).
+    Delay,
+    /// Where it appears, m before its stop line (`Lead`: ahead of the car's front).
+    Start,
+    /// Probability that a firing spawns a vehicle.
+    Probability,
+    /// How many copies of the rule the map has (a whole number).
+    Copies,
+    /// `Stalls`' `at`: metres past its stop line where it stalls (no effect on another
+    /// behaviour).
+    StallAt,
+    /// `BrakesHard`'s `after`, s (no effect on another behaviour).
+    BrakeAfter,
+    /// `BrakesHard`'s `decel`, m/s² (no effect on another behaviour).
+    BrakeDecel,
+}
+
+/// The stall a space's `behaviour: Stalls` gives a rule that has none: 3 m into the box,
+/// for ever.
+pub const DEFAULT_STALL: Behaviour = Behaviour::Stalls {
+    at: 3.0,
+    hold: f64::INFINITY,
+};
+
+/// The hard stop a space's `behaviour: BrakesHard` gives a rule that has none: 3 s after
+/// appearing, at 8 m/s², standing 3 s.
+pub const DEFAULT_BRAKES_HARD: Behaviour = Behaviour::BrakesHard {
+    after: 3.0,
+    decel: 8.0,
+    hold: 3.0,
+};
 
 /// A field of one surface patch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -170,6 +228,24 @@ const SURFACE_FIELDS: [(&str, SurfaceField); 3] = [
     ("friction", SurfaceField::Friction),
 ];
 
+const TRAFFIC_FIELDS: [(&str, TrafficField); 13] = [
+    ("route", TrafficField::Route),
+    ("behaviour", TrafficField::Behaviour),
+    ("trigger.value", TrafficField::TriggerValue),
+    ("trigger.kind", TrafficField::TriggerKind),
+    ("light", TrafficField::Light),
+    ("speed", TrafficField::Speed),
+    ("delay", TrafficField::Delay),
+    ("start", TrafficField::Start),
+    ("probability", TrafficField::Probability),
+    ("copies", TrafficField::Copies),
+    ("stall_at", TrafficField::StallAt),
+    ("brake_after", TrafficField::BrakeAfter),
+    ("brake_decel", TrafficField::BrakeDecel),
+];
+
+const ROUTES: [&str; 5] = ["Lead", "Oncoming", "FromSouth", "FromNorth", "OncomingLeft"];
+const BEHAVIOURS: [&str; 5] = ["Careful", "RunsRed", "DoesNotYield", "Stalls", "BrakesHard"];
 const TRIGGER_KINDS: [&str; 3] = ["CarArrivesWithin", "AtTime", "CarWithin"];
 const LIGHTS: [&str; 3] = ["Any", "Green", "Red"];
 const SIDES: [&str; 3] = ["Near", "Far", "Random"];
@@ -182,11 +258,13 @@ fn field_list() -> String {
         .iter()
         .map(|(n, _)| format!("road.surface[i].{n}"))
         .collect();
+    let traffic: Vec<String> = TRAFFIC_FIELDS.iter().map(|(n, _)| format!("traffic[i].{n}")).collect();
     format!(
-        "{}, light.cycle[i].duration, {}, {}",
+        "{}, light.cycle[i].duration, {}, {}, {}",
         global.join(", "),
         surface.join(", "),
-        rule.join(", ")
+        rule.join(", "),
+        traffic.join(", ")
     )
 }
 
@@ -212,6 +290,14 @@ impl Field {
                 .find(|(n, _)| *n == name)
                 .map(|(_, f)| Field::Surface(i, *f));
         }
+        if let Some(rest) = text.strip_prefix("traffic[") {
+            let (i, tail) = index(rest)?;
+            let name = tail.strip_prefix('.')?;
+            return TRAFFIC_FIELDS
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, f)| Field::Traffic(i, *f));
+        }
         let rest = text.strip_prefix("pedestrians[")?;
         let (i, tail) = index(rest)?;
         let name = tail.strip_prefix('.')?;
@@ -227,6 +313,10 @@ impl Field {
             Field::Rule(_, RuleField::TriggerKind) => Some(&TRIGGER_KINDS),
             Field::Rule(_, RuleField::Light) => Some(&LIGHTS),
             Field::Rule(_, RuleField::Side) => Some(&SIDES),
+            Field::Traffic(_, TrafficField::Route) => Some(&ROUTES),
+            Field::Traffic(_, TrafficField::Behaviour) => Some(&BEHAVIOURS),
+            Field::Traffic(_, TrafficField::TriggerKind) => Some(&TRIGGER_KINDS),
+            Field::Traffic(_, TrafficField::Light) => Some(&LIGHTS),
             _ => None,
         }
     }
@@ -234,7 +324,16 @@ impl Field {
     /// The values the map limits (maps/README.md, "Limits") allow, with the unit.
     fn limits(self, base: &Map) -> (f64, f64, &'static str) {
         use RuleField as R;
+        use TrafficField as T;
         match self {
+            Field::Traffic(_, T::TriggerValue) => (0.0, 3600.0, "s or m"),
+            Field::Traffic(_, T::Speed) => (0.01, 70.0, "m/s"),
+            Field::Traffic(_, T::Delay | T::BrakeAfter) => (0.0, 3600.0, "s"),
+            Field::Traffic(_, T::Start | T::StallAt) => (0.0, unforeseen_sim::MAX_METRES, "m"),
+            Field::Traffic(_, T::Probability) => (0.0, 1.0, "(a probability)"),
+            Field::Traffic(_, T::Copies) => (0.0, unforeseen_sim::MAX_SPAWN_RULES as f64, "copies"),
+            Field::Traffic(_, T::BrakeDecel) => (0.1, unforeseen_sim::traffic::MAX_DECEL, "m/s²"),
+            Field::Traffic(_, T::Route | T::Behaviour | T::TriggerKind | T::Light) => (0.0, 0.0, ""),
             Field::Rule(_, R::TriggerValue) => (0.0, 3600.0, "s or m"),
             Field::Rule(_, R::Speed) => (0.01, 12.0, "m/s"),
             Field::Rule(_, R::Delay | R::PauseDuration) => (0.0, 3600.0, "s"),
@@ -382,6 +481,8 @@ pub struct Space {
     pub base: Map,
     /// The space's extra rules (after the base's).
     pub rules: Vec<SpawnRule>,
+    /// The space's extra traffic rules (after the base's).
+    pub traffic: Vec<TrafficRule>,
     /// The parameters, in order.
     pub params: Vec<Param>,
     /// The file as read (for the run's identity).
@@ -465,6 +566,8 @@ impl Space {
         let position = |field: &str| locate(text, field);
         let n_base = base.pedestrians.len();
         let n_rules = n_base + file.rules.len();
+        let n_traffic_base = base.traffic.len();
+        let n_traffic = n_traffic_base + file.traffic.len();
         if file.params.is_empty() {
             problems.push(diag(
                 None,
@@ -490,6 +593,17 @@ impl Space {
                     unforeseen_sim::MAX_SPAWN_RULES
                 ),
                 "add fewer rules".into(),
+            ));
+        }
+        if n_traffic > unforeseen_sim::MAX_SPAWN_RULES {
+            problems.push(diag(
+                None,
+                "traffic",
+                format!(
+                    "the base's and the space's traffic rules are {n_traffic}, more than {}",
+                    unforeseen_sim::MAX_SPAWN_RULES
+                ),
+                "add fewer traffic rules".into(),
             ));
         }
         let mut params: Vec<Param> = Vec::new();
@@ -520,6 +634,18 @@ impl Space {
                         file.rules.len()
                     ),
                     format!("use an index below {n_rules}, or add the rule to the space's `rules`"),
+                );
+                continue;
+            }
+            if let Field::Traffic(r, _) = field
+                && r >= n_traffic
+            {
+                bad(
+                    format!(
+                        "traffic rule {r} does not exist: the base map has {n_traffic_base} traffic rule(s) and the space adds {}",
+                        file.traffic.len()
+                    ),
+                    format!("use an index below {n_traffic}, or add the rule to the space's `traffic`"),
                 );
                 continue;
             }
@@ -616,7 +742,10 @@ impl Space {
                         );
                         continue;
                     }
-                    if matches!(field, Field::Rule(_, RuleField::Copies)) {
+                    if matches!(
+                        field,
+                        Field::Rule(_, RuleField::Copies) | Field::Traffic(_, TrafficField::Copies)
+                    ) {
                         if lo.fract() != 0.0 || hi.fract() != 0.0 {
                             bad(
                                 format!("copies are whole numbers, found ({lo}, {hi})"),
@@ -650,8 +779,29 @@ impl Space {
                     continue;
                 }
             }
+            let traffic_of = |r: usize| {
+                if r < n_traffic_base {
+                    &base.traffic[r]
+                } else {
+                    &file.traffic[r - n_traffic_base]
+                }
+            };
+            if let Field::Traffic(r, TrafficField::TriggerValue) = field {
+                let kind_varies = file
+                    .params
+                    .iter()
+                    .any(|q| Field::parse(&q.field) == Some(Field::Traffic(r, TrafficField::TriggerKind)));
+                if !kind_varies && trigger_value(&traffic_of(r).trigger).is_none() {
+                    bad(
+                        format!("traffic rule {r}'s trigger {:?} has no number to vary", traffic_of(r).trigger),
+                        "vary `trigger.value` of a rule triggered by CarArrivesWithin, AtTime or CarWithin, or vary its `trigger.kind` too".into(),
+                    );
+                    continue;
+                }
+            }
             let base_value = match field {
                 Field::Rule(r, f) => rule_value(rule_of(r), f, r < n_base),
+                Field::Traffic(r, f) => traffic_value(traffic_of(r), f, r < n_traffic_base),
                 _ => global_value(base, field),
             };
             params.push(Param {
@@ -682,6 +832,7 @@ impl Space {
             source: origin.to_string(),
             base: base.clone(),
             rules: file.rules,
+            traffic: file.traffic,
             params,
             text: text.to_string(),
         })
@@ -704,10 +855,14 @@ impl Space {
         let mut rules: Vec<SpawnRule> = map.pedestrians.iter().chain(&self.rules).cloned().collect();
         let n_base = map.pedestrians.len();
         let mut copies: Vec<u32> = (0..rules.len()).map(|r| u32::from(r < n_base)).collect();
+        let mut traffic: Vec<TrafficRule> = map.traffic.iter().chain(&self.traffic).copied().collect();
+        let n_traffic_base = map.traffic.len();
+        let mut traffic_copies: Vec<u32> = (0..traffic.len()).map(|r| u32::from(r < n_traffic_base)).collect();
         // Kinds before the numbers they carry; copies last (the copies are of the varied rule).
         let order = |f: &Field| match f {
-            Field::Rule(_, RuleField::TriggerKind) => 0,
-            Field::Rule(_, RuleField::Copies) => 2,
+            Field::Rule(_, RuleField::TriggerKind)
+            | Field::Traffic(_, TrafficField::TriggerKind | TrafficField::Behaviour) => 0,
+            Field::Rule(_, RuleField::Copies) | Field::Traffic(_, TrafficField::Copies) => 2,
             _ => 1,
         };
         let mut todo: Vec<(&Param, &Value)> = self.params.iter().zip(values).collect();
@@ -726,41 +881,9 @@ impl Space {
                     let rule = &mut rules[r];
                     match f {
                         RuleField::Copies => copies[r] = num()?.max(0.0).round() as u32,
-                        RuleField::TriggerKind => {
-                            let value = trigger_value(&rule.trigger);
-                            rule.trigger = match name_of()? {
-                                "CarArrivesWithin" => Trigger::CarArrivesWithin(value.unwrap_or(4.8)),
-                                "AtTime" => Trigger::AtTime(value.unwrap_or(5.0)),
-                                "CarWithin" => {
-                                    let min = value.unwrap_or(40.0);
-                                    Trigger::CarWithin {
-                                        min,
-                                        max: min + CAR_WITHIN_WIDTH,
-                                    }
-                                }
-                                other => return Err(format!("{}: unknown trigger kind {other}", p.name)),
-                            }
-                        }
-                        RuleField::TriggerValue => {
-                            let x = num()?;
-                            rule.trigger = match rule.trigger {
-                                Trigger::CarArrivesWithin(_) => Trigger::CarArrivesWithin(x),
-                                Trigger::AtTime(_) => Trigger::AtTime(x),
-                                Trigger::CarWithin { min, max } => Trigger::CarWithin {
-                                    min: x,
-                                    max: x + (max - min),
-                                },
-                                t => return Err(format!("{}: the trigger {t:?} has no number", p.name)),
-                            }
-                        }
-                        RuleField::Light => {
-                            rule.light = match name_of()? {
-                                "Any" => LightCondition::Any,
-                                "Green" => LightCondition::Green,
-                                "Red" => LightCondition::Red,
-                                other => return Err(format!("{}: unknown light {other}", p.name)),
-                            }
-                        }
+                        RuleField::TriggerKind => rule.trigger = with_kind(&rule.trigger, name_of()?, &p.name)?,
+                        RuleField::TriggerValue => rule.trigger = with_value(&rule.trigger, num()?, &p.name)?,
+                        RuleField::Light => rule.light = light_named(name_of()?, &p.name)?,
                         RuleField::Side => {
                             rule.side = match name_of()? {
                                 "Near" => Side::Near,
@@ -791,6 +914,56 @@ impl Space {
                         }
                         RuleField::Probability => rule.probability = num()?,
                         RuleField::Radius => rule.radius = num()?,
+                    }
+                }
+                Field::Traffic(r, f) => {
+                    let rule = &mut traffic[r];
+                    match f {
+                        TrafficField::Copies => traffic_copies[r] = num()?.max(0.0).round() as u32,
+                        TrafficField::Route => {
+                            rule.route = match name_of()? {
+                                "Lead" => Route::Lead,
+                                "Oncoming" => Route::Oncoming,
+                                "FromSouth" => Route::FromSouth,
+                                "FromNorth" => Route::FromNorth,
+                                "OncomingLeft" => Route::OncomingLeft,
+                                other => return Err(format!("{}: unknown route {other}", p.name)),
+                            }
+                        }
+                        TrafficField::Behaviour => {
+                            rule.behaviour = match (name_of()?, rule.behaviour) {
+                                ("Careful", _) => Behaviour::Careful,
+                                ("RunsRed", _) => Behaviour::RunsRed,
+                                ("DoesNotYield", _) => Behaviour::DoesNotYield,
+                                ("Stalls", b @ Behaviour::Stalls { .. }) => b,
+                                ("Stalls", _) => DEFAULT_STALL,
+                                ("BrakesHard", b @ Behaviour::BrakesHard { .. }) => b,
+                                ("BrakesHard", _) => DEFAULT_BRAKES_HARD,
+                                (other, _) => return Err(format!("{}: unknown behaviour {other}", p.name)),
+                            }
+                        }
+                        TrafficField::TriggerKind => rule.trigger = with_kind(&rule.trigger, name_of()?, &p.name)?,
+                        TrafficField::TriggerValue => rule.trigger = with_value(&rule.trigger, num()?, &p.name)?,
+                        TrafficField::Light => rule.light = light_named(name_of()?, &p.name)?,
+                        TrafficField::Speed => rule.speed = shifted(rule.speed, num()?),
+                        TrafficField::Delay => rule.delay = shifted(rule.delay, num()?),
+                        TrafficField::Start => rule.start = num()?,
+                        TrafficField::Probability => rule.probability = num()?,
+                        TrafficField::StallAt => {
+                            if let Behaviour::Stalls { at, .. } = &mut rule.behaviour {
+                                *at = num()?;
+                            }
+                        }
+                        TrafficField::BrakeAfter => {
+                            if let Behaviour::BrakesHard { after, .. } = &mut rule.behaviour {
+                                *after = num()?;
+                            }
+                        }
+                        TrafficField::BrakeDecel => {
+                            if let Behaviour::BrakesHard { decel, .. } = &mut rule.behaviour {
+                                *decel = num()?;
+                            }
+                        }
                     }
                 }
                 Field::StartSpeed => map.vehicle.start_speed = num()?,
@@ -828,10 +1001,22 @@ impl Space {
                 unforeseen_sim::MAX_SPAWN_RULES
             ));
         }
+        let traffic_total: u64 = traffic_copies.iter().map(|&c| u64::from(c)).sum();
+        if traffic_total > unforeseen_sim::MAX_SPAWN_RULES as u64 {
+            return Err(format!(
+                "{traffic_total} traffic rules after copying, more than {}",
+                unforeseen_sim::MAX_SPAWN_RULES
+            ));
+        }
         map.pedestrians = rules
             .iter()
             .zip(&copies)
             .flat_map(|(r, &c)| std::iter::repeat_n(r.clone(), c as usize))
+            .collect();
+        map.traffic = traffic
+            .iter()
+            .zip(&traffic_copies)
+            .flat_map(|(r, &c)| std::iter::repeat_n(*r, c as usize))
             .collect();
         map.name = name.to_string();
         map.description = format!("a candidate of the search space {}", self.name);
@@ -868,6 +1053,47 @@ fn shifted((a, b): (f64, f64), low: f64) -> (f64, f64) {
     (low, round(low + (b - a)))
 }
 
+/// `trigger` made of the kind `kind` (`CarArrivesWithin`, `AtTime`, `CarWithin`), keeping
+/// its number where it has one; `param` names the parameter in the error.
+fn with_kind(trigger: &Trigger, kind: &str, param: &str) -> Result<Trigger, Rejection> {
+    let value = trigger_value(trigger);
+    Ok(match kind {
+        "CarArrivesWithin" => Trigger::CarArrivesWithin(value.unwrap_or(4.8)),
+        "AtTime" => Trigger::AtTime(value.unwrap_or(5.0)),
+        "CarWithin" => {
+            let min = value.unwrap_or(40.0);
+            Trigger::CarWithin {
+                min,
+                max: min + CAR_WITHIN_WIDTH,
+            }
+        }
+        other => return Err(format!("{param}: unknown trigger kind {other}")),
+    })
+}
+
+/// `trigger` with its number set to `x` (a `CarWithin`'s width kept).
+fn with_value(trigger: &Trigger, x: f64, param: &str) -> Result<Trigger, Rejection> {
+    Ok(match *trigger {
+        Trigger::CarArrivesWithin(_) => Trigger::CarArrivesWithin(x),
+        Trigger::AtTime(_) => Trigger::AtTime(x),
+        Trigger::CarWithin { min, max } => Trigger::CarWithin {
+            min: x,
+            max: x + (max - min),
+        },
+        t => return Err(format!("{param}: the trigger {t:?} has no number")),
+    })
+}
+
+/// The light condition named `name`.
+fn light_named(name: &str, param: &str) -> Result<LightCondition, Rejection> {
+    Ok(match name {
+        "Any" => LightCondition::Any,
+        "Green" => LightCondition::Green,
+        "Red" => LightCondition::Red,
+        other => return Err(format!("{param}: unknown light {other}")),
+    })
+}
+
 /// The number a trigger carries, if any.
 fn trigger_value(t: &Trigger) -> Option<f64> {
     match *t {
@@ -877,23 +1103,79 @@ fn trigger_value(t: &Trigger) -> Option<f64> {
     }
 }
 
+/// The name a trigger's kind is varied by, if it is one a space can choose.
+fn trigger_kind_name(t: &Trigger) -> Option<Value> {
+    let name = match t {
+        Trigger::CarArrivesWithin(_) => "CarArrivesWithin",
+        Trigger::AtTime(_) => "AtTime",
+        Trigger::CarWithin { .. } => "CarWithin",
+        _ => return None,
+    };
+    Some(Value::Name(name.to_string()))
+}
+
+/// The name of a light condition.
+fn light_name(light: LightCondition) -> Value {
+    Value::Name(
+        match light {
+            LightCondition::Any => "Any",
+            LightCondition::Green => "Green",
+            LightCondition::Red => "Red",
+        }
+        .to_string(),
+    )
+}
+
+/// A traffic rule's value of a field (`in_base`: the rule is the base map's).
+fn traffic_value(rule: &TrafficRule, f: TrafficField, in_base: bool) -> Option<Value> {
+    let num = |x: f64| Some(Value::Num(x));
+    let name = |n: &str| Some(Value::Name(n.to_string()));
+    match f {
+        TrafficField::Route => name(match rule.route {
+            Route::Lead => "Lead",
+            Route::Oncoming => "Oncoming",
+            Route::FromSouth => "FromSouth",
+            Route::FromNorth => "FromNorth",
+            Route::OncomingLeft => "OncomingLeft",
+        }),
+        TrafficField::Behaviour => name(match rule.behaviour {
+            Behaviour::Careful => "Careful",
+            Behaviour::RunsRed => "RunsRed",
+            Behaviour::DoesNotYield => "DoesNotYield",
+            Behaviour::Stalls { .. } => "Stalls",
+            Behaviour::BrakesHard { .. } => "BrakesHard",
+        }),
+        TrafficField::TriggerValue => trigger_value(&rule.trigger).map(Value::Num),
+        TrafficField::TriggerKind => trigger_kind_name(&rule.trigger),
+        TrafficField::Light => Some(light_name(rule.light)),
+        TrafficField::Speed => num(rule.speed.0),
+        TrafficField::Delay => num(rule.delay.0),
+        TrafficField::Start => num(rule.start),
+        TrafficField::Probability => num(rule.probability),
+        TrafficField::Copies => num(if in_base { 1.0 } else { 0.0 }),
+        TrafficField::StallAt => match rule.behaviour {
+            Behaviour::Stalls { at, .. } => num(at),
+            _ => None,
+        },
+        TrafficField::BrakeAfter => match rule.behaviour {
+            Behaviour::BrakesHard { after, .. } => num(after),
+            _ => None,
+        },
+        TrafficField::BrakeDecel => match rule.behaviour {
+            Behaviour::BrakesHard { decel, .. } => num(decel),
+            _ => None,
+        },
+    }
+}
+
 /// A rule's value of a field (`in_base`: the rule is the base map's, so it has one copy).
 fn rule_value(rule: &SpawnRule, f: RuleField, in_base: bool) -> Option<Value> {
     let num = |x: f64| Some(Value::Num(x));
     let name = |n: &str| Some(Value::Name(n.to_string()));
     match f {
         RuleField::TriggerValue => trigger_value(&rule.trigger).map(Value::Num),
-        RuleField::TriggerKind => match rule.trigger {
-            Trigger::CarArrivesWithin(_) => name("CarArrivesWithin"),
-            Trigger::AtTime(_) => name("AtTime"),
-            Trigger::CarWithin { .. } => name("CarWithin"),
-            _ => None,
-        },
-        RuleField::Light => name(match rule.light {
-            LightCondition::Any => "Any",
-            LightCondition::Green => "Green",
-            LightCondition::Red => "Red",
-        }),
+        RuleField::TriggerKind => trigger_kind_name(&rule.trigger),
+        RuleField::Light => Some(light_name(rule.light)),
         RuleField::Side => name(match rule.side {
             Side::Near => "Near",
             Side::Far => "Far",
@@ -938,7 +1220,7 @@ fn global_value(map: &Map, f: Field) -> Option<Value> {
                 SurfaceField::Friction => patch.friction,
             }
         }
-        Field::Rule(..) => return None,
+        Field::Rule(..) | Field::Traffic(..) => return None,
     };
     Some(Value::Num(x))
 }
