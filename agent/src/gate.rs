@@ -196,6 +196,18 @@ impl StateGate {
         }
     }
 
+    /// Sets state `s`'s endorsement as if `memory` reasoning ticks there had each endorsed
+    /// the habit by `endorsement` in [0, 1] (the audit of a trained habit). Takes effect at
+    /// [`StateGate::consolidate`]. With an unbounded memory no endorsement is ever full, and
+    /// this does nothing.
+    pub fn set_endorsed(&mut self, s: usize, endorsement: f64) {
+        if let Some(e) = self.endorsed.get_mut(s)
+            && self.memory.is_finite()
+        {
+            *e = endorsement.clamp(0.0, 1.0) * self.memory;
+        }
+    }
+
     /// `P(x = value | given = given_values)` (given values in the order of [`StateGate::given`]),
     /// e.g. the paper's `P(p=1 | L=1, d=2)` (Fig. 9b). NaN when out of range.
     pub fn probability(&self, value: usize, given_values: &[usize]) -> f64 {
@@ -311,6 +323,40 @@ mod tests {
         }
         assert!(StateGate::from_model(&w, "pedestrian", 20.0).is_err());
         assert!(StateGate::from_model(&w, "p", 0.0).is_err());
+    }
+
+    #[test]
+    fn an_audited_endorsement_counts_as_a_full_memory_of_reasoning_ticks() {
+        let mut w = model();
+        let st = w.structure().clone();
+        // Row (L=1, d=2) at P = 1/2 (H = ln 2), as in `excess_surprise_by_hand`.
+        for k in 0..10 {
+            w.observe_transition(st.encode(&[3, 2, 1, 0]), 1, st.encode(&[2, 2, 1, usize::from(k < 5)]));
+        }
+        let (s_fast, s_slow) = (st.encode(&[2, 3, 1, 1]), st.encode(&[2, 0, 1, 1]));
+        let one_hot = |s: usize| {
+            let mut q = vec![0.0; 64];
+            q[s] = 1.0;
+            q
+        };
+        let ln2 = 2f64.ln();
+        let mut g = StateGate::from_model(&w, "p", 20.0).unwrap();
+        g.set_endorsed(s_slow, 1.0);
+        g.set_endorsed(s_fast, 0.25);
+        g.consolidate();
+        // Fully endorsed: the row's whole entropy is expected, nothing is in excess.
+        assert!(g.excess_surprise(&one_hot(s_slow), ln2).abs() < 1e-12);
+        // A quarter: a quarter of it.
+        assert!((g.excess_surprise(&one_hot(s_fast), ln2) - 0.75 * ln2).abs() < 1e-12);
+        // Setting replaces (an audit is not added to): 0.5 after 1 is half.
+        g.set_endorsed(s_slow, 0.5);
+        g.consolidate();
+        assert!((g.excess_surprise(&one_hot(s_slow), ln2) - 0.5 * ln2).abs() < 1e-12);
+        // With an unbounded memory nothing is ever fully endorsed: no effect.
+        let mut unbounded = StateGate::from_model(&w, "p", f64::INFINITY).unwrap();
+        unbounded.set_endorsed(s_slow, 1.0);
+        unbounded.consolidate();
+        assert!((unbounded.excess_surprise(&one_hot(s_slow), ln2) - ln2).abs() < 1e-12);
     }
 
     #[test]

@@ -211,6 +211,13 @@ param_enum! {
         /// been shown to act there as reasoning would. Zero for a never-endorsed state.
         #[default]
         Endorsed = "endorsed",
+        /// As `endorsed`, with every state's endorsement first audited when the agent is
+        /// built: the planner, from a certain belief in that state, endorses the habit's
+        /// action by `ψ(a_o) / max_u ψ(u)` ([`crate::scaled_agent::ScaledAgent::audit_habit`]).
+        /// So the ordinary uncertainty of a familiar situation (a pedestrian or a cross car
+        /// in the car's path on half of the red ticks) does not trigger reasoning from the
+        /// first episode on where the habit already does what reasoning would.
+        Audited = "audited",
         /// Ablation (the paper's trigger): nothing; `θ` reads the surprise itself.
         None = "none",
     }
@@ -314,7 +321,7 @@ param_groups! {
     /// | `gate` | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
     /// | `gate` | `gate_memory` | 20.0 | > 0 (`inf` allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
     /// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
-    /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `none` is the paper's trigger) ([`GateBaseline`]) |
+    /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `audited`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `audited` also audits every state's endorsement when the agent is built; `none` is the paper's trigger) ([`GateBaseline`]) |
     /// | `gate` | `handback` | `decline-learned` | `decline-learned`, `risk-checked`, `hand-back-checked`, `theta` | where test-time learning changed the trigger's verdict: a hand-back learning made goes to the habit only if the world model's crash-risk check passes, a reasoning tick learning alone made is declined (beyond the paper; `risk-checked` takes such a tick where the check finds the habit at risk, `hand-back-checked` takes every one, `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
     /// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
     /// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |

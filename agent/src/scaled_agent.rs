@@ -231,7 +231,7 @@ impl<H: Habit> ScaledAgent<H> {
         };
         let n_obs = model.generative().n_obs();
         let handback = HandBack::new(&model);
-        Ok(ScaledAgent {
+        let mut agent = ScaledAgent {
             tree: EfeTree::new(n, n_obs, na, params.planning.horizon),
             window_q: vec![vec![0.0; n]; params.perception.vmp_window],
             window_obs: Vec::with_capacity(params.perception.vmp_window),
@@ -264,7 +264,53 @@ impl<H: Habit> ScaledAgent<H> {
             handback,
             competence: Competence::new(n, n_obs, na),
             learned: false,
-        })
+        };
+        if agent.params.gate.gate_baseline == GateBaseline::Audited {
+            agent.audit_habit();
+        }
+        Ok(agent)
+    }
+
+    /// Audits the habit in every state (`gate_baseline = audited`): in each state `s`, from
+    /// a certain belief there, plans (Prop. 1) and scales the habit's policy by the trained
+    /// trigger's `θ(s)` (Theorem 1), as a reasoning tick there would, and records in the
+    /// gate how far that policy endorses the habit's action, as if `memory` reasoning ticks
+    /// in `s` had ([`StateGate::set_endorsed`]). One planning per state.
+    pub fn audit_habit(&mut self) {
+        let Some(gate) = &self.gate else { return };
+        let n = self.n_states;
+        let mut q = vec![0.0; n];
+        let trained: Vec<f64> = (0..n)
+            .map(|s| {
+                q.fill(0.0);
+                q[s] = 1.0;
+                gate.trained_surprise(&q)
+            })
+            .collect();
+        let mut endorsed = Vec::with_capacity(n);
+        for (s, surprise) in trained.into_iter().enumerate() {
+            q.fill(0.0);
+            q[s] = 1.0;
+            let th = theta(surprise, self.params.gate.omega);
+            let root = match self.params.planning.root_step {
+                RootStep::Learned => self.model.generative(),
+                RootStep::Absorbing => self.model.planning_generative(),
+            };
+            self.tree
+                .evaluate(self.model.planning_generative(), root, &q, self.params.planning.gamma);
+            self.habit.pi_o_belief(0, &q, &mut self.pi);
+            let habit = argmax(&self.pi);
+            self.scale(th);
+            endorsed.push(endorsement(&self.pi, habit));
+        }
+        if let Some(gate) = &mut self.gate {
+            for (s, e) in endorsed.into_iter().enumerate() {
+                gate.set_endorsed(s, e);
+            }
+            gate.consolidate();
+        }
+        self.tree.invalidate();
+        self.last = ReasoningTrace::default();
     }
 
     /// Whether the trained agent's trigger would reason under belief `q_t`
@@ -546,8 +592,14 @@ impl<H: Habit> ScaledAgent<H> {
         tr.q_s.resize(self.n_actions, 0.0);
         q_s_into(&self.tree.psi, self.params.planning.gamma, &mut tr.q_s);
         tr.pi_o.clone_from(&self.pi);
+        self.scale(th)
+    }
+
+    /// Scales the habit's policy in `self.pi` toward the planner's `ψ` of the last
+    /// evaluation by `θ` (Theorem 1) into `self.pi` (and the trace); returns the iterations.
+    fn scale(&mut self, th: f64) -> u32 {
+        let tr = &mut self.last;
         tr.pi_scaled.resize(self.n_actions, 0.0);
-        // Scaling (Theorem 1).
         let iters = match self.params.scaling.scaling_mode {
             ScalingMode::Iterative => {
                 let o = scale_iterative(
@@ -623,7 +675,7 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             Some(gate) => {
                 let s = gate.surprise(&self.q_cur);
                 match self.params.gate.gate_baseline {
-                    GateBaseline::Endorsed => (s, gate.excess_surprise(&self.q_cur, s)),
+                    GateBaseline::Endorsed | GateBaseline::Audited => (s, gate.excess_surprise(&self.q_cur, s)),
                     GateBaseline::None => (s, s),
                 }
             }

@@ -51,6 +51,11 @@ impl Route {
 pub const MAX_DECEL: f64 = 9.0;
 /// Seconds a careful driver stands at the stop line of a dark signal before going.
 pub const ALL_WAY_STOP_WAIT: f64 = 1.0;
+/// At a dark signal a vehicle counts as standing at its line below this speed, m/s ...
+const STOPPED_SPEED: f64 = 0.5;
+/// ... within this many metres of it, m (IDM's approach to a stop line ends in a long
+/// crawl: from 9 m/s it takes about 4 s more to go from 0.5 to 0.05 m/s).
+const STOPPED_GAP: f64 = 1.5;
 /// A careful left-turner waits at the box while the car would reach the box within this
 /// many seconds at its speed (or is in it), s.
 pub const YIELD_GAP: f64 = 4.0;
@@ -63,6 +68,19 @@ const NEAR_SEEN: f64 = 10.0;
 /// A crossing vehicle before its line that would need more than this many times its
 /// comfortable deceleration to stop there is seen as entering the box.
 const WILL_ENTER_BRAKING: f64 = 2.0;
+/// A vehicle in the car's lane slower than this, m/s, with its rear before the far side
+/// of the junction box, blocks the box: while the car has not reached the box, it is in
+/// the car's path however far ahead (a careful driver does not enter a crosswalk or a box
+/// it cannot leave).
+const BLOCKING_SPEED: f64 = 1.0;
+/// A vehicle whose front is this far past its stop line has entered the junction, whatever
+/// its signal shows (one held at its line stops within millimetres of it), m.
+const OVERRUN: f64 = 0.5;
+/// An oncoming car signalling a left turn (route `OncomingLeft`) that comes on faster than
+/// [`BLOCKING_SPEED`] within this many metres of its turn, while the car has not passed
+/// the box, is in the car's path: a careful driver slows for a turning car that shows no
+/// sign of yielding, before it turns, m.
+const TURN_SEEN: f64 = 30.0;
 /// Lateral margin within which something counts as in a vehicle's lane, m (each side).
 const LANE_MARGIN: f64 = 0.3;
 /// How far ahead a vehicle looks, m.
@@ -131,9 +149,9 @@ struct Other {
     /// Seconds stood at a dark stop line, and whether it may go.
     waited: f64,
     cleared: bool,
-    /// Whether its front crossed its stop line with its signal letting it go: from then
-    /// on the signal no longer stops it (a vehicle held at its line that creeps a few mm
-    /// past it in a sub-step is still held).
+    /// Whether its front crossed its stop line with its signal letting it go, or ran
+    /// [`OVERRUN`] past it: from then on the signal no longer stops it (a vehicle held at
+    /// its line that creeps a few mm past it in a sub-step is still held).
     entered: bool,
     /// Whether it began its turn with the way clear (a careful left-turner is held at
     /// the box until then, as at a stop line).
@@ -415,6 +433,9 @@ impl Traffic {
             Approach::FromWest | Approach::FromEast => signals.road,
             Approach::FromSouth | Approach::FromNorth => signals.cross,
         };
+        // Well past its line it has entered, whatever the signal now shows: it clears the
+        // box (one that could not stop for a red before its line does not stop in it).
+        o.entered |= o.s >= OVERRUN;
         if !o.entered && rule.behaviour != Behaviour::RunsRed {
             let to_line = -o.s;
             let stop = match aspect {
@@ -422,7 +443,7 @@ impl Traffic {
                 Aspect::Lit(LightPhase::Amber) => to_line >= o.v * o.v / (2.0 * rule.brake),
                 Aspect::Lit(LightPhase::Green) => false,
                 Aspect::Dark => {
-                    if o.v < 0.05 && to_line < 1.0 {
+                    if o.v < STOPPED_SPEED && to_line < STOPPED_GAP {
                         o.waited += h;
                     }
                     o.cleared |= o.waited >= ALL_WAY_STOP_WAIT;
@@ -515,7 +536,9 @@ impl Traffic {
             // Within 3 s at the car's speed, plus 3 s at the speed it closes on it.
             let closing = (car.vel.0 - b.vel.0).max(0.0);
             let near = (HEADWAY_SEEN * (car.vel.0 + closing)).max(NEAR_SEEN);
-            let in_lane_ahead = b.y.1 > y0 && b.y.0 < y1 && b.x.1 > car.x.1 && b.x.0 - car.x.1 < near;
+            let in_lane = b.y.1 > y0 && b.y.0 < y1 && b.x.1 > car.x.1;
+            let in_lane_ahead = in_lane && b.x.0 - car.x.1 < near;
+            let blocks_box = in_lane && b.vel.0 < BLOCKING_SPEED && b.x.0 < zone.x1 && car.x.1 < zone.x0;
             let crosses = !matches!(rule.route, Route::Lead | Route::Oncoming);
             let in_zone = b.x.1 > zone.x0 && b.x.0 < zone.x1 && b.y.1 > zone.y0 && b.y.0 < zone.y1;
             // Before its line (a turner: its turn), too fast to stop there at twice its
@@ -527,7 +550,12 @@ impl Traffic {
                 .filter(|_| !o.turning)
                 .map_or(0.0, |(enter, _)| enter);
             let will_enter = o.s < hold && o.v * o.v > 2.0 * WILL_ENTER_BRAKING * rule.brake * (hold - o.s);
-            in_lane_ahead || (crosses && ((o.s > 0.0 && in_zone) || will_enter))
+            let turns_ahead = rule.route == Route::OncomingLeft
+                && !o.turning
+                && o.v > BLOCKING_SPEED
+                && hold - o.s < TURN_SEEN
+                && car.x.0 < zone.x1;
+            in_lane_ahead || blocks_box || turns_ahead || (crosses && ((o.s > 0.0 && in_zone) || will_enter))
         })
     }
 

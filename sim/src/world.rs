@@ -93,7 +93,11 @@ pub struct Snapshot {
     /// The other vehicles now.
     pub vehicles: Vec<VehicleSnapshot>,
     /// Whether a vehicle is in the car's path: in its lane ahead of it within 3 s at
-    /// the car's speed plus 3 s at the speed it closes on it (10 m at least), or on a route that crosses the car's (cross
+    /// the car's speed plus 3 s at the speed it closes on it (10 m at least), or standing
+    /// (below 1 m/s) in its lane with its rear before the far side of the junction box
+    /// while the car has not reached the box (the box is blocked), or an oncoming car
+    /// signalling a left turn that comes on (faster than 1 m/s) within 30 m of its turn
+    /// while the car has not passed the box, or on a route that crosses the car's (cross
     /// traffic, an oncoming left-turner) in the box past its stop line, or before its
     /// line (a turner: its turn) too fast to stop there at twice its comfortable braking
     /// (about to run its red, or to turn without yielding). Always false on a map

@@ -8,7 +8,10 @@
 //!   jaywalk family must let it succeed (it is the witness that the map is survivable).
 //!   On a map with the red-light rule (`reward.red_light < 0`) it also stops for red
 //!   ([`RedLightStop`]): it slows down while L = 0 in the distance bin before the
-//!   crosswalk, and in a crosswalk bin while L = 0 at the lowest speeds (v <= 1).
+//!   crosswalk, and in a crosswalk bin while L = 0 at the lowest speeds (v <= 1), unless
+//!   it was in a crosswalk bin on green earlier in the episode: a driver who entered on
+//!   green clears the crosswalk and the junction box behind it, and does not stop in
+//!   them for a later red.
 //! * [`NeverBrake`] (`never-brake`): always speeds up. It is the witness that a map is
 //!   dangerous: a car that drives on must be hit.
 //!
@@ -93,6 +96,9 @@ pub struct BrakeOnPedestrian {
     sizes: [usize; 4],
     /// Stops for red too (maps with the red-light rule).
     red_light: Option<RedLightStop>,
+    /// This episode, the car has been in a crosswalk bin on green: it has entered, and
+    /// no longer stops for red.
+    entered: bool,
 }
 
 impl BrakeOnPedestrian {
@@ -104,6 +110,7 @@ impl BrakeOnPedestrian {
             [n_d, n_v, 2, 2] if n_d >= 2 && n_v >= 1 => Ok(Self {
                 sizes: [n_d, n_v, 2, 2],
                 red_light: None,
+                entered: false,
             }),
             _ => Err(Error::Agent {
                 problem: format!(
@@ -125,20 +132,27 @@ impl BrakeOnPedestrian {
         Ok(c)
     }
 
-    /// The action for joint observation `obs`: slow down iff p = 1 and d >= 1, or the
-    /// red-light rule says so; otherwise speed up.
+    /// The action for joint observation `obs` before the car has entered on green: slow
+    /// down iff p = 1 and d >= 1, or the red-light rule says so; otherwise speed up.
     pub fn action(&self, obs: usize) -> Action {
-        let [_, n_v, n_l, n_p] = self.sizes;
-        let p = obs % n_p;
-        let l = (obs / n_p) % n_l;
-        let v = (obs / (n_l * n_p)) % n_v;
-        let d = obs / (n_v * n_l * n_p);
-        let red = self.red_light.as_ref().is_some_and(|r| r.stops(d, v, l));
+        let (d, v, l, p) = self.decode(obs);
+        let red = !self.entered && self.red_light.as_ref().is_some_and(|r| r.stops(d, v, l));
         if (p == 1 && d >= 1) || red {
             Action::SlowDown
         } else {
             Action::SpeedUp
         }
+    }
+
+    /// `(d, v, L, p)` of joint observation `obs`.
+    fn decode(&self, obs: usize) -> (usize, usize, usize, usize) {
+        let [_, n_v, n_l, n_p] = self.sizes;
+        (
+            obs / (n_v * n_l * n_p),
+            (obs / (n_l * n_p)) % n_v,
+            (obs / n_p) % n_l,
+            obs % n_p,
+        )
     }
 }
 
@@ -146,9 +160,16 @@ impl Controller for BrakeOnPedestrian {
     fn name(&self) -> &'static str {
         "brake-on-pedestrian"
     }
-    fn begin_episode(&mut self, _seed: u64) {}
-    /// Scripted; never reasons.
+    fn begin_episode(&mut self, _seed: u64) {
+        self.entered = false;
+    }
+    /// Scripted; never reasons. Records when the car is in a crosswalk bin on green
+    /// (with the red-light rule), after which it no longer stops for red.
     fn act(&mut self, obs: usize) -> Decision {
+        let (d, _, l, _) = self.decode(obs);
+        if l == 1 && self.red_light.as_ref().is_some_and(|r| r.crosswalk.contains(&d)) {
+            self.entered = true;
+        }
         decision(self.action(obs))
     }
 }
@@ -265,8 +286,10 @@ mod tests {
             } else {
                 Action::SpeedUp
             };
+            c.begin_episode(0);
             assert_eq!(act(&mut c, st.d, st.v, st.l, st.p), want, "{st:?}");
         }
+        c.begin_episode(0);
         // The light turns amber or red at d = 2 at full speed: brake.
         assert_eq!(act(&mut c, 2, 3, 0, 0), Action::SlowDown);
         // Standing or crawling before the crosswalk (d = 1) on red: stop; on green: go.
@@ -277,6 +300,26 @@ mod tests {
         assert_eq!(act(&mut c, 1, 2, 0, 0), Action::SpeedUp);
         // Far away (d = 3) on red: not yet.
         assert_eq!(act(&mut c, 3, 3, 0, 0), Action::SpeedUp);
+    }
+
+    #[test]
+    fn once_in_the_crosswalk_bin_on_green_it_clears_instead_of_stopping_for_red() {
+        let map = unforeseen_sim::embedded::load("intersection").unwrap();
+        let mut map = map;
+        map.reward.red_light = -10.0;
+        let mut c = BrakeOnPedestrian::for_map(&disc().factor_sizes(), &map).unwrap();
+        c.begin_episode(0);
+        // Stopped in the crosswalk bin for an obstacle on green, then the obstacle goes.
+        assert_eq!(act(&mut c, 1, 2, 1, 1), Action::SlowDown);
+        assert_eq!(act(&mut c, 1, 0, 1, 0), Action::SpeedUp);
+        // Amber at a crawl: it drives on (before entering on green it would stop here).
+        assert_eq!(act(&mut c, 1, 1, 0, 0), Action::SpeedUp);
+        assert_eq!(act(&mut c, 1, 0, 0, 0), Action::SpeedUp);
+        // An obstacle still stops it.
+        assert_eq!(act(&mut c, 1, 1, 0, 1), Action::SlowDown);
+        // A new episode forgets.
+        c.begin_episode(1);
+        assert_eq!(act(&mut c, 1, 1, 0, 0), Action::SlowDown);
     }
 
     #[test]
