@@ -4,7 +4,7 @@
 //! agree: the cross street with its lanes and sidewalks, the crosswalks of the other
 //! arms, every approach's stop line, the signal heads besides the car's and what each
 //! shows ([`Lamp`]), and the other vehicles as oriented rectangles
-//! (docs/ARCHITECTURE.md §2 for the junction, §7 for the pictures).
+//! (docs/ARCHITECTURE.md §2 for the junction, §6 for the pictures).
 //!
 //! Coordinates are the simulator's: x along the road, y across it, the car driving +x
 //! in the lane at negative y.

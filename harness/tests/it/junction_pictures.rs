@@ -1,7 +1,7 @@
 //! The pictures and the trace of an episode at a junction show the street: never-brake
 //! on `maps/junction/red_runner.ron` drives into the car that runs its red from the cross
 //! street, and its filmstrip, replay page and trace.csv have that car, the cross street
-//! and its signal heads (docs/ARCHITECTURE.md §7). The straight road's stay as they were
+//! and its signal heads (docs/ARCHITECTURE.md §6). The straight road's stay as they were
 //! (the filmstrip's and the CSV's columns here; the frame's bytes in
 //! `python/tests/test_render.py`).
 
