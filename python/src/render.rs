@@ -95,11 +95,12 @@ pub fn frame(map: &Map, snap: &Snapshot, scale: f32) -> (Vec<u8>, usize, usize) 
             pix.fill_path(&path, &paint(rgb), FillRule::Winding, Transform::identity(), None);
         }
     };
-    // A box (the box of the junction) the road's markings stop at, if any.
-    let (box_x0, box_x1) = junction.as_ref().map_or((f32::NAN, f32::NAN), |j| {
-        (j.junction_box.x0 as f32, j.junction_box.x1 as f32)
-    });
-    let in_box = |a: f32, b: f32| b > box_x0 && a < box_x1;
+    // Whether the stretch of road from x `a` to `b` overlaps the junction's box (where
+    // the road's lane lines stop).
+    let box_x = junction
+        .as_ref()
+        .map(|j| (j.junction_box.x0 as f32, j.junction_box.x1 as f32));
+    let in_box = |a: f32, b: f32| box_x.is_some_and(|(x0, x1)| b > x0 && a < x1);
     pix.fill(Color::from_rgba8(96, 140, 80, 255));
     let sidewalk = road.sidewalk_width as f32;
     rect(&mut pix, x_lo, half, x_hi, half + sidewalk, SIDEWALK);
