@@ -1,5 +1,7 @@
 """Rendering as Gymnasium users expect it: readable frames, render_fps, "human" through
-the render extra (pygame), RecordVideo to mp4 (the video extra), the vector env's frames."""
+the render extra (pygame), RecordVideo to mp4 (the video extra), the vector env's frames;
+the straight road's frames as they always were, and a junction's with its cross street,
+signal heads and vehicles."""
 
 from __future__ import annotations
 
@@ -12,11 +14,17 @@ import pytest
 
 import unforeseen
 
+from conftest import REPO
+
 # The colours render.rs paints (RGB).
 CAR = (40, 90, 220)
 CROSSWALK = (240, 240, 240)
 ON_CROSSWALK = (250, 120, 20)
 OFF_CROSSWALK = (230, 60, 160)
+VEHICLE = (20, 150, 140)
+VEHICLE_IN_PATH = (200, 30, 90)
+RED = (220, 30, 30)
+GREEN = (40, 200, 60)
 
 
 def _pixels(frame: np.ndarray, rgb: tuple[int, int, int]) -> np.ndarray:
@@ -160,3 +168,54 @@ def test_saves_a_frame_as_png(tmp_path):
     with pil.open(path) as back:
         assert back.size == (frame.shape[1], frame.shape[0])
         np.testing.assert_array_equal(np.asarray(back.convert("RGB")), frame)
+
+
+def test_the_straight_road_frames_are_as_they_were():
+    """Maps without a junction draw as before there were junctions: the frames of a few
+    seeded episodes hash to the digest taken before the junction was drawn (a change of
+    tiny-skia or of the straight road's drawing shows here too)."""
+    import hashlib
+
+    digest = hashlib.sha256()
+    for name in ["jaywalk", "intersection", str(REPO / "maps" / "ice_before_crosswalk.ron"), "two_pedestrians"]:
+        env = unforeseen.make_env(name, render_mode="rgb_array")
+        env.reset(seed=3)
+        for k in range(12):
+            digest.update(env.render().tobytes())
+            _, _, term, trunc, _ = env.step(k % 3)
+            if term or trunc:
+                break
+        digest.update(env.render().tobytes())
+    assert digest.hexdigest() == "1c0123b0b69e35a75fff9c32ea6ff3d242e36769d771612f244ba741ce7e3885"
+
+
+def test_a_junction_frame_shows_the_cross_street_the_heads_and_the_vehicle():
+    """Speeding up on red_runner meets the car that runs its red from the south arm in
+    the box: the frame reaches along the cross street, the runner is drawn in the car's
+    path inside the box, the cross street's heads show red and the car's green."""
+    env = unforeseen.make_env(str(REPO / "maps" / "junction" / "red_runner.ron"), render_mode="rgb_array")
+    env.reset(seed=7)
+    while True:
+        _, _, term, trunc, info = env.step(1)
+        if term or trunc:
+            break
+    assert info["collision"]
+    frame = env.render()
+    h, w, _ = frame.shape
+    # 25.5 m either side of the road at 10 px/m: the box (x 69..76, y -3.5..3.5) lies at
+    # columns 755..825 and rows 220..290 (x from -6.5 m, y down from 25.5 m).
+    assert (h, w) == (510, 1076)
+    px = lambda x: round((x + 6.5) * 10)  # noqa: E731
+    py = lambda y: round((25.5 - y) * 10)  # noqa: E731
+    box = frame[py(3.5) : py(-3.5), px(69.0) : px(76.0)]
+    assert _pixels(box, VEHICLE_IN_PATH).sum() > 300
+    assert _pixels(frame, VEHICLE_IN_PATH).sum() == _pixels(box, VEHICLE_IN_PATH).sum()
+    # The cross street's asphalt north and south of the road, as the road's.
+    road = tuple(frame[py(-1.0), px(20.0)])
+    assert tuple(frame[py(15.0), px(71.0)]) == road and tuple(frame[py(-15.0), px(74.0)]) == road
+    # The south arm's head (east kerb, 1 m before its stop line at y = -4.5) red; the
+    # car's green.
+    assert tuple(frame[py(-5.5), px(77.0)]) == RED
+    assert tuple(frame[py(-4.5), px(63.0)]) == GREEN
+    line = env.unwrapped._env.render_ansi()
+    assert "+" in line and "V" in line and line.endswith(", cross red, 1 vehicle (1 in path)"), line

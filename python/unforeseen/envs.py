@@ -118,7 +118,11 @@ class UnforeseenEnv(gym.Env):
     shipped maps: grass, grey sidewalks, the road with its lane lines, the zebra
     crosswalk, the yellow destination line, the light (a disc on the near sidewalk, in
     its colour), the blue car (its windscreen lighter) and each pedestrian (a dark ring
-    around orange on the crosswalk, magenta elsewhere). ``"ansi"``: one line of text.
+    around orange on the crosswalk, magenta elsewhere). A map with a junction gives a
+    taller frame (about 1080x510) that adds the cross street with its lanes, sidewalks,
+    crosswalks and stop lines, every signal head (round for vehicles, square for
+    pedestrians, grey while dark) and the other vehicles (teal, raspberry while in the
+    car's path). ``"ansi"``: one line of text.
     ``"human"``: the frame in a pygame window, redrawn at each ``reset`` and ``step``
     at ``metadata["render_fps"]`` (one frame per decision tick: 1 per second by
     default); needs the ``render`` extra (``pip install "unforeseen[render]"``).

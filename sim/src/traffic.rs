@@ -119,6 +119,9 @@ pub struct VehicleSnapshot {
     pub route: Route,
     /// Its front's distance past its stop line, m (negative before it).
     pub past_stop_line: f64,
+    /// Whether it is in the car's path (the rule of
+    /// [`crate::world::Snapshot::vehicle_in_path`], which holds when any vehicle's does).
+    pub in_path: bool,
 }
 
 /// A lead car's hard stop, in stages.
@@ -525,42 +528,40 @@ impl Traffic {
         })
     }
 
-    /// Whether a vehicle is in the path of the car occupying `car` (the rule of
+    /// Whether `o` is in the path of the car occupying `car` (the rule of
     /// [`crate::world::Snapshot::vehicle_in_path`]).
-    pub fn in_path(&self, car: Body) -> bool {
+    fn in_path(&self, o: &Other, car: Body) -> bool {
         let zone = self.layout.junction_box.unwrap_or(self.layout.crosswalks[0].1);
         let (y0, y1) = (car.y.0 - LANE_MARGIN, car.y.1 + LANE_MARGIN);
-        self.others.iter().any(|o| {
-            let rule = &self.rules[o.rule];
-            let b = self.body_of(o);
-            // Within 3 s at the car's speed, plus 3 s at the speed it closes on it.
-            let closing = (car.vel.0 - b.vel.0).max(0.0);
-            let near = (HEADWAY_SEEN * (car.vel.0 + closing)).max(NEAR_SEEN);
-            let in_lane = b.y.1 > y0 && b.y.0 < y1 && b.x.1 > car.x.1;
-            let in_lane_ahead = in_lane && b.x.0 - car.x.1 < near;
-            let blocks_box = in_lane && b.vel.0 < BLOCKING_SPEED && b.x.0 < zone.x1 && car.x.1 < zone.x0;
-            let crosses = !matches!(rule.route, Route::Lead | Route::Oncoming);
-            let in_zone = b.x.1 > zone.x0 && b.x.0 < zone.x1 && b.y.1 > zone.y0 && b.y.0 < zone.y1;
-            // Before its line (a turner: its turn), too fast to stop there at twice its
-            // comfortable braking: it will enter (what a driver sees of a car about to run
-            // its red, or to turn without yielding).
-            let hold = o
-                .path
-                .turn_span()
-                .filter(|_| !o.turning)
-                .map_or(0.0, |(enter, _)| enter);
-            let will_enter = o.s < hold && o.v * o.v > 2.0 * WILL_ENTER_BRAKING * rule.brake * (hold - o.s);
-            let turns_ahead = rule.route == Route::OncomingLeft
-                && !o.turning
-                && o.v > BLOCKING_SPEED
-                && hold - o.s < TURN_SEEN
-                && car.x.0 < zone.x1;
-            in_lane_ahead || blocks_box || turns_ahead || (crosses && ((o.s > 0.0 && in_zone) || will_enter))
-        })
+        let rule = &self.rules[o.rule];
+        let b = self.body_of(o);
+        // Within 3 s at the car's speed, plus 3 s at the speed it closes on it.
+        let closing = (car.vel.0 - b.vel.0).max(0.0);
+        let near = (HEADWAY_SEEN * (car.vel.0 + closing)).max(NEAR_SEEN);
+        let in_lane = b.y.1 > y0 && b.y.0 < y1 && b.x.1 > car.x.1;
+        let in_lane_ahead = in_lane && b.x.0 - car.x.1 < near;
+        let blocks_box = in_lane && b.vel.0 < BLOCKING_SPEED && b.x.0 < zone.x1 && car.x.1 < zone.x0;
+        let crosses = !matches!(rule.route, Route::Lead | Route::Oncoming);
+        let in_zone = b.x.1 > zone.x0 && b.x.0 < zone.x1 && b.y.1 > zone.y0 && b.y.0 < zone.y1;
+        // Before its line (a turner: its turn), too fast to stop there at twice its
+        // comfortable braking: it will enter (what a driver sees of a car about to run
+        // its red, or to turn without yielding).
+        let hold = o
+            .path
+            .turn_span()
+            .filter(|_| !o.turning)
+            .map_or(0.0, |(enter, _)| enter);
+        let will_enter = o.s < hold && o.v * o.v > 2.0 * WILL_ENTER_BRAKING * rule.brake * (hold - o.s);
+        let turns_ahead = rule.route == Route::OncomingLeft
+            && !o.turning
+            && o.v > BLOCKING_SPEED
+            && hold - o.s < TURN_SEEN
+            && car.x.0 < zone.x1;
+        in_lane_ahead || blocks_box || turns_ahead || (crosses && ((o.s > 0.0 && in_zone) || will_enter))
     }
 
-    /// The vehicles now.
-    pub fn snapshots(&self, phys: &PhysicsWorld) -> Vec<VehicleSnapshot> {
+    /// The vehicles now, each marked in the path of the car occupying `car` or not.
+    pub fn snapshots(&self, phys: &PhysicsWorld, car: Body) -> Vec<VehicleSnapshot> {
         self.others
             .iter()
             .map(|o| {
@@ -575,6 +576,7 @@ impl Traffic {
                     width: rule.width,
                     route: rule.route,
                     past_stop_line: o.s,
+                    in_path: self.in_path(o, car),
                 }
             })
             .collect()

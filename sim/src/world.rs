@@ -768,6 +768,7 @@ impl World {
                 }
             })
             .collect();
+        let vehicles = self.traffic.snapshots(&self.phys, self.car_body());
         Snapshot {
             step: self.step,
             time: t,
@@ -779,8 +780,8 @@ impl World {
             pedestrians,
             surface: self.surface().copied().collect(),
             signals: self.signals.state(t),
-            vehicles: self.traffic.snapshots(&self.phys),
-            vehicle_in_path: self.traffic.in_path(self.car_body()),
+            vehicle_in_path: vehicles.iter().any(|v| v.in_path),
+            vehicles,
         }
     }
 }

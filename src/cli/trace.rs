@@ -10,7 +10,9 @@ use super::{AgentArgs, warn_replacing};
 use unforeseen_harness::episodes::Method;
 use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::files::num;
-use unforeseen_harness::runs::trace::{TRACE_FILES, TraceReport, TraceRequest, mode, surprise_bits};
+use unforeseen_harness::reports::nearest_in_path;
+use unforeseen_harness::runs::trace::{TRACE_FILES, TraceReport, TraceRequest, mode, shows_street, surprise_bits};
+use unforeseen_sim::Map;
 
 /// Arguments of `trace`.
 #[derive(Debug, Clone, Args)]
@@ -90,7 +92,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
         args.episode,
         args.protocol
     );
-    print_ticks(&report);
+    print_ticks(&job.map, &report);
     outln!("{}", report.summary());
     let dir = &args.out;
     warn_replacing(dir, &TRACE_FILES);
@@ -104,12 +106,16 @@ pub fn run(args: TraceArgs) -> anyhow::Result<()> {
 }
 
 /// The decision ticks as a table: the state, the action and how it was chosen, the
-/// surprise and theta, the reward, the policy and psi.
-fn print_ticks(report: &TraceReport) {
+/// surprise and theta, the reward, the policy and psi; on a map with a junction or
+/// traffic ([`shows_street`]) also the vehicles and the nearest in the car's path
+/// (`3/1 12.4m@9.0` is three vehicles, one in its path, 12.4 m from the car's front at
+/// 9.0 m/s).
+fn print_ticks(map: &Map, report: &TraceReport) {
     let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
     let dist = |x: &[f64]| x.iter().map(|p| format!("{p:.2}")).collect::<Vec<_>>().join("/");
+    let street = shows_street(map);
     outln!(
-        "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}  {:<14} {:<14}",
+        "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8}  {:<14} {:<14}{}",
         "step",
         "d",
         "v",
@@ -121,12 +127,22 @@ fn print_ticks(report: &TraceReport) {
         "theta",
         "reward",
         "policy",
-        "psi"
+        "psi",
+        if street { "  vehicles (in path, nearest)" } else { "" }
     );
     for t in report.decided() {
         let s = t.state;
+        let vehicles = if street {
+            let snap = &t.snapshot;
+            let seen = snap.vehicles.iter().filter(|v| v.in_path).count();
+            let nearest =
+                nearest_in_path(map, snap).map_or_else(String::new, |(v, gap)| format!(" {gap:.1}m@{:.1}", v.speed));
+            format!("  {}/{seen}{nearest}", snap.vehicles.len())
+        } else {
+            String::new()
+        };
         outln!(
-            "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8.2}  {:<14} {:<14}",
+            "{:>4} {:>2} {:>2} {:>2} {:>2}  {:<10} {:<12} {:>8} {:>7} {:>8.2}  {:<14} {:<14}{}",
             t.step,
             s.d,
             s.v,
@@ -139,6 +155,7 @@ fn print_ticks(report: &TraceReport) {
             t.reward,
             dist(&t.policy),
             t.psi.as_deref().map(dist).unwrap_or_else(|| "-".into()),
+            vehicles,
         );
     }
 }

@@ -593,36 +593,68 @@ pub fn surface_tint(mu: f64) -> RGBColor {
     RGBColor(mix(205.0, 150.0), mix(205.0, 200.0), mix(205.0, 245.0))
 }
 
+/// The colour of a head showing `lamp` in the filmstrip.
+fn lamp_colour(lamp: crate::reports::Lamp) -> RGBColor {
+    use crate::reports::Lamp;
+    match lamp {
+        Lamp::Green => GREEN,
+        Lamp::Amber => AMBER,
+        Lamp::Red => RED,
+        Lamp::Walk => WHITE,
+        Lamp::DontWalk => DONT_WALK,
+        Lamp::Dark => DARK_HEAD,
+    }
+}
+
+/// Amber heads.
+const AMBER: RGBColor = RGBColor(255, 170, 0);
+/// A pedestrian head showing don't walk.
+const DONT_WALK: RGBColor = RGBColor(255, 110, 0);
+/// A dark head (an outage).
+const DARK_HEAD: RGBColor = RGBColor(70, 70, 70);
+/// The other vehicles.
+const VEHICLE: RGBColor = RGBColor(20, 150, 140);
+/// A vehicle in the car's path.
+const VEHICLE_IN_PATH: RGBColor = RGBColor(200, 30, 90);
+
 /// Top-down filmstrip of an episode: a title, a key, then one strip per decision tick
 /// showing the road, the crosswalk, the light's colour, the car (orange on ticks that
 /// reasoned, blue on feed-forward ticks), the pedestrians and the road's surface patches
 /// on that tick (tinted by their friction, [`surface_tint`]); left of each strip the
-/// tick, the action taken and the discrete state.
+/// tick, the action taken and the discrete state. A map with a junction adds the cross
+/// street (its lanes, sidewalks, crosswalks and stop lines), every signal head (round:
+/// vehicles', square: pedestrians'; grey when dark) and the other vehicles (teal,
+/// raspberry when in the car's path), as [`crate::reports::junction_scene`] lays them
+/// out, in taller strips that reach [`crate::reports::CROSS_VIEW`] m along the cross
+/// street; a map with traffic and no junction adds the vehicles.
 pub fn filmstrip(
     path: &Path,
     title: &str,
     map: &unforeseen_sim::Map,
     ticks: &[crate::episodes::runner::Tick],
 ) -> Result<()> {
-    use unforeseen_sim::LightPhase;
+    use crate::reports::{FRONT_BAND, Lamp, junction_scene, vehicle_quad};
     const WIDTH: u32 = 1000;
     const LABEL_W: u32 = 150;
-    const STRIP: u32 = 60;
+    let junction = junction_scene(map);
     let road_half = f64::from(map.road.lanes) * map.road.lane_width / 2.0;
-    let y_span = road_half + map.road.sidewalk_width;
+    let (y_span, strip) = match &junction {
+        // About 5 px per metre across, as the straight road's strips.
+        Some(j) => (j.reach, (10.0 * j.reach).round() as u32 + 6),
+        None => (road_half + map.road.sidewalk_width, 60),
+    };
     let car_y = -road_half + map.road.lane_width / 2.0;
     let x0 = map.vehicle.start_x - map.vehicle.length - 2.0;
     let x1 = map.road.goal_x + 4.0;
     let verge = RGBColor(190, 225, 180);
     let asphalt = surface_tint(map.road.friction);
     let walk = RGBColor(245, 245, 245);
-    let amber = RGBColor(255, 170, 0);
-    let key = [
+    let mut key = vec![
         KeyEntry::new(Swatch::Fill(HABIT.to_rgba()), "car, acting on its habit (feed-forward)"),
         KeyEntry::new(Swatch::Fill(REASONING.to_rgba()), "car, reasoning on this tick"),
         KeyEntry::new(Swatch::Dot(BLACK), "pedestrian"),
         KeyEntry::new(Swatch::Dot(GREEN), "light green"),
-        KeyEntry::new(Swatch::Dot(amber), "amber"),
+        KeyEntry::new(Swatch::Dot(AMBER), "amber"),
         KeyEntry::new(Swatch::Dot(RED), "red"),
         KeyEntry::new(Swatch::Fill(walk.to_rgba()), "crosswalk"),
         KeyEntry::new(Swatch::Fill(BLACK.to_rgba()), "destination"),
@@ -631,12 +663,25 @@ pub fn filmstrip(
         KeyEntry::new(Swatch::Fill(surface_tint(0.1).to_rgba()), "ice (μ 0.1)"),
         KeyEntry::new(Swatch::Fill(verge.to_rgba()), "sidewalk"),
     ];
+    if junction.is_some() || !map.traffic.is_empty() {
+        key.extend([
+            KeyEntry::new(Swatch::Fill(VEHICLE.to_rgba()), "vehicle"),
+            KeyEntry::new(Swatch::Fill(VEHICLE_IN_PATH.to_rgba()), "vehicle in the car's path"),
+        ]);
+    }
+    if junction.is_some() {
+        key.extend([
+            KeyEntry::new(Swatch::Dot(DARK_HEAD), "head dark (outage)"),
+            KeyEntry::new(Swatch::Fill(DONT_WALK.to_rgba()), "pedestrian head: don't walk"),
+            KeyEntry::new(Swatch::Blank, "white square: walk; white bar: stop line"),
+        ]);
+    }
     let note =
         "left of each strip: tick, action taken, state (d distance bin, v speed bin, L light 1 = green, p pedestrian)";
     let title_h = 36;
     let key_h = key_flow_height(&key, WIDTH as i32 - 20);
     let head = title_h + key_h + 26;
-    let height = head as u32 + STRIP * ticks.len().max(1) as u32;
+    let height = head as u32 + strip * ticks.len().max(1) as u32;
     write_svg(path, (WIDTH, height), |root| {
         let below = titled(root, title, 18.0)?;
         key_flow(&below, 10, 0, &key)?;
@@ -676,6 +721,12 @@ pub fn filmstrip(
                     Rectangle::new([(x0, -road_half), (x1, road_half)], asphalt.filled()),
                 ])
                 .map_err(plot_err)?;
+            if let Some(j) = &junction {
+                let (k0, k1) = j.cross_kerbs;
+                chart
+                    .draw_series([Rectangle::new([(k0, -y_span), (k1, y_span)], asphalt.filled())])
+                    .map_err(plot_err)?;
+            }
             chart
                 .draw_series(t.snapshot.surface.iter().map(|p| {
                     Rectangle::new(
@@ -699,11 +750,28 @@ pub fn filmstrip(
                     ),
                 ])
                 .map_err(plot_err)?;
-            let light = match t.snapshot.light {
-                LightPhase::Green => GREEN,
-                LightPhase::Amber => amber,
-                LightPhase::Red => RED,
-            };
+            if let Some(j) = &junction {
+                chart
+                    .draw_series(
+                        j.crosswalks
+                            .iter()
+                            .map(|(_, r)| Rectangle::new([(r.x0, r.y0), (r.x1, r.y1)], walk.filled())),
+                    )
+                    .map_err(plot_err)?;
+                let white = WHITE.stroke_width(3);
+                chart
+                    .draw_series(j.stop_lines.iter().map(|l| PathElement::new(l.to_vec(), white)))
+                    .map_err(plot_err)?;
+                let dash = WHITE.mix(0.8).stroke_width(1);
+                chart
+                    .draw_series(j.cross_lane_lines.iter().flat_map(|&x| {
+                        [
+                            PathElement::new(vec![(x, road_half), (x, y_span)], dash),
+                            PathElement::new(vec![(x, -y_span), (x, -road_half)], dash),
+                        ]
+                    }))
+                    .map_err(plot_err)?;
+            }
             let s = &t.snapshot;
             let car = Rectangle::new(
                 [
@@ -719,8 +787,44 @@ pub fn filmstrip(
                         -road_half - map.road.sidewalk_width / 2.0,
                     ),
                     4,
-                    light.filled(),
+                    lamp_colour(Lamp::of_aspect(s.signals.road)).filled(),
                 )])
+                .map_err(plot_err)?;
+            if let Some(j) = &junction {
+                for h in &j.heads {
+                    let colour = lamp_colour(h.lamp(&s.signals));
+                    let at = EmptyElement::at((h.x, h.y));
+                    if h.pedestrian() {
+                        chart
+                            .draw_series([at
+                                + Rectangle::new([(-4, -4), (4, 4)], BLACK.filled())
+                                + Rectangle::new([(-3, -3), (3, 3)], colour.filled())])
+                            .map_err(plot_err)?;
+                    } else {
+                        chart
+                            .draw_series([at
+                                + Circle::new((0, 0), 5, BLACK.filled())
+                                + Circle::new((0, 0), 4, colour.filled())])
+                            .map_err(plot_err)?;
+                    }
+                }
+            }
+            // Vehicles in view (one beyond it would be drawn squashed onto its edge).
+            let in_view = |v: &&unforeseen_sim::VehicleSnapshot| {
+                let r = v.length.hypot(v.width) / 2.0;
+                v.x + r > x0 && v.x - r < x1 && v.y.abs() - r < y_span
+            };
+            chart
+                .draw_series(s.vehicles.iter().filter(in_view).flat_map(|v| {
+                    let colour = if v.in_path { VEHICLE_IN_PATH } else { VEHICLE };
+                    [
+                        Polygon::new(vehicle_quad(v, 0.0, v.length).to_vec(), colour.filled()),
+                        Polygon::new(
+                            vehicle_quad(v, v.length - FRONT_BAND, v.length).to_vec(),
+                            WHITE.mix(0.6).filled(),
+                        ),
+                    ]
+                }))
                 .map_err(plot_err)?;
             chart.draw_series([car]).map_err(plot_err)?;
             chart

@@ -4,12 +4,16 @@
 //! theta and the action of every tick (paper Figs. 6-7); a slider scrubs, a button
 //! plays. Positions between two decision ticks are interpolated for display only; the
 //! per-tick data are embedded as JSON (`<script type="application/json" id="episode">`),
-//! the same figures as `trace.csv`.
+//! the same figures as `trace.csv`. On a map with a junction the scene adds the cross
+//! street, its crosswalks and the stop lines ([`crate::reports::junction_scene`]) and
+//! every tick carries every signal head's state and the other vehicles' poses, which the
+//! page animates.
 
 use serde::Serialize;
 use unforeseen_sim::{LightPhase, Map};
 
 use crate::episodes::runner::Tick;
+use crate::reports::scene::{JunctionScene, Lamp, Shows, junction_scene};
 
 /// The road's geometry, in metres, as the replay draws it.
 #[derive(Debug, Serialize)]
@@ -27,6 +31,64 @@ struct Scene {
     light_x: f64,
     /// The road's colour: its friction's tint (`figures::surface_tint`).
     road_colour: String,
+    /// The junction, if the map has one.
+    junction: Option<JunctionView>,
+}
+
+/// A rectangle `[x0, y0, x1, y1]`, m.
+type Area = [f64; 4];
+
+/// The junction as the page draws it ([`JunctionScene`]).
+#[derive(Debug, Serialize)]
+struct JunctionView {
+    /// How far across the road the scene reaches, m.
+    reach: f64,
+    junction_box: Area,
+    /// x of the cross street's kerbs, m.
+    cross_kerbs: (f64, f64),
+    cross_sidewalk: f64,
+    cross_lane_lines: Vec<f64>,
+    /// (across the road, the rectangle) per crosswalk of the other arms.
+    crosswalks: Vec<(bool, Area)>,
+    stop_lines: Vec<[(f64, f64); 2]>,
+    /// (x, y, which head it repeats: `road`, `cross`, `walk_road` or `walk_cross`) per
+    /// head besides the car's.
+    heads: Vec<(f64, f64, &'static str)>,
+}
+
+impl JunctionView {
+    fn of(j: JunctionScene) -> JunctionView {
+        let area = |r: unforeseen_sim::junction::Rect| [r.x0, r.y0, r.x1, r.y1];
+        JunctionView {
+            reach: j.reach,
+            junction_box: area(j.junction_box),
+            cross_kerbs: j.cross_kerbs,
+            cross_sidewalk: j.cross_sidewalk,
+            cross_lane_lines: j.cross_lane_lines,
+            crosswalks: j.crosswalks.iter().map(|(arm, r)| (arm.on_road(), area(*r))).collect(),
+            stop_lines: j.stop_lines,
+            heads: (j.heads.iter())
+                .map(|h| {
+                    let shows = match h.shows {
+                        Shows::Road => "road",
+                        Shows::Cross => "cross",
+                        Shows::WalkRoad => "walk_road",
+                        Shows::WalkCross => "walk_cross",
+                    };
+                    (h.x, h.y, shows)
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Every head at one tick, as [`Lamp::name`]s.
+#[derive(Debug, Serialize)]
+struct Heads {
+    road: &'static str,
+    cross: &'static str,
+    walk_road: &'static str,
+    walk_cross: &'static str,
 }
 
 /// One decision tick of the replay.
@@ -42,6 +104,12 @@ struct Frame {
     pedestrians: Vec<(f64, f64, bool)>,
     /// (from, to, friction, CSS colour) per surface patch on the road at this tick.
     surface: Vec<(f64, f64, f64, String)>,
+    /// Every signal head (the car's is `road`; dark in an outage, whatever `light` reads).
+    signals: Heads,
+    /// (x, y, heading rad, length, width, in the car's path) per other vehicle.
+    vehicles: Vec<(f64, f64, f64, f64, f64, bool)>,
+    /// Whether a vehicle is in the car's path.
+    vehicle_in_path: bool,
     /// The action taken at this tick (none on the final frame).
     action: Option<String>,
     reasoned: bool,
@@ -118,6 +186,7 @@ pub fn replay_html(
                 let c = crate::reports::figures::surface_tint(map.road.friction);
                 format!("rgb({},{},{})", c.0, c.1, c.2)
             },
+            junction: junction_scene(map).map(JunctionView::of),
         },
         ticks: ticks
             .iter()
@@ -144,6 +213,19 @@ pub fn replay_html(
                         (p.from, p.to, p.friction, format!("rgb({},{},{})", c.0, c.1, c.2))
                     })
                     .collect(),
+                signals: {
+                    let g = &t.snapshot.signals;
+                    Heads {
+                        road: Lamp::of_aspect(g.road).name(),
+                        cross: Lamp::of_aspect(g.cross).name(),
+                        walk_road: Lamp::of_walk(g.walk_road).name(),
+                        walk_cross: Lamp::of_walk(g.walk_cross).name(),
+                    }
+                },
+                vehicles: (t.snapshot.vehicles.iter())
+                    .map(|v| (v.x, v.y, v.heading, v.length, v.width, v.in_path))
+                    .collect(),
+                vehicle_in_path: t.snapshot.vehicle_in_path,
                 action: (i < last).then(|| t.action.to_string()),
                 reasoned: t.reasoned && i < last,
                 theta: t.theta.filter(|_| i < last),
@@ -199,6 +281,8 @@ const PAGE: &str = r##"<!DOCTYPE html>
   .mode-reasoning { color: #c06000; font-weight: bold; }
   .mode-habit { color: #2846e6; font-weight: bold; }
   .violation { color: #d01818; font-weight: bold; }
+  .junction-key { display: none; }
+  .has-junction .junction-key { display: inline; }
 </style>
 </head>
 <body>
@@ -229,6 +313,10 @@ const PAGE: &str = r##"<!DOCTYPE html>
       <span><span class="sw" style="background:rgb(174,202,228)"></span>wet road (μ 0.4)</span>
       <span><span class="sw" style="background:rgb(150,200,245)"></span>ice (μ 0.1): road surface tinted by its friction</span>
       <span><span class="sw" style="border:2px solid #d01818"></span>car outlined red: that tick entered the crosswalk on red</span>
+      <span class="junction-key"><span class="sw" style="background:#14968c"></span>vehicle</span>
+      <span class="junction-key"><span class="sw" style="background:#c81e5a"></span>vehicle in the car's path</span>
+      <span class="junction-key"><span class="sw dot" style="background:#464646"></span>head dark (outage)</span>
+      <span class="junction-key"><span class="sw" style="background:#fff"></span><span class="sw" style="background:#ff6e00"></span>pedestrian head: walk, don't walk</span>
     </div>
   </div>
   <div class="card" id="info-card">
@@ -265,21 +353,46 @@ function el(parent, name, attrs, text) {
   parent.appendChild(e);
   return e;
 }
-const LIGHT = { green: "#1db31d", amber: "#ffaa00", red: "#e02020" };
+const LIGHT = { green: "#1db31d", amber: "#ffaa00", red: "#e02020", walk: "#ffffff", dont_walk: "#ff6e00", dark: "#464646" };
+const WALK = { walk: "walk", dont_walk: "don't walk", dark: "dark" };
 const ACTION = { "speed up": "#8fd18f", "maintain": "#d0d0d0", "slow down": "#f09090" };
 
 // The scene, in metres: x along the road, y up (SVG y down, so y is negated).
-const half = S.road_half + S.sidewalk;
+const J = S.junction;
+if (J) document.body.classList.add("has-junction");
+const half = J ? J.reach : S.road_half + S.sidewalk;
 const scene = $("scene");
 scene.setAttribute("viewBox", `${S.x0} ${-half} ${S.x1 - S.x0} ${2 * half}`);
+// An area [x0, y0, x1, y1] in metres as an SVG rect.
+const area = (parent, [x0, y0, x1, y1], attrs) =>
+  el(parent, "rect", Object.assign({ x: x0, y: -y1, width: x1 - x0, height: y1 - y0 }, attrs));
 el(scene, "rect", { x: S.x0, y: -half, width: S.x1 - S.x0, height: 2 * half, fill: "#bee1b4" });
 el(scene, "rect", { x: S.x0, y: -S.road_half, width: S.x1 - S.x0, height: 2 * S.road_half, fill: S.road_colour });
+if (J) area(scene, [J.cross_kerbs[0], -half, J.cross_kerbs[1], half], { fill: S.road_colour });
 const surface = el(scene, "g", {});
 el(scene, "line", { x1: S.x0, x2: S.x1, y1: 0, y2: 0, stroke: "#fff", "stroke-width": 0.15, "stroke-dasharray": "2 2" });
 for (let y = -S.road_half; y < S.road_half - 0.01; y += 0.8)
   el(scene, "rect", { x: S.crosswalk_x - S.crosswalk_width / 2, y: y + 0.1, width: S.crosswalk_width, height: 0.5, fill: "#f5f5f5" });
+if (J) {
+  // The box covers the road's lane line; the cross street's lane lines stop at the road.
+  area(scene, J.junction_box, { fill: S.road_colour });
+  for (const x of J.cross_lane_lines)
+    for (const [y0, y1] of [[-half, J.junction_box[1]], [J.junction_box[3], half]])
+      el(scene, "line", { x1: x, x2: x, y1: -y0, y2: -y1, stroke: "#fff", "stroke-width": 0.15, "stroke-dasharray": "2 2" });
+  for (const [acrossRoad, [x0, y0, x1, y1]] of J.crosswalks) {
+    if (acrossRoad) for (let y = y0; y < y1 - 0.01; y += 0.8) area(scene, [x0, y + 0.1, x1, y + 0.6], { fill: "#f5f5f5" });
+    else for (let x = x0; x < x1 - 0.01; x += 0.8) area(scene, [x + 0.1, y0, x + 0.6, y1], { fill: "#f5f5f5" });
+  }
+  for (const [[ax, ay], [bx, by]] of J.stop_lines)
+    el(scene, "line", { x1: ax, y1: -ay, x2: bx, y2: -by, stroke: "#fff", "stroke-width": 0.4, class: "stop-line" });
+}
 el(scene, "rect", { x: S.goal_x - 0.3, y: -S.road_half, width: 0.3, height: 2 * S.road_half, fill: "#000" });
 const light = el(scene, "circle", { cx: S.light_x, cy: S.road_half + S.sidewalk / 2, r: 0.8, stroke: "#333", "stroke-width": 0.1 });
+// The other heads: vehicle heads round, pedestrian heads square; filled per tick.
+const heads = (J ? J.heads : []).map(([x, y, shows]) => [shows, shows.startsWith("walk")
+  ? el(scene, "rect", { x: x - 0.5, y: -y - 0.5, width: 1, height: 1, stroke: "#222", "stroke-width": 0.2, class: "head" })
+  : el(scene, "circle", { cx: x, cy: -y, r: 0.8, stroke: "#333", "stroke-width": 0.1, class: "head" })]);
+const vehicles = el(scene, "g", {});
 const car = el(scene, "rect", { y: -S.car_y - S.car_width / 2, width: S.car_length, height: S.car_width, rx: 0.3 });
 const peds = el(scene, "g", {});
 
@@ -341,6 +454,8 @@ function info(i) {
     ["car", `x ${t.car_x.toFixed(1)} m, ${t.speed.toFixed(1)} m/s`],
     ["light", `${t.light}, ${t.light_left.toFixed(1)} s left`],
     ["pedestrians", String(t.pedestrians.length)],
+    ["vehicles", `${t.vehicles.length} (${t.vehicles.filter((v) => v[5]).length} in the car's path)`],
+    ...(J ? [["signals", `road ${t.signals.road}, cross ${t.signals.cross}; pedestrians: ${WALK[t.signals.walk_road]} across the road, ${WALK[t.signals.walk_cross]} across the cross street`]] : []),
     ["reward", t.reward.toFixed(2)],
     ["red light", t.red_light ? '<span class="violation">ran a red light: entered the crosswalk on red this tick</span>' : "–"],
   ];
@@ -359,7 +474,21 @@ function show(t) {
   car.setAttribute("fill", a.reasoned ? "#e68c00" : "#2846e6");
   car.setAttribute("stroke", a.red_light ? "#d01818" : "none");
   car.setAttribute("stroke-width", a.red_light ? 0.6 : 0);
-  light.setAttribute("fill", LIGHT[a.light]);
+  light.setAttribute("fill", LIGHT[a.signals.road]);
+  for (const [shows, head] of heads) head.setAttribute("fill", LIGHT[a.signals[shows]]);
+  vehicles.replaceChildren();
+  const sameVehicles = a.vehicles.length === b.vehicles.length;
+  a.vehicles.forEach((v, k) => {
+    // Taken to be the same vehicle on the next tick when both ticks have as many.
+    const w = sameVehicles ? b.vehicles[k] : v;
+    let turn = w[2] - v[2];
+    turn -= 2 * Math.PI * Math.round(turn / (2 * Math.PI));
+    const [x, y, h] = [lerp(v[0], w[0]), lerp(v[1], w[1]), v[2] + turn * f];
+    const [len, wid] = [v[3], v[4]];
+    const g = el(vehicles, "g", { transform: `translate(${x} ${-y}) rotate(${-h * 180 / Math.PI})`, class: "vehicle" });
+    el(g, "rect", { x: -len / 2, y: -wid / 2, width: len, height: wid, rx: 0.3, fill: v[5] ? "#c81e5a" : "#14968c" });
+    el(g, "rect", { x: len / 2 - 0.6, y: -wid / 2, width: 0.6, height: wid, fill: "#fff", "fill-opacity": 0.6 });
+  });
   surface.replaceChildren();
   for (const [from, to, mu, colour] of a.surface) {
     const x0 = Math.max(from, S.x0), x1 = Math.min(to, S.x1);

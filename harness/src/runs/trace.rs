@@ -22,6 +22,7 @@ use crate::limits::MAX_EPISODES;
 use crate::progress::Progress;
 use crate::reports::figures::{filmstrip, theta_trace};
 use crate::reports::replay_page::replay_html;
+use crate::reports::{Lamp, nearest_in_path};
 use crate::runs::batch::AgentChoice;
 use crate::runs::batch::request::AgentFields;
 use crate::runs::outputs::{Outputs, Own};
@@ -109,15 +110,24 @@ impl TraceReport {
         &self.ticks[..self.ticks.len().saturating_sub(1)]
     }
 
-    /// How the episode ended: `reached the destination`, `hit a pedestrian` or `ran out
-    /// of time`.
+    /// How the episode ended: `reached the destination`, `hit a pedestrian`, `hit a
+    /// vehicle` (another vehicle and no pedestrian in the world at the end), `hit a
+    /// pedestrian or a vehicle` (both there: the world reports a collision, not with
+    /// what) or `ran out of time`.
     pub fn outcome(&self) -> &'static str {
+        let last = self.ticks.last().map(|t| &t.snapshot);
+        let vehicles = last.is_some_and(|s| !s.vehicles.is_empty());
+        let pedestrians = last.is_some_and(|s| !s.pedestrians.is_empty());
         if self.result.success {
             "reached the destination"
-        } else if self.result.collision {
-            "hit a pedestrian"
-        } else {
+        } else if !self.result.collision {
             "ran out of time"
+        } else if !vehicles {
+            "hit a pedestrian"
+        } else if pedestrians {
+            "hit a pedestrian or a vehicle"
+        } else {
+            "hit a vehicle"
         }
     }
 
@@ -232,7 +242,7 @@ impl TraceJob {
         };
         all_or_none(|| -> Result<(), Error> {
             if let Some([csv, theta, film]) = paths.get(..3) {
-                trace_csv(report.decided()).write(csv)?;
+                trace_csv(map, report.decided()).write(csv)?;
                 let points: Vec<_> = report
                     .decided()
                     .iter()
@@ -269,11 +279,22 @@ impl TraceJob {
     }
 }
 
+/// Whether a trace of `map` lists the street around the car: the map has a junction or
+/// traffic. The paper's maps have neither, and their trace.csv keeps the columns it had
+/// before there were vehicles.
+pub fn shows_street(map: &Map) -> bool {
+    map.junction.is_some() || !map.traffic.is_empty()
+}
+
 /// `trace.csv`: one row per decision tick (the state, the action and how it was
 /// chosen, the surprise and theta, the reward, the policy and psi, the car and the
-/// light).
-fn trace_csv(decided: &[Tick]) -> Csv {
-    let mut csv = Csv::new(&[
+/// light). On a map with a junction or traffic ([`shows_street`]) the columns after
+/// those add the vehicles: how many, whether one is in the car's path, the nearest of
+/// those in its path (metres from the car's front bumper to its body, its speed; `-`
+/// with none), and what the road's and the cross street's heads show (`dark` in an
+/// outage, whatever `light`, the car's reading, says).
+fn trace_csv(map: &Map, decided: &[Tick]) -> Csv {
+    let mut columns = vec![
         "step",
         "d",
         "v",
@@ -289,12 +310,24 @@ fn trace_csv(decided: &[Tick]) -> Csv {
         "car_x",
         "car_speed",
         "light",
-    ]);
+    ];
+    let street = shows_street(map);
+    if street {
+        columns.extend([
+            "vehicles",
+            "vehicle_in_path",
+            "nearest_in_path_m",
+            "nearest_in_path_speed",
+            "road_head",
+            "cross_head",
+        ]);
+    }
+    let mut csv = Csv::new(&columns);
     let opt = |x: Option<f64>, d| x.map(|v| num(v, d)).unwrap_or_else(|| "-".into());
     let cells = |x: &[f64]| x.iter().map(|p| num(*p, 6)).collect::<Vec<_>>().join(" ");
     for t in decided {
         let s = t.state;
-        csv.row(vec![
+        let mut row = vec![
             t.step.to_string(),
             s.d.to_string(),
             s.v.to_string(),
@@ -310,7 +343,20 @@ fn trace_csv(decided: &[Tick]) -> Csv {
             num(t.snapshot.car_x, 3),
             num(t.snapshot.car_speed, 3),
             format!("{:?}", t.snapshot.light),
-        ]);
+        ];
+        if street {
+            let snap = &t.snapshot;
+            let nearest = nearest_in_path(map, snap);
+            row.extend([
+                snap.vehicles.len().to_string(),
+                u8::from(snap.vehicle_in_path).to_string(),
+                opt(nearest.map(|(_, gap)| gap), 3),
+                opt(nearest.map(|(v, _)| v.speed), 3),
+                Lamp::of_aspect(snap.signals.road).name().into(),
+                Lamp::of_aspect(snap.signals.cross).name().into(),
+            ]);
+        }
+        csv.row(row);
     }
     csv
 }

@@ -7,5 +7,6 @@ mod end_to_end;
 mod figures;
 mod fuzz;
 mod golden;
+mod junction_pictures;
 mod protocols;
 mod safety;
