@@ -78,6 +78,11 @@ pub struct EnvConfig {
     pub observation: ObservationForm,
     /// Pedestrian slots of the kinematic vector (1..=[`kinematic::MAX_SLOTS`]). Default 4.
     pub pedestrian_slots: usize,
+    /// Vehicle slots of the kinematic vector (0..=[`kinematic::MAX_SLOTS`]). Default
+    /// `None`: [`kinematic::default_vehicle_slots`] (4 on a map with traffic rules, 0 on
+    /// one without). Not serialised when `None`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vehicle_slots: Option<usize>,
 }
 
 impl Default for EnvConfig {
@@ -85,6 +90,7 @@ impl Default for EnvConfig {
         Self {
             observation: ObservationForm::Discrete,
             pedestrian_slots: 4,
+            vehicle_slots: None,
         }
     }
 }
@@ -215,6 +221,7 @@ pub struct Env {
     map: Map,
     disc: Discretizer,
     config: EnvConfig,
+    slots: kinematic::Slots,
     world: Option<World>,
     noise: ChaCha8Rng,
     snapshot: Option<Snapshot>,
@@ -251,9 +258,22 @@ impl Env {
                 ),
             });
         }
+        let vehicles = config
+            .vehicle_slots
+            .unwrap_or_else(|| kinematic::default_vehicle_slots(map));
+        if vehicles > kinematic::MAX_SLOTS {
+            return Err(EnvError::Config {
+                field: "vehicle_slots",
+                problem: format!("must be in 0..={}, got {vehicles}", kinematic::MAX_SLOTS),
+            });
+        }
         Ok(Env {
             map: map.clone(),
             disc,
+            slots: kinematic::Slots {
+                pedestrians: config.pedestrian_slots,
+                vehicles,
+            },
             config,
             world: None,
             noise: ChaCha8Rng::seed_from_u64(0),
@@ -288,6 +308,11 @@ impl Env {
     /// The configuration.
     pub fn config(&self) -> &EnvConfig {
         &self.config
+    }
+
+    /// The kinematic vector's slots (the configured vehicle slots, or the map's default).
+    pub fn slots(&self) -> kinematic::Slots {
+        self.slots
     }
 
     /// Starts an episode: the world's randomness (light offset, spawns) from `seed`, the
@@ -369,12 +394,12 @@ impl Env {
     }
 
     /// The kinematic vector after the last tick, written into `out`
-    /// ([`kinematic::len`]`(pedestrian_slots)` values), whatever the observation form.
+    /// ([`kinematic::len`]`(`[`Env::slots`]`)` values), whatever the observation form.
     ///
     /// # Panics
     /// If `out` has another length, or before the first reset.
     pub fn kinematic_into(&self, out: &mut [f32]) {
-        kinematic::write(&self.map, self.snapshot(), self.config.pedestrian_slots, out);
+        kinematic::write(&self.map, self.snapshot(), self.slots, out);
     }
 
     /// Snapshot, true and observed state after a reset or a tick.
@@ -404,7 +429,7 @@ impl Env {
                 index: self.disc.encode(self.observed()),
             },
             ObservationForm::Kinematic => {
-                let mut v = vec![0.0; kinematic::len(self.config.pedestrian_slots)];
+                let mut v = vec![0.0; kinematic::len(self.slots)];
                 self.kinematic_into(&mut v);
                 Observation::Kinematic(v)
             }

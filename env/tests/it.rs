@@ -18,6 +18,7 @@ fn kinematic_env(map: &Map) -> Env {
     let config = EnvConfig {
         observation: ObservationForm::Kinematic,
         pedestrian_slots: 3,
+        ..EnvConfig::default()
     };
     Env::new(map, config).expect("env")
 }
@@ -205,8 +206,8 @@ fn observation_noise_corrupts_the_observation_not_the_true_state() {
 fn the_kinematic_observation_follows_its_documented_layout() {
     let m = map("two_pedestrians");
     let mut env = kinematic_env(&m);
-    let (low, high) = kinematic::bounds(&m, 3);
-    assert_eq!(low.len(), kinematic::len(3));
+    let (low, high) = kinematic::bounds(&m, kinematic::Slots::pedestrians(3));
+    assert_eq!(low.len(), kinematic::len(kinematic::Slots::pedestrians(3)));
     let mut seen_pedestrian = false;
     for seed in 0..4 {
         let (_, steps) = rollout(&mut env, seed, &[1, 1, 2, 0]);
@@ -237,11 +238,81 @@ fn the_kinematic_observation_follows_its_documented_layout() {
                 }
             }
         }
-        let mut buf = vec![0.0; kinematic::len(3)];
+        let mut buf = vec![0.0; kinematic::len(kinematic::Slots::pedestrians(3))];
         env.kinematic_into(&mut buf);
         assert_eq!(buf, v);
     }
     assert!(seen_pedestrian, "two_pedestrians shows pedestrians in some slot");
+}
+
+#[test]
+fn vehicle_slots_hold_the_nearest_vehicles_within_bounds() {
+    // Without traffic rules there are no vehicle slots: the layout is the pedestrians'.
+    let plain = kinematic_env(&map("jaywalk"));
+    assert_eq!(plain.slots(), kinematic::Slots::pedestrians(3));
+    let m = map("junction_training");
+    let mut env = kinematic_env(&m);
+    let slots = env.slots();
+    assert_eq!(slots.vehicles, kinematic::DEFAULT_VEHICLE_SLOTS);
+    let (low, high) = kinematic::bounds(&m, slots);
+    assert_eq!(low.len(), kinematic::len(slots));
+    let (cy, start) = (
+        m.road.car_lane_y(),
+        kinematic::HEAD + kinematic::PER_SLOT * slots.pedestrians,
+    );
+    let mut filled = 0;
+    for seed in 0..6 {
+        let (_, steps) = rollout(&mut env, seed, &[0, 0, 1, 2]);
+        let v = steps.last().unwrap().observation.kinematic().unwrap().to_vec();
+        let snap = env.snapshot();
+        let mut dists: Vec<f64> = (snap.vehicles.iter())
+            .map(|o| (o.x - snap.car_x).hypot(o.y - cy))
+            .filter(|d| *d <= kinematic::VEHICLE_RANGE)
+            .collect();
+        dists.sort_by(f64::total_cmp);
+        for (j, slot) in v[start..].chunks(kinematic::PER_VEHICLE).enumerate() {
+            match dists.get(j) {
+                Some(d) => {
+                    filled += 1;
+                    assert_eq!(slot[0], 1.0);
+                    let got = (f64::from(slot[1]) - snap.car_x).hypot(f64::from(slot[2]) - cy);
+                    assert!((got - d).abs() < 1e-3, "slot {j}: {got} m, the {j}-th nearest is {d} m");
+                    let speed = f64::from(slot[3]).hypot(f64::from(slot[4]));
+                    assert!((f64::from(slot[5]).cos() * speed - f64::from(slot[3])).abs() < 1e-3);
+                }
+                None => assert!(slot.iter().all(|x| *x == 0.0), "an empty slot is zeros: {slot:?}"),
+            }
+        }
+        for s in &steps {
+            let v = s.observation.kinematic().unwrap();
+            for (i, x) in v.iter().enumerate() {
+                assert!(
+                    low[i] <= *x && *x <= high[i],
+                    "value {i} = {x} outside [{}, {}]",
+                    low[i],
+                    high[i]
+                );
+            }
+        }
+    }
+    assert!(filled > 0, "the training junction shows vehicles in some slot");
+    let too_many = EnvConfig {
+        vehicle_slots: Some(kinematic::MAX_SLOTS + 1),
+        ..EnvConfig::default()
+    };
+    assert!(matches!(
+        Env::new(&m, too_many),
+        Err(EnvError::Config {
+            field: "vehicle_slots",
+            ..
+        })
+    ));
+    let none = EnvConfig {
+        observation: ObservationForm::Kinematic,
+        vehicle_slots: Some(0),
+        ..EnvConfig::default()
+    };
+    assert_eq!(Env::new(&m, none).unwrap().slots(), kinematic::Slots::pedestrians(4));
 }
 
 #[test]
@@ -289,7 +360,7 @@ proptest! {
     fn every_step_keeps_the_laws(seed in any::<u64>(), actions in proptest::collection::vec(0usize..3, 1..12)) {
         let m = map("two_pedestrians");
         let mut env = kinematic_env(&m);
-        let (low, high) = kinematic::bounds(&m, 3);
+        let (low, high) = kinematic::bounds(&m, kinematic::Slots::pedestrians(3));
         let (_, steps) = rollout(&mut env, seed, &actions);
         for (k, s) in steps.iter().enumerate() {
             let t = s.info.reward;

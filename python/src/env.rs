@@ -44,16 +44,40 @@ pub fn observation_form(name: &str) -> PyResult<ObservationForm> {
     }
 }
 
-/// Builds an env of `map` observing in `form`.
-pub fn new_env(map: &Map, form: ObservationForm, pedestrian_slots: usize) -> PyResult<Env> {
+/// Builds an env of `map` observing in `form` with `pedestrian_slots` and
+/// `vehicle_slots` (`None`: the map's default, [`kinematic::default_vehicle_slots`]).
+pub fn new_env(
+    map: &Map,
+    form: ObservationForm,
+    pedestrian_slots: usize,
+    vehicle_slots: Option<usize>,
+) -> PyResult<Env> {
     Env::new(
         map,
         EnvConfig {
             observation: form,
             pedestrian_slots,
+            vehicle_slots,
         },
     )
     .map_err(errors::to_py)
+}
+
+/// The slot counts given from Python: `pedestrian_slots` in 1..=[`kinematic::MAX_SLOTS`]
+/// (`None`: the default 4), `vehicle_slots` in 0..=[`kinematic::MAX_SLOTS`] (`None`: the
+/// map's default), each named in a `ValueError`.
+pub fn slot_counts(
+    pedestrian_slots: Option<&Bound<'_, PyAny>>,
+    vehicle_slots: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(usize, Option<usize>)> {
+    let pedestrians = pedestrian_slots
+        .map(|n| convert::size("pedestrian_slots", n, 1..=kinematic::MAX_SLOTS))
+        .transpose()?
+        .unwrap_or(EnvConfig::default().pedestrian_slots);
+    let vehicles = vehicle_slots
+        .map(|n| convert::size("vehicle_slots", n, 0..=kinematic::MAX_SLOTS))
+        .transpose()?;
+    Ok((pedestrians, vehicles))
 }
 
 /// Checks an action given from Python (any integer) and returns it as an index.
@@ -197,24 +221,23 @@ impl PyEnv {
 
 #[pymethods]
 impl PyEnv {
-    /// An env of `map` (file or embedded name) with map `overrides` (dict).
+    /// An env of `map` (file or embedded name) with map `overrides` (dict);
+    /// `vehicle_slots` `None` is the map's default.
     #[new]
-    #[pyo3(signature = (map, observation = "discrete", pedestrian_slots = None, overrides = None))]
+    #[pyo3(signature = (map, observation = "discrete", pedestrian_slots = None, overrides = None, vehicle_slots = None))]
     fn new(
         py: Python<'_>,
         map: &Bound<'_, PyAny>,
         observation: &str,
         pedestrian_slots: Option<&Bound<'_, PyAny>>,
         overrides: Option<&Bound<'_, PyDict>>,
+        vehicle_slots: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let map = convert::path("map", map)?;
-        let pedestrian_slots = pedestrian_slots
-            .map(|n| convert::size("pedestrian_slots", n, 1..=kinematic::MAX_SLOTS))
-            .transpose()?
-            .unwrap_or(EnvConfig::default().pedestrian_slots);
+        let (pedestrian_slots, vehicle_slots) = slot_counts(pedestrian_slots, vehicle_slots)?;
         let form = observation_form(observation)?;
         let map = crate::maps::load(&map.to_string_lossy(), overrides)?;
-        let env = new_env(&map, form, pedestrian_slots)?;
+        let env = new_env(&map, form, pedestrian_slots, vehicle_slots)?;
         Ok(PyEnv {
             states: state_tuples(py, &env)?,
             env,
@@ -253,12 +276,24 @@ impl PyEnv {
     /// Length of the kinematic vector.
     #[getter]
     fn kinematic_len(&self) -> usize {
-        kinematic::len(self.env.config().pedestrian_slots)
+        kinematic::len(self.env.slots())
+    }
+
+    /// Pedestrian slots of the kinematic vector.
+    #[getter]
+    fn pedestrian_slots(&self) -> usize {
+        self.env.slots().pedestrians
+    }
+
+    /// Vehicle slots of the kinematic vector (the configured count, or the map's default).
+    #[getter]
+    fn vehicle_slots(&self) -> usize {
+        self.env.slots().vehicles
     }
 
     /// `(low, high)` of the kinematic vector (float32 arrays; [`kinematic::bounds`]).
     fn kinematic_bounds<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>) {
-        let (lo, hi) = kinematic::bounds(self.env.map(), self.env.config().pedestrian_slots);
+        let (lo, hi) = kinematic::bounds(self.env.map(), self.env.slots());
         (PyArray1::from_vec(py, lo), PyArray1::from_vec(py, hi))
     }
 
@@ -378,7 +413,7 @@ pub fn rust_loop(
     let seed = seed.map(|s| convert::seed("seed", s)).transpose()?.unwrap_or(0);
     let form = observation_form(observation)?;
     let map = crate::maps::load(&map.to_string_lossy(), overrides)?;
-    let mut env = new_env(&map, form, 4)?;
+    let mut env = new_env(&map, form, 4, None)?;
     let actions = actions.into_iter().map(action_index).collect::<PyResult<Vec<_>>>()?;
     if actions.is_empty() {
         return Err(errors::value("actions: give at least one action"));

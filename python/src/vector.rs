@@ -14,7 +14,7 @@ use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
-use unforeseen_env::{Env, EnvConfig, Info, Observation, ObservationForm, kinematic};
+use unforeseen_env::{Env, Info, Observation, ObservationForm, kinematic};
 
 use crate::convert;
 use crate::env::{action_index, frame_array, light_code, new_env, observation, observation_form, stream_seed};
@@ -95,7 +95,8 @@ impl PyVectorEnv {
     /// `num_envs` envs of `map` with map `overrides`; `num_threads` threads (default:
     /// rayon's global pool, one per core); `autoreset` "next_step" or "same_step".
     #[new]
-    #[pyo3(signature = (map, num_envs, observation = "discrete", pedestrian_slots = None, overrides = None, num_threads = None, autoreset = "next_step"))]
+    #[pyo3(signature = (map, num_envs, observation = "discrete", pedestrian_slots = None, overrides = None, num_threads = None, autoreset = "next_step", vehicle_slots = None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         map: &Bound<'_, PyAny>,
         num_envs: &Bound<'_, PyAny>,
@@ -104,13 +105,11 @@ impl PyVectorEnv {
         overrides: Option<&Bound<'_, PyDict>>,
         num_threads: Option<&Bound<'_, PyAny>>,
         autoreset: &str,
+        vehicle_slots: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let map = convert::path("map", map)?;
         let num_envs = convert::size("num_envs", num_envs, 1..=MAX_ENVS)?;
-        let pedestrian_slots = pedestrian_slots
-            .map(|n| convert::size("pedestrian_slots", n, 1..=kinematic::MAX_SLOTS))
-            .transpose()?
-            .unwrap_or(EnvConfig::default().pedestrian_slots);
+        let (pedestrian_slots, vehicle_slots) = crate::env::slot_counts(pedestrian_slots, vehicle_slots)?;
         let num_threads = num_threads
             .map(|n| convert::size("num_threads", n, 1..=MAX_THREADS))
             .transpose()?;
@@ -125,10 +124,6 @@ impl PyVectorEnv {
         };
         let form = observation_form(observation)?;
         let map = crate::maps::load(&map.to_string_lossy(), overrides)?;
-        let obs_len = match form {
-            ObservationForm::Discrete => 4,
-            ObservationForm::Kinematic => kinematic::len(pedestrian_slots),
-        };
         let pool = match num_threads {
             None => None,
             Some(n) => Some(
@@ -141,13 +136,17 @@ impl PyVectorEnv {
         let slots = (0..num_envs)
             .map(|_| {
                 Ok(Slot {
-                    env: new_env(&map, form, pedestrian_slots)?,
+                    env: new_env(&map, form, pedestrian_slots, vehicle_slots)?,
                     key: 0,
                     episode: 0,
                     ended: true,
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
+        let obs_len = match form {
+            ObservationForm::Discrete => 4,
+            ObservationForm::Kinematic => kinematic::len(slots[0].env.slots()),
+        };
         let out = Out {
             reward: 0.0,
             terminated: false,

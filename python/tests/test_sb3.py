@@ -35,6 +35,19 @@ def test_the_adapter_follows_sb3s_conventions():
         SB3VecEnv(unforeseen.VectorEnv("jaywalk", 2))
 
 
+def test_the_adapter_runs_a_junction_map_with_vehicle_slots():
+    venv = make_vec_env("junction_red_runner", num_envs=3, observation="kinematic")
+    assert venv.observation_space.shape == (7 + 5 * 4 + 6 * 4,)
+    venv.seed(1)
+    obs = venv.reset()
+    ended = 0
+    for _ in range(60):
+        obs, rewards, dones, infos = venv.step(np.random.default_rng(0).integers(0, 3, size=3))
+        assert obs in venv.venv.observation_space
+        ended += int(dones.sum())
+    assert ended > 0
+
+
 @pytest.mark.filterwarnings("ignore::DeprecationWarning")
 @pytest.mark.filterwarnings("ignore::UserWarning")
 def test_dqn_trains_on_the_native_vector_env():

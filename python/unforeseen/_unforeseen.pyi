@@ -81,7 +81,9 @@ class Env:
         observation: str = "discrete",
         pedestrian_slots: int = 4,
         overrides: dict[str, Any] | None = None,
-    ) -> None: ...
+        vehicle_slots: int | None = None,
+    ) -> None:
+        """``vehicle_slots`` ``None``: 4 on a map with traffic rules, 0 without."""
     @property
     def map_name(self) -> str: ...
     @property
@@ -94,6 +96,11 @@ class Env:
         """``[n_d, n_v, n_L, n_p]``."""
     @property
     def kinematic_len(self) -> int: ...
+    @property
+    def pedestrian_slots(self) -> int: ...
+    @property
+    def vehicle_slots(self) -> int:
+        """The configured count, or the map's default."""
     def kinematic_bounds(self) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
     @property
     def decision_dt(self) -> float: ...
@@ -130,6 +137,7 @@ class VectorEnv:
         overrides: dict[str, Any] | None = None,
         num_threads: int | None = None,
         autoreset: str = "next_step",
+        vehicle_slots: int | None = None,
     ) -> None: ...
     @property
     def num_envs(self) -> int: ...

@@ -56,20 +56,29 @@ class UnforeseenEnv(gym.Env):
     | 2   | L      | light: 0 red or amber, 1 green                                       |
     | 3   | p      | a pedestrian on the crosswalk: 0 no, 1 yes                           |
 
-    ``observation="kinematic"``: ``Box(low, high, (7 + 5·slots,), float32)`` with the bounds
-    of ``unforeseen_env::kinematic::bounds`` (the map's ranges plus a 1-unit margin):
+    ``observation="kinematic"``: ``Box(low, high, (7 + 5·P + 6·V,), float32)`` with ``P``
+    pedestrian slots and ``V`` vehicle slots, and the bounds of
+    ``unforeseen_env::kinematic::bounds`` (the map's ranges plus a 1-unit margin):
 
-    | Index         | Value                                                      | Unit |
-    |---------------|------------------------------------------------------------|------|
-    | 0             | x of the car's front bumper                                | m    |
-    | 1             | the car's speed along +x                                   | m/s  |
-    | 2             | distance to the destination line (``goal_x - x``; <= 0 arrived) | m |
-    | 3, 4, 5       | light green, amber, red (one-hot)                          | 0/1  |
-    | 6             | time until the light changes                               | s    |
-    | 7+5k .. 11+5k | pedestrian slot k: present, x, y, vx, vy                   | 0/1, m, m, m/s, m/s |
+    | Index                     | Value                                          | Unit |
+    |---------------------------|------------------------------------------------|------|
+    | 0                         | x of the car's front bumper                    | m    |
+    | 1                         | the car's speed along +x                       | m/s  |
+    | 2                         | distance to the destination line (``goal_x - x``; <= 0 arrived) | m |
+    | 3, 4, 5                   | light green, amber, red (one-hot)              | 0/1  |
+    | 6                         | time until the light changes                   | s    |
+    | 7+5k .. 11+5k             | pedestrian slot k: present, x, y, vx, vy       | 0/1, m, m, m/s, m/s |
+    | 7+5P+6j .. 12+5P+6j       | vehicle slot j: present, x, y, vx, vy, heading | 0/1, m, m, m/s, m/s, rad |
 
     Coordinates: x along the road, y across it (the car's lane at negative y). Slot k is
-    the k-th pedestrian in the world in order of appearance; empty slots are zeros.
+    the k-th pedestrian in the world in order of appearance. Vehicle slot j is the j-th
+    nearest other vehicle within 100 m (``unforeseen_env::kinematic::VEHICLE_RANGE``):
+    nearest by the distance from the car's front bumper (its x, its lane's centre y) to
+    the vehicle's centre, ties in order of appearance; x, y its centre, vx, vy its
+    velocity, heading its direction of travel (0 along +x, counter-clockwise, in
+    [-π, π]). Empty slots are zeros. ``V`` is 0 on a map without traffic rules (every
+    straight-road map: the vector is the pedestrian layout alone) and 4 on one with them
+    (the junction maps), unless ``vehicle_slots`` says otherwise.
 
     ## Rewards
 
@@ -105,7 +114,8 @@ class UnforeseenEnv(gym.Env):
     ``map``: an embedded map name (``unforeseen.embedded_maps()``) or a map file;
     ``observation``: ``"discrete"`` or ``"kinematic"``; ``render_mode``: see Rendering;
     ``render_scale``: pixels per metre of a frame (default 10);
-    ``pedestrian_slots`` (kinematic, default 4); any other keyword overrides a map field
+    ``pedestrian_slots`` (kinematic, 1..=100, default 4); ``vehicle_slots`` (kinematic,
+    0..=100; default ``None``: 4 on a map with traffic rules, 0 without); any other keyword overrides a map field
     (``max_steps=60``, ``lane_width=3.0``, ``reward__goal=40``; ``section__field`` when a
     name is in several sections; a name the optional ``junction`` shares with a section
     every map has means the latter's: ``junction__lane_width`` for the cross street's),
@@ -139,6 +149,7 @@ class UnforeseenEnv(gym.Env):
         render_mode: str | None = None,
         pedestrian_slots: int = 4,
         render_scale: float = 10.0,
+        vehicle_slots: int | None = None,
         **map_overrides: Any,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -146,7 +157,7 @@ class UnforeseenEnv(gym.Env):
                 f"render_mode {render_mode!r}: expected None or one of {self.metadata['render_modes']}"
             )
         self._window: _Window | None = _Window() if render_mode == "human" else None
-        self._env = _unforeseen.Env(map, observation, pedestrian_slots, map_overrides)
+        self._env = _unforeseen.Env(map, observation, pedestrian_slots, map_overrides, vehicle_slots)
         self.render_mode = render_mode
         self._scale = float(render_scale)
         self.metadata = {**type(self).metadata, "render_fps": 1.0 / self._env.decision_dt}

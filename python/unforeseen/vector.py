@@ -72,6 +72,7 @@ class VectorEnv(_GymVectorEnv):
         num_threads: int | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         render_scale: float = 10.0,
+        vehicle_slots: int | None = None,
         **map_overrides: Any,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -84,9 +85,11 @@ class VectorEnv(_GymVectorEnv):
         if mode not in modes:
             raise ValueError(f"autoreset_mode {mode}: expected AutoresetMode.NEXT_STEP or AutoresetMode.SAME_STEP")
         self._env = _unforeseen.VectorEnv(
-            map, num_envs, observation, pedestrian_slots, map_overrides, num_threads, modes[mode]
+            map, num_envs, observation, pedestrian_slots, map_overrides, num_threads, modes[mode], vehicle_slots
         )
-        single = UnforeseenEnv(map, observation, render_mode, pedestrian_slots, render_scale, **map_overrides)
+        single = UnforeseenEnv(
+            map, observation, render_mode, pedestrian_slots, render_scale, vehicle_slots, **map_overrides
+        )
         self._single = single
         self.num_envs = num_envs = self._env.num_envs
         self.render_mode = render_mode

@@ -6,7 +6,7 @@ use crate::load::{Diagnostic, MapError};
 use crate::map::Map;
 pub use crate::map_texts::{
     FAR_APPEARANCE, INTERSECTION, JAYWALK, JAYWALK_LATE, LATE_FAST, LONG_PAUSE, NEAR_KERB, SLOW_WALKER, STOP_MIDWAY,
-    STUCK_GREEN, TWO_PEDESTRIANS, names, source,
+    STUCK_GREEN, TWO_PEDESTRIANS, names, path, source,
 };
 
 /// Load an embedded map by name (`"jaywalk"` or `"jaywalk.ron"`).
@@ -21,12 +21,7 @@ pub fn load(name: &str) -> Result<Map, MapError> {
         }]));
     };
     let stem = name.strip_suffix(".ron").unwrap_or(name);
-    Map::from_str_named(&format!("{stem}.ron"), src, &|base| {
-        source(base).map(|s| {
-            let b = base.strip_suffix(".ron").unwrap_or(base);
-            (format!("{b}.ron"), s.to_string())
-        })
-    })
+    Map::load_embedded(stem, src)
 }
 
 /// An embedded map as a base (`"jaywalk"` or `"jaywalk.ron"`): its origin
@@ -35,6 +30,15 @@ pub fn load(name: &str) -> Result<Map, MapError> {
 pub fn base(base: &str) -> Option<(String, String)> {
     let name = base.strip_suffix(".ron").unwrap_or(base);
     source(name).map(|t| (format!("{}{name}", crate::EMBEDDED_PREFIX), t.to_string()))
+}
+
+/// An embedded map as a base of the embedded map `including` (a name): the base as
+/// `including`'s file in `maps/` finds it (`"training.ron"` beside
+/// `junction/red_runner.ron` is `junction_training`; `"../intersection.ron"` is
+/// `intersection`), else by name as [`base`]. Its origin and text.
+pub fn base_in(including: &str, base: &str) -> Option<(String, String)> {
+    crate::map_texts::base_of(including, base)
+        .map(|(name, t)| (format!("{}{name}", crate::EMBEDDED_PREFIX), t.to_string()))
 }
 
 /// Why a map could not be had.

@@ -152,28 +152,35 @@ impl Map {
                     });
                 }
             }
-            let name = base.strip_suffix(".ron").unwrap_or(base);
-            crate::map_texts::source(name).map(|text| {
-                let origin = format!("{EMBEDDED_PREFIX}{name}");
-                Resolved {
-                    text: check_text(&origin, text).map(|()| text.to_string()),
-                    key: origin.clone(),
-                    origin,
-                }
-            })
+            embedded_base(including, base)
         };
         load_top(&origin, &key, &text, &resolve)
     }
 
+    /// Load the embedded map `name` (its text `src`): its bases are embedded maps, found
+    /// as its file in `maps/` would find them ([`crate::map_texts::base_of`]).
+    /// Its origin in diagnostics is `name.ron`.
+    pub(crate) fn load_embedded(name: &str, src: &str) -> Result<Map, MapError> {
+        let origin = format!("{name}.ron");
+        let top = format!("{EMBEDDED_PREFIX}{name}");
+        let resolve =
+            |including: &str, base: &str| embedded_base(if including == origin { &top } else { including }, base);
+        load_top(&origin, &origin, src, &resolve)
+    }
+
     /// Parse map text. `origin` names it in diagnostics (and gives the default
     /// name); `bases` maps a base as written (e.g. `"intersection.ron"`) to
-    /// `(origin, text)`, or `None` if there is no such map.
+    /// `(origin, text)`, or `None` if there is no such map; the bases of an embedded base
+    /// (origin `embedded:...`) are embedded maps, as [`Map::load`] finds them.
     pub fn from_str_named(
         origin: &str,
         src: &str,
         bases: &dyn Fn(&str) -> Option<(String, String)>,
     ) -> Result<Map, MapError> {
-        let resolve = |_including: &str, base: &str| -> Option<Resolved> {
+        let resolve = |including: &str, base: &str| -> Option<Resolved> {
+            if including.starts_with(EMBEDDED_PREFIX) {
+                return embedded_base(including, base);
+            }
             bases(base).map(|(origin, text)| Resolved {
                 key: origin.clone(),
                 text: check_text(&origin, &text).map(|()| text),
@@ -182,6 +189,20 @@ impl Map {
         };
         load_top(origin, origin, src, &resolve)
     }
+}
+
+/// The embedded map a base names: relative to the including map's file in `maps/` when
+/// that map is embedded, else by name.
+fn embedded_base(including: &str, base: &str) -> Option<Resolved> {
+    let including = including.strip_prefix(EMBEDDED_PREFIX).unwrap_or("");
+    crate::map_texts::base_of(including, base).map(|(name, text)| {
+        let origin = format!("{EMBEDDED_PREFIX}{name}");
+        Resolved {
+            text: check_text(&origin, text).map(|()| text.to_string()),
+            key: origin.clone(),
+            origin,
+        }
+    })
 }
 
 fn canonical_key(p: &Path) -> String {

@@ -225,7 +225,12 @@ mod tests {
     fn a_kinematic_env_hands_the_controller_its_vector_before_each_act() {
         let scenario = jaywalk();
         for (form, len) in [
-            (ObservationForm::Kinematic, Some(unforeseen_env::kinematic::len(4))),
+            (
+                ObservationForm::Kinematic,
+                Some(unforeseen_env::kinematic::len(
+                    unforeseen_env::kinematic::Slots::pedestrians(4),
+                )),
+            ),
             (ObservationForm::Discrete, None),
         ] {
             let lens = std::sync::Mutex::new(Vec::new());

@@ -169,7 +169,8 @@ fn mutated_maps_are_refused_or_run_within_the_limits() {
     for case in 0..n {
         let name = names[case % names.len()];
         let text = mutate(unforeseen_sim::embedded::source(name).unwrap(), &mut rng);
-        let map = match Map::from_str_named("fuzz.ron", &text, &unforeseen_sim::embedded::base) {
+        let bases = |b: &str| unforeseen_sim::embedded::base_in(name, b);
+        let map = match Map::from_str_named("fuzz.ron", &text, &bases) {
             Ok(map) => map,
             Err(e) => {
                 assert!(e.to_string().starts_with("fuzz.ron"), "case {case}: {e}");

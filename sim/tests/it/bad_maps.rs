@@ -281,7 +281,8 @@ fn missing_file_is_an_error_not_a_panic() {
 fn shipped_maps_load_from_disk_with_bases() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../maps");
     for name in unforeseen_sim::embedded::names() {
-        let m = Map::load(&dir.join(format!("{name}.ron"))).unwrap_or_else(|e| panic!("{e}"));
+        let file = unforeseen_sim::embedded::path(name).unwrap();
+        let m = Map::load(&dir.join(file)).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(m, unforeseen_sim::embedded::load(name).unwrap());
     }
 }

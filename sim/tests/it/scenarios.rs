@@ -163,7 +163,8 @@ fn maps_round_trip_through_ron() {
     for name in unforeseen_sim::embedded::names() {
         let map = unforeseen_sim::embedded::load(name).unwrap();
         let text = ron::to_string(&map).unwrap();
-        let again = unforeseen_sim::Map::from_str_named(&format!("{name}.ron"), &text, &unforeseen_sim::embedded::base)
+        let bases = |b: &str| unforeseen_sim::embedded::base_in(name, b);
+        let again = unforeseen_sim::Map::from_str_named(&format!("{name}.ron"), &text, &bases)
             .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
         assert_eq!(again, map, "{name}");
         if let Some(e) = map.expect.first() {
