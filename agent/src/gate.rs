@@ -208,6 +208,20 @@ impl StateGate {
         }
     }
 
+    /// Counts every state's row as endorsed by the data the habit was trained on
+    /// (`gate_baseline = foreseen`): `c(s) = min(1, n(row(s)) / memory)`, with `n(row)` the
+    /// row's data counts, where `c(s)` is not already higher. A row the training visited
+    /// often then expects its own uncertainty (its entropy) from the first tick on; a row it
+    /// never saw keeps the paper's trigger. Takes effect at [`StateGate::consolidate`].
+    pub fn foresee(&mut self) {
+        for s in 0..self.endorsed.len() {
+            let row = self.row_of[s];
+            let mass: f64 = self.data[row * self.size..(row + 1) * self.size].iter().sum();
+            let e = &mut self.endorsed[s];
+            *e = e.max(mass.min(self.memory));
+        }
+    }
+
     /// `P(x = value | given = given_values)` (given values in the order of [`StateGate::given`]),
     /// e.g. the paper's `P(p=1 | L=1, d=2)` (Fig. 9b). NaN when out of range.
     pub fn probability(&self, value: usize, given_values: &[usize]) -> f64 {
@@ -357,6 +371,44 @@ mod tests {
         unbounded.set_endorsed(s_slow, 1.0);
         unbounded.consolidate();
         assert!((unbounded.excess_surprise(&one_hot(s_slow), ln2) - ln2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_foreseen_row_expects_its_entropy_in_proportion_to_its_training_data() {
+        let mut w = model();
+        let st = w.structure().clone();
+        // Row (L=1, d=2): 10 ticks at P = 1/2 (H = ln 2); row (L=0, d=2): 4 ticks at 1/2.
+        for k in 0..10 {
+            w.observe_transition(st.encode(&[3, 2, 1, 0]), 1, st.encode(&[2, 2, 1, usize::from(k < 5)]));
+        }
+        for k in 0..4 {
+            w.observe_transition(st.encode(&[3, 2, 0, 0]), 1, st.encode(&[2, 2, 0, usize::from(k < 2)]));
+        }
+        let one_hot = |s: usize| {
+            let mut q = vec![0.0; 64];
+            q[s] = 1.0;
+            q
+        };
+        let ln2 = 2f64.ln();
+        let (full, part, unseen) = (
+            st.encode(&[2, 0, 1, 1]),
+            st.encode(&[2, 0, 0, 1]),
+            st.encode(&[0, 0, 1, 1]),
+        );
+        // Memory 10: the first row's 10 ticks fill it, the second's 4 fill 0.4 of it, an
+        // unvisited row (d=0 under green) has no data and keeps the whole surprise.
+        let mut g = StateGate::from_model(&w, "p", 10.0).unwrap();
+        g.foresee();
+        g.consolidate();
+        assert!(g.excess_surprise(&one_hot(full), ln2).abs() < 1e-12);
+        assert!((g.excess_surprise(&one_hot(part), ln2) - 0.6 * ln2).abs() < 1e-12);
+        assert!((g.excess_surprise(&one_hot(unseen), ln2) - ln2).abs() < 1e-12);
+        // A state already endorsed further keeps its endorsement.
+        let mut g = StateGate::from_model(&w, "p", 10.0).unwrap();
+        g.set_endorsed(part, 1.0);
+        g.foresee();
+        g.consolidate();
+        assert!(g.excess_surprise(&one_hot(part), ln2).abs() < 1e-12);
     }
 
     #[test]

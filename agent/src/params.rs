@@ -218,6 +218,12 @@ param_enum! {
         /// in the car's path on half of the red ticks) does not trigger reasoning from the
         /// first episode on where the habit already does what reasoning would.
         Audited = "audited",
+        /// As `endorsed`, with every state's endorsement first set by how much the habit
+        /// was trained there: `c(s) = min(1, n(row(s)) / gate_memory)` for the row's data
+        /// counts ([`crate::gate::StateGate::foresee`]). The uncertainty the training data
+        /// showed (a cross car in the car's path on half of the red ticks) is expected; the
+        /// surprise beyond it, and any surprise in a row training never filled, triggers.
+        Foreseen = "foreseen",
         /// Ablation (the paper's trigger): nothing; `θ` reads the surprise itself.
         None = "none",
     }
@@ -321,7 +327,7 @@ param_groups! {
     /// | `gate` | `gate_factor` | `"p"` | a factor's name | the factor the state gate watches, given its next-time parents |
     /// | `gate` | `gate_memory` | 20.0 | > 0 (`inf` allowed) | ticks of data a row of the gate's table keeps (§V learning, bounded) |
     /// | `gate` | `gate_learning` | `endorsed` | `endorsed`, `every` | reasoning ticks count in the gate's table as far as the planner endorses the habit ([`GateLearning`]) |
-    /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `audited`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `audited` also audits every state's endorsement when the agent is built; `none` is the paper's trigger) ([`GateBaseline`]) |
+    /// | `gate` | `gate_baseline` | `endorsed` | `endorsed`, `audited`, `foreseen`, `none` | the trigger reads the surprise in excess of what is expected where reasoning endorsed the habit (beyond the paper; `audited` also audits every state's endorsement when the agent is built; `foreseen` starts it from the row's training data; `none` is the paper's trigger) ([`GateBaseline`]) |
     /// | `gate` | `handback` | `decline-learned` | `decline-learned`, `risk-checked`, `hand-back-checked`, `theta` | where test-time learning changed the trigger's verdict: a hand-back learning made goes to the habit only if the world model's crash-risk check passes, a reasoning tick learning alone made is declined (beyond the paper; `risk-checked` takes such a tick where the check finds the habit at risk, `hand-back-checked` takes every one, `theta` is the rule `θ <= ε` alone) ([`HandBackRule`]) |
     /// | `gate` | `handback_risk` ρ | 0.08 | [0, 1) | the largest excess of the habit's predicted crash risk (entering a crash-risk state within `handback_horizon` ticks, following the habit) over the safest first action's at which control goes back to it |
     /// | `gate` | `handback_horizon` | 3 | 1..=8 | ticks the habit is rolled forward through the learned model by the hand-back check |

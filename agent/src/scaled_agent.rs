@@ -265,8 +265,15 @@ impl<H: Habit> ScaledAgent<H> {
             competence: Competence::new(n, n_obs, na),
             learned: false,
         };
-        if agent.params.gate.gate_baseline == GateBaseline::Audited {
-            agent.audit_habit();
+        match agent.params.gate.gate_baseline {
+            GateBaseline::Audited => agent.audit_habit(),
+            GateBaseline::Foreseen => {
+                if let Some(gate) = &mut agent.gate {
+                    gate.foresee();
+                    gate.consolidate();
+                }
+            }
+            GateBaseline::Endorsed | GateBaseline::None => {}
         }
         Ok(agent)
     }
@@ -675,7 +682,9 @@ impl<H: Habit> Controller for ScaledAgent<H> {
             Some(gate) => {
                 let s = gate.surprise(&self.q_cur);
                 match self.params.gate.gate_baseline {
-                    GateBaseline::Endorsed | GateBaseline::Audited => (s, gate.excess_surprise(&self.q_cur, s)),
+                    GateBaseline::Endorsed | GateBaseline::Audited | GateBaseline::Foreseen => {
+                        (s, gate.excess_surprise(&self.q_cur, s))
+                    }
                     GateBaseline::None => (s, s),
                 }
             }
