@@ -12,25 +12,19 @@
 //! parameters): the first step through the learned `B` (the root step), later ones through
 //! the planning `B` (episode-ending states absorbing), the crash model's hazard and risk,
 //! and a transition cost where the model has one. Two models in pymdp's layout are built
-//! from the same agent:
-//!
-//! * **exported**: what `unforeseen export-model` writes, one factor of the agent's states:
-//!   `A`, the planning `B`, `C = ln c`, `D`;
-//! * **equivalent**: the same with what the exported layout leaves out expressed in it: a
-//!   crashed state (absorbing, `B[u][crashed, s] = hazard[u][s]`) seen as its own outcome
-//!   with `C = ` the crash model's `crashed` (its risk term `m (ln m − crashed)` is then the
-//!   KL risk of that outcome), and a second factor, the step (root or later, one control),
-//!   on which `B` of the states depends (`B_dependencies = [[0, 1], [1]]`), so that the
-//!   first step goes through the learned `B`. A transition cost has no such form here and
-//!   is reported when present.
+//! from the same agent (`unforeseen_agent::aif::driving`): **exported**, what `unforeseen
+//! export-model` writes (one factor, the planning `B`, no crash terms), and
+//! **equivalent**, with the root step and the crash terms expressed in the layout. A
+//! transition cost has no form there: on an agent with one, `equivalent` is built without
+//! it and its disagreements are the cost's.
 //!
 //! Beliefs: every one-hot state, then `TICKS` (default 2000) exact filtering steps of a
 //! walk through the learned model (true state drawn from `D` and the learned `B`,
 //! observation from `A`, action the driving planner's argmax `ψ`; a new walk every 40
 //! ticks or in an episode-ending state). On each belief: the largest `|ΔG|` over policies,
 //! and whether the argmax of the first-action marginal `ψ` agrees. Each disagreement of
-//! the exported model is put down to the root step, the crash terms, or both, by
-//! evaluating the driving tree without them. Per-tick cost: the median over the beliefs of
+//! the exported model is put down to the root step, the crash terms (with the transition
+//! cost, where there is one), or both, by evaluating the driving tree without them. Per-tick cost: the median over the beliefs of
 //! the fastest of `REPS` (default 5) timed evaluations of each. Prints one JSON object.
 
 use std::time::Instant;
@@ -39,103 +33,13 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use unforeseen_agent::aif::action::marginals;
 use unforeseen_agent::aif::agent::{Agent, AgentParams};
-use unforeseen_agent::aif::model::{Model, ModelParts};
-use unforeseen_agent::aif::tensor::Tensor;
+use unforeseen_agent::aif::driving::{equivalent, exported};
 use unforeseen_agent::maths::argmax;
 use unforeseen_agent::model::GenerativeModel;
 use unforeseen_agent::params::{RootStep, ScaledParams};
 use unforeseen_agent::persist::AgentBundle;
 use unforeseen_agent::planning::EfeTree;
 use unforeseen_agent::scaled_agent::ScaledAgent;
-
-/// `B[s', s, u]` of `gm` as a pymdp-layout tensor (column `s` of `gm.b[u]`).
-fn b_tensor(gm: &GenerativeModel) -> Tensor {
-    let (n, na) = (gm.n_states(), gm.n_actions());
-    let mut t = Tensor::filled(vec![n, n, na], 0.0);
-    for u in 0..na {
-        for s in 0..n {
-            for s2 in 0..n {
-                t.data[(s2 * n + s) * na + u] = gm.b[u][(s2, s)];
-            }
-        }
-    }
-    t
-}
-
-fn a_tensor(gm: &GenerativeModel) -> Tensor {
-    let (no, n) = (gm.n_obs(), gm.n_states());
-    let mut t = Tensor::filled(vec![no, n], 0.0);
-    for o in 0..no {
-        for s in 0..n {
-            t.data[o * n + s] = gm.a[(o, s)];
-        }
-    }
-    t
-}
-
-/// The exported model: one factor, the planning `B` throughout, no crash terms.
-fn exported(plan: &GenerativeModel) -> Model {
-    Model::new(ModelParts {
-        A: vec![a_tensor(plan)],
-        B: vec![b_tensor(plan)],
-        C: Some(vec![Tensor {
-            shape: vec![plan.n_obs()],
-            data: plan.c.clone(),
-        }]),
-        D: Some(vec![plan.d.clone()]),
-        ..ModelParts::default()
-    })
-    .expect("the exported model is valid")
-}
-
-/// The equivalent model: a crashed state and outcome, and the step factor choosing the
-/// root model's `B` for the first step (module docs).
-fn equivalent(plan: &GenerativeModel, root: &GenerativeModel) -> Model {
-    let (n, no, na) = (plan.n_states(), plan.n_obs(), plan.n_actions());
-    let hazard = |u: usize, s: usize| plan.crash.as_ref().map_or(0.0, |c| c.hazard[u][s]);
-    let crashed_pref = plan.crash.as_ref().map_or(0.0, |c| c.crashed);
-    let mut b = Tensor::filled(vec![n + 1, n + 1, 2, na], 0.0);
-    let at = |s2: usize, s: usize, t: usize, u: usize| ((s2 * (n + 1) + s) * 2 + t) * na + u;
-    for (t, gm) in [root, plan].into_iter().enumerate() {
-        for u in 0..na {
-            for s in 0..n {
-                let h = hazard(u, s);
-                for s2 in 0..n {
-                    b.data[at(s2, s, t, u)] = (1.0 - h) * gm.b[u][(s2, s)];
-                }
-                b.data[at(n, s, t, u)] = h;
-            }
-            b.data[at(n, n, t, u)] = 1.0;
-        }
-    }
-    let mut step = Tensor::filled(vec![2, 2, 1], 0.0);
-    step.data[1] = 1.0; // root -> later
-    step.data[3] = 1.0; // later -> later
-    let mut a = Tensor::filled(vec![no + 1, n + 1], 0.0);
-    for o in 0..no {
-        for s in 0..n {
-            a.data[o * (n + 1) + s] = plan.a[(o, s)];
-        }
-    }
-    a.data[no * (n + 1) + n] = 1.0;
-    let mut c = plan.c.clone();
-    c.push(crashed_pref);
-    let mut d = plan.d.clone();
-    d.push(0.0);
-    Model::new(ModelParts {
-        A: vec![a],
-        B: vec![b, step],
-        C: Some(vec![Tensor {
-            shape: vec![no + 1],
-            data: c,
-        }]),
-        D: Some(vec![d, vec![1.0, 0.0]]),
-        A_dependencies: Some(vec![vec![0]]),
-        B_dependencies: Some(vec![vec![0, 1], vec![1]]),
-        ..ModelParts::default()
-    })
-    .expect("the equivalent model is valid")
-}
 
 /// `G`, `ψ` of the general agent from `qs`.
 fn general(agent: &Agent, qs: &[Vec<f64>]) -> (Vec<f64>, Vec<f64>) {
@@ -195,8 +99,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         gamma,
         ..AgentParams::default()
     };
-    let exp = Agent::new(exported(&plan), ap, None)?;
-    let eqv = Agent::new(equivalent(&plan, &root), ap, None)?;
+    let exp = Agent::new(exported(&plan)?, ap, None)?;
+    let no_cost = |gm: &GenerativeModel| GenerativeModel {
+        transition_cost: None,
+        ..gm.clone()
+    };
+    let eqv = Agent::new(equivalent(&no_cost(&plan), &no_cost(&root))?, ap, None)?;
     let mut tree = EfeTree::new(n, no, na, horizon);
 
     // The beliefs: one-hot states, then a filtered walk.
@@ -299,7 +207,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "max_abs_dG": dg_exp,
             "argmax_psi_differs": differ_exp,
             "differs_by_root_step": by_root,
-            "differs_by_crash_terms": by_crash,
+            "differs_by_crash_terms_or_transition_cost": by_crash,
             "differs_by_either_alone": by_both,
             "differs_only_by_both_together": needs_both,
             "us_per_tick_median": median(t_exp),
