@@ -12,9 +12,16 @@
    gated agent's habit (the action it planned most often in each most likely state) is
    learned here.
 4. Test: the gate at ε = 1 bit (plan only when surprised, otherwise act from the habit),
-   beside planning on every tick, in the T-maze as trained and in one whose cue points
-   to the wrong arm 95 % of the time (an unforeseen change); both learn pA, pB after each
-   episode. Prints the fraction of ticks planned and the return per episode of each.
+   with the learned habit and with a Python policy as the habit (go to the cue until the
+   reward condition is known, then to its arm), beside planning on every tick, in the
+   T-maze as trained and in one whose cue points to the wrong arm 95 % of the time (an
+   unforeseen change); all learn pA, pB after each episode. Prints the fraction of ticks
+   planned and the return per episode of each.
+
+In the T-maze the learned habit (the action planned most often in the most likely
+state) keeps the agent at the cue, where nothing surprises it: the gate saves compute
+but not return there (EXPERIMENTS.md, "The habit ablation"; the grid world with a wall
+is where it pays).
 """
 
 from __future__ import annotations
@@ -37,6 +44,7 @@ TRAIN_EPISODES = 3 if SMALL else 20
 TEST_EPISODES = 3 if SMALL else 30
 TICKS = 8 if SMALL else 10
 SEED = 11
+CENTRE, LEFT, RIGHT, CUE, MIDDLE = range(5)
 
 
 def pymdp_agent(env: TMaze) -> PymdpAgent:
@@ -50,9 +58,18 @@ def pymdp_agent(env: TMaze) -> PymdpAgent:
                       B_dependencies=env.B_dependencies, policy_len=3)
 
 
-def trained(theirs: PymdpAgent, world: TMaze) -> Agent:
+def cue_then_arm(observation: list[int], qs: list[np.ndarray]) -> list[int]:
+    """A Python habit: to the cue while the reward condition is uncertain, then to its arm."""
+    location = observation[0]
+    if float(np.max(qs[1])) < 0.8:
+        return [CUE if location in (CENTRE, CUE) else (MIDDLE if location in (LEFT, RIGHT) else CENTRE), 0]
+    arm = LEFT + int(np.argmax(qs[1]))
+    return [arm if location == arm else {CUE: CENTRE, CENTRE: MIDDLE, MIDDLE: arm}.get(location, MIDDLE), 0]
+
+
+def trained(theirs: PymdpAgent, world: TMaze, habit) -> Agent:
     """Converted, then trained in ``world`` planning on every tick (habit and counts)."""
-    agent = Agent.from_pymdp(theirs, gate=None)
+    agent = Agent.from_pymdp(theirs, gate=None, habit=habit)
     for e in range(TRAIN_EPISODES):
         rollout(agent, world, TICKS, seed=SEED * 1000 + e, learn=True)
     return agent
@@ -70,10 +87,12 @@ def main() -> None:
           f"q_pi equal to pymdp's within {gap:.1e}")
 
     worlds = {"as trained": world, "cue lies": TMaze(cue_validity=0.05)}
+    arms = [("plans every tick", None, "learned"), ("gated, learned habit", 1.0, "learned"),
+            ("gated, Python habit", 1.0, cue_then_arm)]
     print(f"{'test world':<11} {'agent':<21} {'ticks planned':>13} {'return per episode':>19}")
     for name, test in worlds.items():
-        for label, gate in [("plans every tick", None), ("gated at 1 bit", 1.0)]:
-            agent = trained(theirs, world)
+        for label, gate, habit in arms:
+            agent = trained(theirs, world, habit)
             agent.gate = gate
             planned, returns = [], []
             for e in range(TEST_EPISODES):
