@@ -16,7 +16,13 @@ loop); ε ≥ 0 plans when the surprise exceeds ε bits; ε = 1e9 is the habit a
 only in a cell it never planned in). Return per test episode = Σ_t C[o_t]; success = the
 goal reached within the episode.
 
+With ``--ablation``, the habit ablation of scripts/aif_gate_runs.py instead (ε chosen per
+habit on ``--choose`` seeds, then the report seeds): the habit learned in training, a given
+``E``, or a Python policy written for the wall-free grid (right along the row, then down
+the last column, then stay: the trained agent's path from the top row, into the wall).
+
 Usage (needs jax and pymdp):  python3 scripts/aif_grid_wall.py --seeds 11..20 --figure docs/figures/aif_grid_wall.png
+                              python3 scripts/aif_grid_wall.py --ablation --choose 1..10 --seeds 11..20
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
+import sys
 
 import jax
 import numpy as np
@@ -32,6 +39,7 @@ jax.config.update("jax_enable_x64", True)
 
 from pymdp.envs.grid_world import GridWorld  # noqa: E402
 
+import aif_gate_runs  # noqa: E402
 from unforeseen.aif import Agent, rollout  # noqa: E402
 
 T975 = {2: 12.71, 3: 4.30, 4: 3.18, 5: 2.78, 6: 2.57, 7: 2.45, 8: 2.36, 9: 2.31, 10: 2.26, 11: 2.23}
@@ -49,20 +57,27 @@ def interval(xs: list[float]) -> tuple[float, float]:
     return m, h
 
 
-def make_agent(world: GridWorld, seed: int) -> Agent:
-    A = [np.asarray(a) for a in world.A]
-    B = [np.asarray(b) for b in world.B]
-    C = [np.zeros(A[0].shape[0])]
+def make_agent(seed: int, habit="learned", E=None, A=None, B=None, pA=None, pB=None, world: GridWorld | None = None) -> Agent:
+    world = world or GridWorld()
+    if pB is None:
+        A = [np.asarray(a) for a in world.A]
+        pB = [5.0 * np.asarray(b) + 0.1 for b in world.B]
+        B = [p / p.sum(axis=0, keepdims=True) for p in pB]
+    C = [np.zeros(np.asarray(A[0]).shape[0])]
     C[0][-1] = 3.0
-    pB = [5.0 * b + 0.1 for b in B]
-    B = [p / p.sum(axis=0, keepdims=True) for p in pB]
-    return Agent(A, B, C=C, D=[np.asarray(d) for d in world.D], pB=pB,
+    return Agent(A, B, C=C, D=[np.asarray(d) for d in world.D], E=E, pA=pA, pB=pB,
                  A_dependencies=world.A_dependencies, B_dependencies=world.B_dependencies,
-                 policy_len=4, gate=None, seed=seed)
+                 policy_len=4, gate=None, habit=habit, seed=seed)
+
+
+def policy(observation: list[int], qs: list[np.ndarray]) -> int:
+    """The wall-free grid's way to the goal: right along the row, down the last column."""
+    row, col = divmod(int(observation[0]), 3)
+    return GridWorld.RIGHT if col < 2 else (GridWorld.DOWN if row < 2 else GridWorld.STAY)
 
 
 def run_seed(seed: int, eps: float, args, free: GridWorld, test_world: GridWorld) -> dict[str, float]:
-    agent = make_agent(free, seed)
+    agent = make_agent(seed, world=free)
     for e in range(args.train):
         rollout(agent, free, args.steps, seed=seed * 1000 + e, learn=True)
     agent.gate = None if eps < 0 else eps
@@ -76,7 +91,20 @@ def run_seed(seed: int, eps: float, args, free: GridWorld, test_world: GridWorld
     return {"return": statistics.mean(rets), "success": statistics.mean(wins), "planned": statistics.mean(planned)}
 
 
+def ablation() -> None:
+    args = aif_gate_runs.arguments(__doc__, train=20, test=20, steps=8).parse_args(
+        [a for a in sys.argv[1:] if a != "--ablation"])
+    free, walled = GridWorld(), GridWorld(walls=[WALL])
+    goal = free.A[0].shape[0] - 1
+    aif_gate_runs.main(aif_gate_runs.Setup(
+        lambda seed, **kw: make_agent(seed, world=free, **kw), free, {"wall": walled, "no wall": free}, "wall", policy,
+        lambda out: float(np.any(out["observation"][:, 0] == goal))), args)
+
+
 def main() -> None:
+    if "--ablation" in sys.argv:
+        ablation()
+        return
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seeds", default="11..20")
     ap.add_argument("--eps", default="-1,0.1,0.5,1,2,4,1e9")

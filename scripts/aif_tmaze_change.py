@@ -1,54 +1,75 @@
 #!/usr/bin/env python3
-"""The gate on pymdp's T-maze when the cue starts to lie (issue 46): `unforeseen run-model`
-with the shipped model (examples/models/tmaze_model.json, pA/pB learned after every
-episode) in the world it describes and in the world whose cue points to the wrong arm
-(tmaze_env_cue_lies.json), for several ε, over seeds; prints a markdown table of the mean
-return per episode (95% interval over seeds, t-based), its worst seed, and the fraction
-of ticks planned. ε < 0 plans on every tick (pymdp's loop).
+"""The gate on pymdp's T-maze when the cue starts to lie (issue 46), with the habit learned
+in a training phase before the change, and the habit ablation.
 
-Usage:  cargo build --release
-        python3 scripts/aif_tmaze_change.py --seeds 11..20
+pymdp 1.0.4's own ``TMaze()`` (5 locations: centre, left arm, right arm, cue, middle; the
+reward condition drawn at each reset; the cue right 95 % of the time), stepped through its
+public ``reset``/``step`` by ``unforeseen.aif.rollout``. The agent is
+``unforeseen.aif.Agent`` on its A, B, D with C = [0, 2, −4] on the reward modality (no
+outcome, reward, punishment), ``policy_len`` 3, γ = 1, counts pA = 10 A + 0.1 and
+pB = 10 B + 0.1 (A, B their normalisation), learned after every episode.
+
+The protocol and the arms are scripts/aif_gate_runs.py's: ``--train`` episodes in the
+T-maze planning on every tick, then ``--test`` episodes in ``TMaze(cue_validity=0.05)``
+(the cue points to the wrong arm 95 % of the time: the unforeseen change) and, as the
+control, in the T-maze as trained. The Python policy habit is what a person who knows the
+trained T-maze would write: while the posterior over the reward condition is below 0.8,
+go to the cue (from the centre; stay there); once it is above, go to that condition's arm
+through the centre and the middle, and stay. Return = Σ_t C[o_t]; success = a reward and
+no punishment in the episode.
+
+Usage (needs jax and pymdp):  python3 scripts/aif_tmaze_change.py --choose 1..10 --seeds 11..20
 """
-import argparse
-import json
-import math
-import statistics
-import subprocess
 
-T975 = {2: 12.71, 3: 4.30, 4: 3.18, 5: 2.78, 6: 2.57, 7: 2.45, 8: 2.36, 9: 2.31, 10: 2.26, 11: 2.23}
+from __future__ import annotations
+
+import jax
+import numpy as np
+
+jax.config.update("jax_enable_x64", True)
+
+from pymdp.envs.tmaze import TMaze  # noqa: E402
+
+from aif_gate_runs import Setup, arguments, main  # noqa: E402
+from unforeseen.aif import Agent  # noqa: E402
+
+CENTRE, LEFT, RIGHT, CUE, MIDDLE = range(5)
+#: The trained T-maze (one instance: pymdp jits reset/step per instance).
+TRAINED = TMaze()
 
 
-def seeds(spec):
-    a, b = spec.split("..")
-    return list(range(int(a), int(b) + 1))
+def make_agent(seed: int, habit, E=None, A=None, B=None, pA=None, pB=None) -> Agent:
+    world = TRAINED
+    if pA is None:
+        pA = [10.0 * np.asarray(a) + 0.1 for a in world.A]
+        pB = [10.0 * np.asarray(b) + 0.1 for b in world.B]
+        A = [p / p.sum(axis=0, keepdims=True) for p in pA]
+        B = [p / p.sum(axis=0, keepdims=True) for p in pB]
+    C = [np.zeros(np.asarray(a).shape[0]) for a in world.A]
+    C[1] = np.array([0.0, 2.0, -4.0])
+    return Agent(A, B, C=C, D=[np.asarray(d) for d in world.D], E=E, pA=pA, pB=pB,
+                 A_dependencies=world.A_dependencies, B_dependencies=world.B_dependencies,
+                 policy_len=3, gate=None, habit=habit, seed=seed)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seeds", default="11..20")
-    ap.add_argument("--eps", default="-1,0.25,0.5,1,2,1000")
-    ap.add_argument("--episodes", type=int, default=30)
-    ap.add_argument("--steps", type=int, default=10)
-    ap.add_argument("--bin", default="target/release/unforeseen")
-    args = ap.parse_args()
-    print("| world | ε (bits) | return per episode, mean [95%] | worst seed | ticks planned |")
-    print("|---|---|---|---|---|")
-    for world in ["tmaze_env", "tmaze_env_cue_lies"]:
-        for eps in args.eps.split(","):
-            rets, planned = [], []
-            for s in seeds(args.seeds):
-                out = subprocess.run([args.bin, "run-model", "--model", "examples/models/tmaze_model.json",
-                                      "--env", f"examples/models/{world}.json", "--episodes", str(args.episodes),
-                                      "--steps", str(args.steps), "--epsilon", eps, "--seed", str(s), "--learn"],
-                                     check=True, capture_output=True, text=True).stdout
-                r = json.loads(out)
-                rets.append(r["mean_return"])
-                planned.append(r["planned_fraction"])
-            n = len(rets)
-            m = statistics.mean(rets)
-            h = T975.get(n, 1.96) * statistics.stdev(rets) / math.sqrt(n) if n > 1 else float("nan")
-            print(f"| {world} | {eps} | {m:.2f} [{m - h:.2f}, {m + h:.2f}] | {min(rets):.2f} | {statistics.mean(planned):.3f} |")
+def policy(observation: list[int], qs: list[np.ndarray]) -> list[int]:
+    """The trained T-maze's way: find out at the cue, then go to the cued arm and stay."""
+    location = int(observation[0])
+    condition = int(np.argmax(qs[1]))
+    if float(np.max(qs[1])) < 0.8:
+        return [CUE if location in (CENTRE, CUE) else (MIDDLE if location in (LEFT, RIGHT) else CENTRE), 0]
+    arm = LEFT + condition
+    if location == arm:
+        return [arm, 0]
+    return [{CUE: CENTRE, CENTRE: MIDDLE, MIDDLE: arm}.get(location, MIDDLE), 0]
+
+
+def success(out) -> float:
+    reward = out["observation"][:, 1]
+    return float(np.any(reward == 1) and not np.any(reward == 2))
 
 
 if __name__ == "__main__":
-    main()
+    args = arguments(__doc__, train=20, test=30, steps=10).parse_args()
+    main(Setup(make_agent, TRAINED, {"cue lies": TMaze(cue_validity=0.05), "as trained": TRAINED}, "cue lies",
+               policy, success), args)

@@ -97,6 +97,45 @@ fn habit(name: &str) -> PyResult<Habit> {
     }
 }
 
+/// An error of a tick with a Python habit: the policy's own exception, or the model's.
+struct TickError(PyErr);
+
+impl From<ModelError> for TickError {
+    fn from(e: ModelError) -> TickError {
+        TickError(bad(e))
+    }
+}
+
+impl From<PyErr> for TickError {
+    fn from(e: PyErr) -> TickError {
+        TickError(e)
+    }
+}
+
+impl From<TickError> for PyErr {
+    fn from(e: TickError) -> PyErr {
+        e.0
+    }
+}
+
+/// What a Python habit returned, as one control index per factor: an int (one factor)
+/// or a sequence of ints; anything else raises `ValueError` naming `habit`.
+fn habit_action(u: &Bound<'_, PyAny>) -> Result<Vec<usize>, TickError> {
+    let refuse = || {
+        errors::value(format!(
+            "habit returned {u}, must be one control index per factor (ints >= 0)"
+        ))
+    };
+    let raw: Vec<i64> = match u.extract::<i64>() {
+        Ok(x) => vec![x],
+        Err(_) => u.extract::<Vec<i64>>().map_err(|_| refuse())?,
+    };
+    Ok(raw
+        .iter()
+        .map(|&x| usize::try_from(x).map_err(|_| refuse()))
+        .collect::<PyResult<Vec<_>>>()?)
+}
+
 /// A model in pymdp's layout behind the paper's surprise gate (the library's
 /// `aif::gate::GatedAgent`).
 #[pyclass(module = "unforeseen._unforeseen", unsendable)]
@@ -324,14 +363,29 @@ impl AifAgent {
     }
 
     /// One tick of the gated loop: `(action, info)` with `info` the surprise (bits),
-    /// whether it planned, `q_pi` when it did, and the posterior `qs`.
+    /// whether it planned, `q_pi` when it did, and the posterior `qs`. With `habit` (a
+    /// callable `(observation, qs) -> action`), it acts from that policy instead of its
+    /// own habit when the gate is closed; its exception propagates, and an action that
+    /// is not one control index per factor raises `ValueError` naming `habit`.
+    #[pyo3(signature = (observation, habit=None))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         observation: Vec<i64>,
+        habit: Option<Bound<'py, PyAny>>,
     ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyDict>)> {
         let obs = indices("observation", &observation)?;
-        let (tick, qs) = self.gated.step(&obs, &mut self.rng).map_err(bad)?;
+        let (tick, qs) = match habit {
+            None => self.gated.step(&obs, &mut self.rng).map_err(bad)?,
+            Some(policy) => self
+                .gated
+                .step_with(&obs, &mut self.rng, |o, qs| {
+                    let o: Vec<i64> = o.iter().map(|&x| x as i64).collect();
+                    let u = policy.call1((o, vecs_out(py, qs)))?;
+                    habit_action(&u)
+                })
+                .map_err(PyErr::from)?,
+        };
         let info = PyDict::new(py);
         info.set_item("surprise", tick.surprise_bits)?;
         info.set_item("planned", tick.planned)?;

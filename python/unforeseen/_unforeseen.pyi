@@ -532,8 +532,13 @@ class AifAgent:
         lr_pB: float | None,
     ) -> None:
         """Dirichlet learning from one sequence (``beliefs[t][f]``, ``observations[t][m]``, ``actions[t][f]``)."""
-    def step(self, observation: Sequence[int]) -> tuple[npt.NDArray[np.int64], dict[str, Any]]:
-        """One gated tick: the action and ``surprise`` (bits), ``planned``, ``q_pi`` (when planned), ``qs``."""
+    def step(
+        self,
+        observation: Sequence[int],
+        habit: Callable[[list[int], list[npt.NDArray[np.float64]]], Any] | None = None,
+    ) -> tuple[npt.NDArray[np.int64], dict[str, Any]]:
+        """One gated tick: the action and ``surprise`` (bits), ``planned``, ``q_pi`` (when planned), ``qs``;
+        with ``habit`` (``(observation, qs) -> action``) that policy acts when the gate is closed."""
     @property
     def epsilon(self) -> float:
         """ε in bits (negative: plan on every tick); settable, the learned habit kept."""

@@ -19,14 +19,19 @@ array, an unnormalised column or a shape that does not fit its dependencies rais
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, Union
 
 import numpy as np
 
 from ._unforeseen import AifAgent
 
-__all__ = ["Agent", "rollout"]
+__all__ = ["Agent", "Habit", "rollout"]
+
+#: What ``step`` does when not surprised: ``"learned"``, ``"prior"``, or a policy
+#: ``habit(observation, qs) -> action`` (one control index per factor, or an int for one
+#: factor), asked with the observation (one index per modality) and the posterior.
+Habit = Union[str, Callable[[list[int], list[np.ndarray]], Any]]
 
 
 def _array(name: str, x: Any) -> np.ndarray:
@@ -69,7 +74,11 @@ class Agent:
     negative value: on every tick, as pymdp). ``habit`` is what ``step`` does otherwise:
     ``"learned"`` (the action it planned most often before in the same most likely
     state; a state never planned in is planned in) or ``"prior"`` (``E``'s first-step
-    marginal). ``preferences`` is ``"raw"`` (pymdp: ``C`` as given) or ``"ln_softmax"``
+    marginal) or any Python policy ``habit(observation, qs) -> action`` (the
+    ``ScaledWrapper`` pattern: it is asked only when the gate is closed, with the
+    observation as a list of indices and the posterior ``qs``, one array per factor, and
+    returns one control index per factor; planned actions still count toward the learned
+    habit). ``preferences`` is ``"raw"`` (pymdp: ``C`` as given) or ``"ln_softmax"``
     (the paper). ``seed`` seeds stochastic action selection.
     """
 
@@ -96,9 +105,19 @@ class Agent:
         use_param_info_gain: bool = False,
         preferences: str = "raw",
         gate: float | None = 1.0,
-        habit: str = "learned",
+        habit: Habit = "learned",
         seed: int = 0,
     ) -> None:
+        if isinstance(habit, str):
+            self._habit: Callable[[list[int], list[np.ndarray]], Any] | None = None
+            habit_name = habit
+        elif callable(habit):
+            self._habit, habit_name = habit, "learned"
+        else:
+            raise ValueError(
+                f"habit is a {type(habit).__name__}, must be \"learned\", \"prior\" or a callable "
+                "(observation, qs) -> action"
+            )
         deps = lambda name, d: None if d is None else [_indices(f"{name}[{i}]", x) for i, x in enumerate(d)]  # noqa: E731
         pol = None
         if policies is not None:
@@ -128,12 +147,12 @@ class Agent:
             bool(use_param_info_gain),
             preferences,
             -1.0 if gate is None else float(gate),
-            habit,
+            habit_name,
             int(seed),
         )
 
     @classmethod
-    def from_pymdp(cls, agent: Any, gate: float | None = 1.0, habit: str = "learned", seed: int = 0) -> Agent:
+    def from_pymdp(cls, agent: Any, gate: float | None = 1.0, habit: Habit = "learned", seed: int = 0) -> Agent:
         """This agent on a pymdp 1.0.4 ``Agent``'s model and settings (its first batch
         element; a batch of several is refused)."""
         if getattr(agent, "batch_size", 1) != 1:
@@ -306,8 +325,9 @@ class Agent:
 
     def step(self, observation: Sequence[Any]) -> tuple[np.ndarray, dict[str, Any]]:
         """One tick of the gated loop: ``(action, info)``; ``info`` holds ``surprise``
-        (bits), ``planned``, ``q_pi`` (when planned) and ``qs``."""
-        return self._core.step(_indices("observation", observation))
+        (bits), ``planned``, ``q_pi`` (when planned) and ``qs``. A Python ``habit``
+        is asked here when the gate is closed; its exceptions propagate."""
+        return self._core.step(_indices("observation", observation), self._habit)
 
     def utility(self, observation: Sequence[Any]) -> float:
         """``Σ_m C[m][o_m]`` of ``observation`` (a time-indexed ``C``'s first row)."""

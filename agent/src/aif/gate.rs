@@ -7,7 +7,10 @@
 //!   policies as a habit);
 //! * [`Habit::Learned`]: the action it planned most often before in the same most likely
 //!   state (counts on (argmax state per factor, multi-action)); a state never planned in
-//!   is planned in.
+//!   is planned in;
+//! * any other policy, through [`GatedAgent::step_with`]: a function of the observation
+//!   and the posterior that returns the action (e.g. a Python policy, the `ScaledWrapper`
+//!   pattern).
 //!
 //! With ε < 0 the gate is open on every tick: the agent is pymdp's.
 
@@ -125,12 +128,45 @@ impl GatedAgent {
     /// One tick: infer the state from `obs`, score the surprise, plan or act from habit,
     /// and predict the next state. Also returns the posterior `qs`.
     pub fn step(&mut self, obs: &[usize], rng: &mut impl RngExt) -> Result<(Tick, Vec<Vec<f64>>), ModelError> {
+        self.tick(obs, rng, |gated, _, qs| Ok(gated.habit_action(qs)))
+    }
+
+    /// One tick as [`GatedAgent::step`], with `habit` in place of the agent's own: when the
+    /// surprise does not exceed ε it is called with the observation and the posterior
+    /// `qs` and returns the multi-action to take (one control per factor; any other is
+    /// refused naming `habit`). Planned actions still add to the learned habit's counts.
+    /// `habit`'s own error type carries through; the model's errors convert into it.
+    pub fn step_with<E: From<ModelError>>(
+        &mut self,
+        obs: &[usize],
+        rng: &mut impl RngExt,
+        habit: impl FnOnce(&[usize], &[Vec<f64>]) -> Result<Vec<usize>, E>,
+    ) -> Result<(Tick, Vec<Vec<f64>>), E> {
+        self.tick(obs, rng, |gated, obs, qs| {
+            let u = habit(obs, qs)?;
+            gated
+                .agent
+                .model()
+                .check_action(&u)
+                .map_err(|e| ModelError::invalid("habit", format!("returned the action {u:?}: {e}")))?;
+            Ok(Some(u))
+        })
+    }
+
+    /// The tick itself; `habit` (asked only when the gate is closed) gives the action or
+    /// `None` to plan.
+    fn tick<E: From<ModelError>>(
+        &mut self,
+        obs: &[usize],
+        rng: &mut impl RngExt,
+        habit: impl FnOnce(&GatedAgent, &[usize], &[Vec<f64>]) -> Result<Option<Vec<usize>>, E>,
+    ) -> Result<(Tick, Vec<Vec<f64>>), E> {
         let qs = self.agent.infer_states(obs, &self.prior)?;
         let surprise_bits = self.agent.vfe(obs, &self.prior, &qs) / std::f64::consts::LN_2;
         let habit = if surprise_bits > self.epsilon_bits {
             None
         } else {
-            self.habit_action(&qs)
+            habit(self, obs, &qs)?
         };
         let (action, q_pi) = match habit {
             Some(u) => (u, None),

@@ -7,7 +7,8 @@
 //! (`agent/tests/it/aif_pymdp.rs`, data from `scripts/pymdp_envs_reference.py`):
 //! [`infer`] (fpi), [`policies`], [`efe`] (G and q_π), [`action`], [`learning`]; [`agent`]
 //! drives them. [`gate`] puts the paper's surprise gate in front of any such agent, and
-//! [`run`] runs it in a [`process`] (a world in the same layout). Where the paper's agent differs it is named: `C` as `ln softmax`
+//! [`run`] runs it in a [`process`] (a world in the same layout). [`driving`] writes the
+//! driving agent's planning model in this layout, its planner's `G` exactly. Where the paper's agent differs it is named: `C` as `ln softmax`
 //! ([`efe::Preferences::LnSoftmax`]), VMP over a window ([`crate::perception`]).
 //!
 //! ```
@@ -26,6 +27,7 @@
 
 pub mod action;
 pub mod agent;
+pub mod driving;
 pub mod efe;
 pub mod error;
 pub mod gate;

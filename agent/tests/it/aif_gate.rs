@@ -73,3 +73,62 @@ fn a_gate_plans_less_and_is_deterministic() {
     let e = GatedAgent::new(agent, 1.0, Habit::Prior).unwrap_err().to_string();
     assert!(e.contains("no E"), "{e}");
 }
+
+/// A habit given as a function (`step_with`) acts whenever the gate is closed, with the
+/// observation and the posterior it is asked with; an open gate never asks it; an action
+/// outside the model is refused naming `habit`, and the function's own error carries
+/// through.
+#[test]
+fn a_given_habit_acts_when_the_gate_is_closed_and_is_checked() {
+    let (model, params) = tmaze();
+    let agent = Agent::new(model.clone(), params, None).unwrap();
+    let mut world = Process::new(model);
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let obs = world.reset(&mut rng);
+
+    let mut closed = GatedAgent::new(agent.clone(), 1e9, Habit::Learned).unwrap();
+    let (mut asked_obs, mut asked_qs) = (Vec::new(), Vec::new());
+    let (tick, qs) = closed
+        .step_with(&obs, &mut rng, |o, q| {
+            asked_obs = o.to_vec();
+            asked_qs = q.to_vec();
+            Ok::<_, unforeseen_agent::aif::error::ModelError>(vec![2, 0])
+        })
+        .unwrap();
+    assert!(!tick.planned);
+    assert_eq!(tick.action, vec![2, 0]);
+    assert_eq!((asked_obs, asked_qs), (obs.clone(), qs));
+
+    let mut open = GatedAgent::new(agent.clone(), -1.0, Habit::Learned).unwrap();
+    let (tick, _) = open
+        .step_with(
+            &obs,
+            &mut rng,
+            |_, _| -> Result<Vec<usize>, unforeseen_agent::aif::error::ModelError> {
+                panic!("an open gate asked the habit")
+            },
+        )
+        .unwrap();
+    assert!(tick.planned);
+
+    let err = closed
+        .step_with(&obs, &mut rng, |_, _| {
+            Ok::<_, unforeseen_agent::aif::error::ModelError>(vec![9, 0])
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("habit") && err.contains("[9, 0]"), "{err}");
+
+    #[derive(Debug, PartialEq)]
+    enum Mine {
+        Model,
+        Policy,
+    }
+    impl From<unforeseen_agent::aif::error::ModelError> for Mine {
+        fn from(_: unforeseen_agent::aif::error::ModelError) -> Mine {
+            Mine::Model
+        }
+    }
+    let err = closed.step_with(&obs, &mut rng, |_, _| Err(Mine::Policy)).unwrap_err();
+    assert_eq!(err, Mine::Policy);
+}
