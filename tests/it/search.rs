@@ -535,3 +535,33 @@ fn the_junction_space_sets_the_vehicle_rules() {
     .to_string();
     assert!(err.contains("the choices are Careful, RunsRed"), "{err}");
 }
+
+/// `maps/spaces/junction_timed.ron` on the red-runner junction times the base's vehicle to
+/// the car: the lowest corner is a runner from the south that starts 2.5 s before the car
+/// arrives, 30 m out at 9 m/s; the highest an oncoming left-turner that does not yield,
+/// started 5 s out, 55 m away at 12.9 m/s (values rounded to 0.001).
+#[test]
+fn the_timed_junction_space_keeps_the_vehicle_near_the_car() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = Map::load(&root.join("maps/junction/red_runner.ron")).unwrap();
+    let space = Space::load(&root.join("maps/spaces/junction_timed.ron"), &base).expect("valid");
+    let corner = |u: f64, name: &str| {
+        let map = space
+            .apply(&space.values_at(&vec![u; space.params.len()]), name)
+            .expect("a corner is a valid map");
+        assert_eq!(map.traffic.len(), base.traffic.len(), "the space adds no vehicle");
+        map.traffic[0]
+    };
+    let low = corner(0.0, "low");
+    assert_eq!(low.route, unforeseen_sim::Route::FromSouth);
+    assert_eq!(low.behaviour, unforeseen_sim::Behaviour::RunsRed);
+    assert_eq!(low.trigger, unforeseen_sim::Trigger::CarArrivesWithin(2.5));
+    assert_eq!((low.speed.0, low.start), (9.0, 30.0));
+    let high = corner(0.999, "high");
+    assert_eq!(high.route, unforeseen_sim::Route::OncomingLeft);
+    assert_eq!(high.behaviour, unforeseen_sim::Behaviour::DoesNotYield);
+    let unforeseen_sim::Trigger::CarArrivesWithin(t) = high.trigger else {
+        panic!("{:?}", high.trigger)
+    };
+    assert!((t - 4.998).abs() < 1e-9 && (high.speed.0 - 12.896).abs() < 1e-9 && (high.start - 54.975).abs() < 1e-9);
+}

@@ -596,13 +596,20 @@ fn draw(cfg: &SearchConfig<'_>, path: &Path, outcome: &Outcome) -> Result<Vec<St
         cfg.protocol.name(),
         space.name
     );
+    // Room for the longest name of a chosen parameter on the y axis beside its title
+    // (about 7 px a character at the mesh's font).
+    let y_names = match dy.map(|d| &space.params[d].domain) {
+        Some(Domain::Choose(n)) => n.iter().map(String::len).max().unwrap_or(0),
+        _ => 0,
+    };
+    let y_area = 64.max(30 + 7 * y_names as u32);
     write_svg(path, (900, 620), |root| {
         let (plot, key) = root.split_horizontally(660);
         let mut chart = ChartBuilder::on(&plot)
             .caption(title.as_str(), ("sans-serif", 17))
             .margin(12)
             .x_label_area_size(44)
-            .y_label_area_size(64)
+            .y_label_area_size(y_area)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(plot_err)?;
         let x_desc = dx.map_or("".to_string(), |d| space.params[d].name.clone());
