@@ -28,7 +28,6 @@ Usage (needs jax and pymdp):  python3 scripts/aif_grid_wall.py --seeds 11..20 --
 from __future__ import annotations
 
 import argparse
-import math
 import statistics
 import sys
 
@@ -42,19 +41,10 @@ from pymdp.envs.grid_world import GridWorld  # noqa: E402
 import aif_gate_runs  # noqa: E402
 from unforeseen.aif import Agent, rollout  # noqa: E402
 
-T975 = {2: 12.71, 3: 4.30, 4: 3.18, 5: 2.78, 6: 2.57, 7: 2.45, 8: 2.36, 9: 2.31, 10: 2.26, 11: 2.23}
 WALL = (1, 2)
 
 
-def seeds(spec: str) -> list[int]:
-    a, b = spec.split("..")
-    return list(range(int(a), int(b) + 1))
-
-
-def interval(xs: list[float]) -> tuple[float, float]:
-    m = statistics.mean(xs)
-    h = T975.get(len(xs), 1.96) * statistics.stdev(xs) / math.sqrt(len(xs)) if len(xs) > 1 else float("nan")
-    return m, h
+seeds, interval = aif_gate_runs.seeds, aif_gate_runs.interval
 
 
 def make_agent(seed: int, habit="learned", E=None, A=None, B=None, pA=None, pB=None, world: GridWorld | None = None) -> Agent:
