@@ -298,4 +298,14 @@ mod tests {
         let e = EstimateRequest::default().setup().unwrap_err();
         assert!(e.to_string().starts_with("space: "), "{e}");
     }
+
+    #[test]
+    fn the_draws_agents_train_on_the_training_map() {
+        let r = EstimateRequest {
+            train_map: "junction_training".into(),
+            ..EstimateRequest::default()
+        };
+        assert_eq!(r.search().train_map, "junction_training");
+        assert_eq!(EstimateRequest::default().train_map, SearchRequest::default().train_map);
+    }
 }

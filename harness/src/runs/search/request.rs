@@ -285,4 +285,26 @@ mod tests {
         .unwrap_err();
         assert!(e.to_string().starts_with("train_seeds: "), "{e}");
     }
+
+    #[test]
+    fn the_training_map_is_part_of_the_agents_identity() {
+        let setup = |train_map: &str| {
+            SearchRequest {
+                space: concat!(env!("CARGO_MANIFEST_DIR"), "/../maps/spaces/jaywalk.ron").into(),
+                train_seeds: Some(TrainSeeds(vec![1, 2])),
+                train_map: train_map.into(),
+                ..SearchRequest::default()
+            }
+            .setup(None)
+        };
+        let default = setup(DEFAULT_TRAIN_MAP).unwrap().agents_identity;
+        assert!(default.starts_with("trained on intersection for "), "{default}");
+        // Agents trained elsewhere are other agents: a folder of one search does not resume the other.
+        let other = setup("junction_training").unwrap().agents_identity;
+        assert!(other.starts_with("trained on junction_training for "), "{other}");
+        assert_ne!(default, other);
+        let e = setup("no_such_map.ron").unwrap_err();
+        assert!(e.to_string().contains("no_such_map.ron"), "{e}");
+        assert!(e.is_user_input(), "{e}");
+    }
 }
