@@ -39,8 +39,8 @@ fn estimate(py: Python<'_>, request: &Bound<'_, PyDict>) -> PyResult<String> {
 /// estimate` checks it, writing nothing. Returns JSON text: `spec` (the request, for
 /// [`drive_estimate`]), `search_spec` (the search request whose candidates are the draws,
 /// for `evaluate_search_candidates`), `train` (the training seeds of the agents to
-/// train), `train_episodes`, `timeout_as`, and `agent` (the agent file's text when one is
-/// given, else null).
+/// train), `train_map` (the training map where a node finds it), `train_episodes`,
+/// `timeout_as`, and `agent` (the agent file's text when one is given, else null).
 #[pyfunction]
 fn plan_estimate(request: &Bound<'_, PyDict>) -> PyResult<String> {
     let request: EstimateRequest = crate::convert::request(request)?;
@@ -53,6 +53,7 @@ fn plan_estimate(request: &Bound<'_, PyDict>) -> PyResult<String> {
         "spec": json_text(&request)?,
         "search_spec": json_text(&request.search())?,
         "train": setup.search.to_train(),
+        "train_map": crate::units::locate(&request.train_map),
         "train_episodes": request.train_episodes,
         "timeout_as": request.timeout_as,
         "agent": agent,

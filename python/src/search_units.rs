@@ -88,8 +88,9 @@ impl Built {
 /// before any task runs, as `unforeseen search` does; `agent` is an agent given loaded
 /// instead of the request's agent file. Returns JSON text: `spec` (the request, for
 /// [`evaluate_search_candidates`] and [`drive_search`]), `train` (the training seeds of
-/// the agents to train), `train_episodes`, `timeout_as`, and `agent` (the agent's text
-/// when one is given, else null).
+/// the agents to train), `train_map` (the training map where a node finds it),
+/// `train_episodes`, `timeout_as`, and `agent` (the agent's text when one is given, else
+/// null).
 #[pyfunction]
 #[pyo3(signature = (request, agent = None))]
 fn plan_search(request: &Bound<'_, PyDict>, agent: Option<PyRef<'_, PyAgent>>) -> PyResult<String> {
@@ -106,6 +107,7 @@ fn plan_search(request: &Bound<'_, PyDict>, agent: Option<PyRef<'_, PyAgent>>) -
     Ok(json!({
         "spec": serde_json::to_string(&spec).map_err(errors::to_py)?,
         "train": setup.to_train(),
+        "train_map": crate::units::locate(&request.train_map),
         "train_episodes": request.train_episodes,
         "timeout_as": request.timeout_as,
         "agent": agent_text,

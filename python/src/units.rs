@@ -40,7 +40,7 @@ pub(crate) fn check_episodes(what: &str, n: u64) -> PyResult<()> {
 /// Where a node finds a map given as `source` (a scenario's source, or the training
 /// map): an embedded map's name, or the map file's absolute path (a node's working
 /// folder is not the driver's).
-fn locate(source: &str) -> String {
+pub(crate) fn locate(source: &str) -> String {
     match source.strip_prefix(unforeseen_sim::EMBEDDED_PREFIX) {
         Some(name) => name.to_string(),
         None if !Path::new(source).exists() => source.to_string(),

@@ -268,3 +268,38 @@ def test_one_estimate_request_gives_the_same_files_through_every_front(agent_fil
         run_estimate(**args, out=tmp_path / f"{estimator}-ray", candidates_per_task=7)
         for front in ("py", "ray"):
             assert [(tmp_path / f"{estimator}-{front}" / f).read_bytes() for f in files] == expected, (estimator, front)
+
+
+def test_a_training_map_crosses_every_front(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    """A search and an estimate whose agents train on a map file other than the default
+    (``train_map``, ``--train-map``): the command line, the library and the Ray driver
+    (whose agents train on the cluster) write the same outputs, and the agents' identity
+    names the training map."""
+    train_map = tmp_path / "short.ron"
+    train_map.write_text('Map(base: "intersection", name: "short_intersection", episode: (max_steps: 60))')
+    space = REPO / "maps" / "spaces" / "jaywalk.ron"
+    agents = ["--method", "q-learning", "--train-seeds", "1", "--train-episodes", "20", "--train-map", str(train_map),
+              "--no-cache", "--episodes", "1", "--seed", "5", "--jobs", "1", "--quiet"]
+    args = dict(space=space, method="q-learning", train_seeds=[1], train_episodes=20, train_map=train_map, episodes=1,
+                seed=5)
+    monkeypatch.setitem(sys.modules, "ray", _InlineRay())
+    from unforeseen.distributed import run_estimate, run_search
+
+    _cli("search", "--space", str(space), *agents, "--budget", "4", "--rounds", "1", "--max-failures", "0",
+         "--out", str(tmp_path / "s-cli"))
+    expected = _search_outputs(tmp_path / "s-cli")
+    assert expected["candidates"][0]["search"]["agents"].startswith("trained on short_intersection for 20 episodes")
+    search_args = dict(budget=4, rounds=1, max_failures=0)
+    unforeseen.search(out=tmp_path / "s-py", **args, **search_args)
+    run_search(out=tmp_path / "s-ray", **args, **search_args)
+    for front in ("py", "ray"):
+        assert _search_outputs(tmp_path / f"s-{front}") == expected, front
+
+    _cli("estimate", "--space", str(space), *agents, "--budget", "50", "--out", str(tmp_path / "e-cli"))
+    files = ["estimate.jsonl", "summary.json"]
+    expected_files = [(tmp_path / "e-cli" / f).read_bytes() for f in files]
+    assert b"trained on short_intersection for 20 episodes" in expected_files[0]
+    unforeseen.estimate(out=tmp_path / "e-py", budget=50, **args)
+    run_estimate(out=tmp_path / "e-ray", budget=50, candidates_per_task=7, **args)
+    for front in ("py", "ray"):
+        assert [(tmp_path / f"e-{front}" / f).read_bytes() for f in files] == expected_files, front

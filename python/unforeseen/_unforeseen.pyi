@@ -423,8 +423,9 @@ def finish_batch(out: str) -> BatchResult:
 def plan_search(request: dict[str, Any], agent: Agent | None = None) -> str:
     """The search request (its fields) checked as ``unforeseen search`` checks
     it (arguments, base map, space file), before any task; JSON text of ``spec`` (the
-    request), ``train`` (training seeds to train), ``train_episodes``, ``timeout_as`` and
-    ``agent`` (the given agent's text, or null)."""
+    request), ``train`` (training seeds to train), ``train_map`` (where a node finds the
+    training map), ``train_episodes``, ``timeout_as`` and ``agent`` (the given agent's
+    text, or null)."""
 def search(request: dict[str, Any], agent: Agent | None = None, command: str = "") -> str:
     """``unforeseen search`` in this process: the search request (its fields) planned, trained and run by the library as the command line runs it, writing
     its folder of outputs; ``summary.json``'s contents (JSON text). A bad field raises
@@ -437,7 +438,7 @@ def estimate(request: dict[str, Any]) -> str:
 def plan_estimate(request: dict[str, Any]) -> str:
     """The estimate request (its fields) checked as ``unforeseen estimate`` checks it,
     writing nothing; JSON text of ``spec`` (the request), ``search_spec`` (the search
-    request whose candidates are the draws), ``train``, ``train_episodes``,
+    request whose candidates are the draws), ``train``, ``train_map``, ``train_episodes``,
     ``timeout_as`` and ``agent`` (the agent file's text, or null)."""
 def drive_estimate(
     spec: str,

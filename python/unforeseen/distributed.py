@@ -355,6 +355,7 @@ def run_search(
     force: bool = False,
     agent: str | os.PathLike[str] | _unforeseen.Agent | None = None,
     train_seeds: Iterable[int] | str | None = None,
+    train_map: str | os.PathLike[str] = "intersection",
     train_episodes: int = 6000,
     timeout_as: str = "truncation",
     cache: str | os.PathLike[str] | None = None,
@@ -426,7 +427,7 @@ def _candidate_tasks(
         pairs = [(None, ray.put(plan["agent"].encode()))]
     else:
         train = ray.remote(num_cpus=1, **options)(_train_task)
-        pairs = [(s, train.remote(s, plan["train_episodes"], "intersection", plan["timeout_as"])) for s in plan["train"]]
+        pairs = [(s, train.remote(s, plan["train_episodes"], plan["train_map"], plan["timeout_as"])) for s in plan["train"]]
     agent_seeds = [s for s, _ in pairs]
     refs = [r for _, r in pairs]
     texts = ray.get(refs) if refs else []
@@ -470,6 +471,7 @@ def run_estimate(
     force: bool = False,
     agent: str | os.PathLike[str] | None = None,
     train_seeds: Iterable[int] | str | None = None,
+    train_map: str | os.PathLike[str] = "intersection",
     train_episodes: int = 6000,
     timeout_as: str = "truncation",
     cache: str | os.PathLike[str] | None = None,

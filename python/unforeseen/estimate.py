@@ -31,6 +31,7 @@ def estimate(
     force: bool = False,
     agent: str | os.PathLike[str] | None = None,
     train_seeds: Iterable[int] | str | None = None,
+    train_map: str | os.PathLike[str] = "intersection",
     train_episodes: int = 6000,
     timeout_as: str = "truncation",
     cache: str | os.PathLike[str] | None = None,
@@ -41,9 +42,9 @@ def estimate(
     interval, or ``"is"``, cross-entropy importance sampling with a weighted interval), at
     most ``budget`` draws of ``episodes`` episodes each, stopping once both relative
     half-widths are at most ``target_rel_error``. Agents: ``agent`` (an agent file), one
-    per training seed (``train_seeds``, trained on the intersection for
-    ``train_episodes`` and kept in ``cache`` when given), or, with neither, one trained
-    with ``seed``. ``jobs`` threads (None: every core; the results do not depend on it);
+    per training seed (``train_seeds``, trained on ``train_map``, a map file or an
+    embedded name, for ``train_episodes`` and kept in ``cache`` when given), or, with
+    neither, one trained on ``train_map`` with ``seed``. ``jobs`` threads (None: every core; the results do not depend on it);
     ``force`` replaces files in ``out`` an estimate did not write.
 
     Writes the folder ``out`` and returns ``summary.json``'s contents. ``ValueError``

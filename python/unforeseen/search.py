@@ -35,6 +35,7 @@ def search(
     force: bool = False,
     agent: str | os.PathLike[str] | _unforeseen.Agent | None = None,
     train_seeds: Iterable[int] | str | None = None,
+    train_map: str | os.PathLike[str] = "intersection",
     train_episodes: int = 6000,
     timeout_as: str = "truncation",
     cache: str | os.PathLike[str] | None = None,
@@ -45,9 +46,10 @@ def search(
     candidates (``sobol_share`` of them scrambled Sobol points, the rest in ``rounds``
     adaptive rounds), ``episodes`` each, then up to ``max_failures`` failures minimised
     toward the base. Agents: ``agent`` (an agent file, or an :class:`unforeseen.Agent`),
-    one per training seed (``train_seeds``, ``range(1, 4)`` or ``"1..3"``, trained on the
-    intersection for ``train_episodes``, and kept in the agent cache ``cache`` when one is
-    given: e.g. ``"out/agents"``, the command line's), or, with neither, one trained with ``seed``. ``jobs`` threads (None: every
+    one per training seed (``train_seeds``, ``range(1, 4)`` or ``"1..3"``, trained on
+    ``train_map``, a map file or an embedded name, for ``train_episodes``, and kept in the
+    agent cache ``cache`` when one is given: e.g. ``"out/agents"``, the command line's),
+    or, with neither, one trained on ``train_map`` with ``seed``. ``jobs`` threads (None: every
     core); ``shard`` (``"I/N"``) evaluates one slice of the Sobol stage; ``resume`` keeps
     the finished candidates in ``out``; ``force`` replaces files there a search did not
     write; ``command`` goes in the failure maps' comments.

@@ -8,9 +8,8 @@ use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::Method;
 use unforeseen_harness::episodes::Protocol;
-use unforeseen_harness::runs::batch::Shard;
+use unforeseen_harness::runs::batch::{AgentChoice, Shard};
 use unforeseen_harness::runs::search::{SearchRequest, Summary};
-use unforeseen_harness::training::DEFAULT_TRAIN_MAP;
 
 /// Arguments of `search`.
 #[derive(Debug, Clone, Args)]
@@ -67,9 +66,13 @@ pub struct SearchArgs {
     /// Training episodes when no --agent is given.
     #[arg(long, default_value_t = SearchRequest::default().train_episodes, value_parser = super::episodes)]
     pub train_episodes: u64,
-    /// Agent file from `unforeseen train` (default: train on the embedded intersection map).
+    /// Agent file from `unforeseen train` (default: train on --train-map).
     #[arg(long, value_name = "FILE")]
     pub agent: Option<PathBuf>,
+    /// Training map (file or embedded name) when no --agent is given: the agent (or, with
+    /// --train-seeds, each agent) is trained there.
+    #[arg(long, value_name = "MAP", default_value_t = SearchRequest::default().train_map, conflicts_with = "agent")]
+    pub train_map: String,
     /// Training seeds and the agent cache.
     #[command(flatten)]
     pub seeds: TrainSeedArgs,
@@ -99,6 +102,7 @@ impl SearchArgs {
             force: self.force,
             agent: self.agent.clone(),
             train_seeds: self.seeds.train_seeds.clone(),
+            train_map: self.train_map.clone(),
             train_episodes: self.train_episodes,
             timeout_as: self.seeds.timeout_as,
             cache: self.seeds.cache_dir().map(Path::to_path_buf),
@@ -116,10 +120,12 @@ pub fn run(args: SearchArgs) -> anyhow::Result<()> {
     super::outputs::creating("--out", creates);
     let setup = &job.setup;
     let to_train = setup.to_train();
-    if !to_train.is_empty() {
+    if let AgentChoice::Trained { map, .. } = &setup.agents
+        && !to_train.is_empty()
+    {
         let per_seed = args.seeds.train_seeds.is_some();
         let episodes = args.train_episodes;
-        progress::training(quiet, per_seed, to_train.len(), episodes, DEFAULT_TRAIN_MAP, args.seed);
+        progress::training(quiet, per_seed, to_train.len(), episodes, &map.name, args.seed);
     }
     let agents = setup.agents(&Bars::counting(quiet, "episodes"))?;
     let command = std::iter::once("unforeseen".to_string())

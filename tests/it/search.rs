@@ -12,7 +12,7 @@ use unforeseen_harness::runs::search::{self, Fairness, SearchConfig, Space, Valu
 use unforeseen_harness::training::Agent;
 use unforeseen_sim::Map;
 
-use crate::common::{assert_exit, run_cli};
+use crate::common::{assert_exit, output_text, run_cli};
 use unforeseen_harness::fixtures::bundle;
 
 /// The output guard of a search into `out`, as a job holds it.
@@ -564,4 +564,121 @@ fn the_timed_junction_space_keeps_the_vehicle_near_the_car() {
         panic!("{:?}", high.trigger)
     };
     assert!((t - 4.998).abs() < 1e-9 && (high.speed.0 - 12.896).abs() < 1e-9 && (high.start - 54.975).abs() < 1e-9);
+}
+
+/// `search --train-map` (and `estimate --train-map`): the agents train on the map given, a
+/// file or an embedded name; the map enters their identity and cache key as batch's does,
+/// so a search of agents trained elsewhere does not resume this one; its default is the
+/// request's; a missing map is refused naming the file, writing nothing; an agent file
+/// and a training map are refused together.
+#[test]
+fn search_and_estimate_train_on_the_train_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let space = root.join("maps/spaces/jaywalk.ron");
+    let short = dir.path().join("short.ron");
+    std::fs::write(
+        &short,
+        "Map(base: \"intersection\", name: \"short_intersection\", episode: (max_steps: 60))",
+    )
+    .unwrap();
+    let cache = dir.path().join("agents");
+    let run = |out: &str, extra: &[&str]| {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "search",
+            "--space",
+            space.to_str().unwrap(),
+            "--method",
+            "q-learning",
+            "--train-seeds",
+            "1",
+            "--train-episodes",
+            "20",
+            "--budget",
+            "2",
+            "--episodes",
+            "1",
+            "--max-failures",
+            "0",
+            "--jobs",
+            "1",
+            "-q",
+            "--cache",
+            cache.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        (run_cli(&args), out)
+    };
+    let identity = |out: &Path| {
+        let text = std::fs::read_to_string(out.join("candidates.jsonl")).unwrap();
+        let first: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+        first["search"]["agents"].as_str().unwrap().to_string()
+    };
+    let (res, trained) = run("short", &["--train-map", short.to_str().unwrap()]);
+    assert_exit(&res, 0, &[]);
+    let (res, default) = run("default", &[]);
+    assert_exit(&res, 0, &[]);
+    assert!(
+        identity(&trained).starts_with("trained on short_intersection for 20 episodes"),
+        "{}",
+        identity(&trained)
+    );
+    assert!(identity(&default).starts_with("trained on intersection for 20 episodes"));
+    let mut cached: Vec<String> = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    cached.sort();
+    assert!(
+        cached.len() == 2
+            && cached[0].starts_with("intersection-seed1-")
+            && cached[1].starts_with("short_intersection-seed1-"),
+        "one cached agent per training map: {cached:?}"
+    );
+    // The default search does not resume the folder of agents trained on the other map.
+    let (res, _) = run("short", &["--resume"]);
+    assert_exit(&res, 2, &["--resume", "another search", "short_intersection"]);
+
+    // The flags' default is the request's.
+    let help = output_text(&run_cli(&["search", "--help"]));
+    let default_map = unforeseen_harness::runs::search::SearchRequest::default().train_map;
+    assert!(
+        help.contains("--train-map <MAP>") && help.contains(&format!("[default: {default_map}]")),
+        "{help}"
+    );
+    let help = output_text(&run_cli(&["estimate", "--help"]));
+    assert!(help.contains("--train-map <MAP>"), "{help}");
+
+    // A missing training map: refused naming it, nothing written; with an agent file: refused.
+    let missing = dir.path().join("no_such_train_map.ron");
+    for command in ["search", "estimate"] {
+        let out = dir.path().join(format!("{command}-missing"));
+        let res = run_cli(&[
+            command,
+            "--space",
+            space.to_str().unwrap(),
+            "--method",
+            "q-learning",
+            "--train-map",
+            missing.to_str().unwrap(),
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_exit(&res, 2, &["no_such_train_map.ron", "no such map file", "pass a path"]);
+        assert!(!out.exists(), "{command}: nothing written for a missing training map");
+        let res = run_cli(&[
+            command,
+            "--space",
+            space.to_str().unwrap(),
+            "--agent",
+            "a.ron",
+            "--train-map",
+            "intersection",
+        ]);
+        assert_exit(&res, 2, &["cannot be used with"]);
+    }
 }

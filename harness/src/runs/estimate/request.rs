@@ -11,6 +11,7 @@ use crate::episodes::Method;
 use crate::episodes::Protocol;
 use crate::error::Error;
 use crate::progress::Progress;
+use crate::runs::batch::AgentChoice;
 use crate::runs::outputs::Guarded;
 use crate::runs::search::{Evaluator, SearchConfig, SearchRequest, SearchSetup};
 use crate::training::TimeoutAs;
@@ -107,8 +108,12 @@ pub struct EstimateRequest {
     pub force: bool,
     /// An agent file (from `unforeseen train`). Default: none.
     pub agent: Option<PathBuf>,
-    /// One agent per training seed (a list, or text such as `1..10`). Default: none.
+    /// One agent per training seed, each trained on `train_map` (a list, or text such as
+    /// `1..10`). Default: none.
     pub train_seeds: Option<TrainSeeds>,
+    /// The training map (file or embedded name) of agents trained here. Default as the
+    /// search's (`intersection`).
+    pub train_map: String,
     /// Training episodes of agents trained here. Default as the search's.
     pub train_episodes: u64,
     /// What a training episode's time-out is to the learners. Default truncation.
@@ -136,6 +141,7 @@ impl Default for EstimateRequest {
             force: false,
             agent: None,
             train_seeds: None,
+            train_map: search.train_map,
             train_episodes: search.train_episodes,
             timeout_as: search.timeout_as,
             cache: search.cache,
@@ -170,6 +176,7 @@ impl EstimateRequest {
             force: self.force,
             agent: self.agent.clone(),
             train_seeds: self.train_seeds.clone(),
+            train_map: self.train_map.clone(),
             train_episodes: self.train_episodes,
             timeout_as: self.timeout_as,
             cache: self.cache.clone(),
@@ -215,6 +222,9 @@ impl EstimateRequest {
             .input("space", &self.space);
         if let Some(agent) = &self.agent {
             guard = guard.input("agent", agent);
+        }
+        if matches!(setup.search.agents, AgentChoice::Trained { .. }) {
+            guard = guard.input("train_map", &self.train_map);
         }
         let guard = guard.guard(self.force)?;
         Ok(EstimateJob { setup, guard })
@@ -287,5 +297,15 @@ mod tests {
         );
         let e = EstimateRequest::default().setup().unwrap_err();
         assert!(e.to_string().starts_with("space: "), "{e}");
+    }
+
+    #[test]
+    fn the_draws_agents_train_on_the_training_map() {
+        let r = EstimateRequest {
+            train_map: "junction_training".into(),
+            ..EstimateRequest::default()
+        };
+        assert_eq!(r.search().train_map, "junction_training");
+        assert_eq!(EstimateRequest::default().train_map, SearchRequest::default().train_map);
     }
 }

@@ -67,9 +67,12 @@ pub struct SearchRequest {
     pub force: bool,
     /// An agent file (from `unforeseen train`). Default: none.
     pub agent: Option<PathBuf>,
-    /// One agent per training seed, each trained on the embedded intersection (a list, or
-    /// text such as `1..10`). Default: none.
+    /// One agent per training seed, each trained on `train_map` (a list, or text such as
+    /// `1..10`). Default: none.
     pub train_seeds: Option<TrainSeeds>,
+    /// The training map (file or embedded name) of agents trained here. Default
+    /// `intersection`.
+    pub train_map: String,
     /// Training episodes of agents trained here. Default [`DEFAULT_TRAIN_EPISODES`].
     pub train_episodes: u64,
     /// What a training episode's time-out is to the learners. Default truncation.
@@ -99,6 +102,7 @@ impl Default for SearchRequest {
             force: false,
             agent: None,
             train_seeds: None,
+            train_map: DEFAULT_TRAIN_MAP.to_string(),
             train_episodes: DEFAULT_TRAIN_EPISODES,
             timeout_as: TimeoutAs::Truncation,
             cache: Some(PathBuf::from(DEFAULT_CACHE)),
@@ -141,7 +145,7 @@ impl SearchRequest {
         let agent_fields = AgentFields {
             agent: self.agent.as_deref(),
             train_seeds: self.train_seeds.as_ref(),
-            train_map: DEFAULT_TRAIN_MAP,
+            train_map: &self.train_map,
             train_episodes: self.train_episodes,
             timeout_as: self.timeout_as,
             cache: self.cache.as_ref(),
@@ -172,6 +176,9 @@ impl SearchRequest {
             .input("space", &self.space);
         if let Some(agent) = &self.agent {
             guard = guard.input("agent", agent);
+        }
+        if matches!(setup.agents, AgentChoice::Trained { .. }) {
+            guard = guard.input("train_map", &self.train_map);
         }
         let guard = guard.guard(self.force || self.resume)?;
         Ok(SearchJob { setup, guard })
@@ -277,5 +284,27 @@ mod tests {
         .setup(None)
         .unwrap_err();
         assert!(e.to_string().starts_with("train_seeds: "), "{e}");
+    }
+
+    #[test]
+    fn the_training_map_is_part_of_the_agents_identity() {
+        let setup = |train_map: &str| {
+            SearchRequest {
+                space: concat!(env!("CARGO_MANIFEST_DIR"), "/../maps/spaces/jaywalk.ron").into(),
+                train_seeds: Some(TrainSeeds(vec![1, 2])),
+                train_map: train_map.into(),
+                ..SearchRequest::default()
+            }
+            .setup(None)
+        };
+        let default = setup(DEFAULT_TRAIN_MAP).unwrap().agents_identity;
+        assert!(default.starts_with("trained on intersection for "), "{default}");
+        // Agents trained elsewhere are other agents: a folder of one search does not resume the other.
+        let other = setup("junction_training").unwrap().agents_identity;
+        assert!(other.starts_with("trained on junction_training for "), "{other}");
+        assert_ne!(default, other);
+        let e = setup("no_such_map.ron").unwrap_err();
+        assert!(e.to_string().contains("no_such_map.ron"), "{e}");
+        assert!(e.is_user_input(), "{e}");
     }
 }
