@@ -29,11 +29,12 @@
 
 use std::time::Instant;
 
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use unforeseen_agent::aif::action::marginals;
 use unforeseen_agent::aif::agent::{Agent, AgentParams};
 use unforeseen_agent::aif::driving::{equivalent, exported};
+use unforeseen_agent::aif::process::sample;
 use unforeseen_agent::maths::argmax;
 use unforeseen_agent::model::GenerativeModel;
 use unforeseen_agent::params::{RootStep, ScaledParams};
@@ -116,28 +117,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect();
     let absorbing = |s: usize| (0..na).all(|u| plan.b[u][(s, s)] == 1.0);
-    let draw = |p: &mut dyn Iterator<Item = f64>, rng: &mut ChaCha8Rng| {
-        let x: f64 = rng.random();
-        let mut acc = 0.0;
-        let mut last = 0;
-        for (i, pi) in p.enumerate() {
-            acc += pi;
-            last = i;
-            if x < acc {
-                return i;
-            }
-        }
-        last
-    };
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let (mut s_true, mut prior, mut age) = (0usize, plan.d.clone(), usize::MAX);
     for _ in 0..ticks {
         if age >= 40 || absorbing(s_true) {
-            s_true = draw(&mut plan.d.iter().copied(), &mut rng);
+            s_true = sample(plan.d.iter().copied(), &mut rng);
             prior = plan.d.clone();
             age = 0;
         }
-        let o = draw(&mut (0..no).map(|o| root.a[(o, s_true)]), &mut rng);
+        let o = sample((0..no).map(|o| root.a[(o, s_true)]), &mut rng);
         let mut q: Vec<f64> = (0..n).map(|s| root.a[(o, s)] * prior[s]).collect();
         let z: f64 = q.iter().sum();
         if z <= 0.0 {
@@ -148,7 +136,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         tree.evaluate(&plan, &root, &q, gamma);
         let u = argmax(&tree.psi);
         beliefs.push(q.clone());
-        s_true = draw(&mut (0..n).map(|s2| root.b[u][(s2, s_true)]), &mut rng);
+        s_true = sample((0..n).map(|s2| root.b[u][(s2, s_true)]), &mut rng);
         prior = (0..n)
             .map(|s2| (0..n).map(|s| root.b[u][(s2, s)] * q[s]).sum())
             .collect();

@@ -291,6 +291,13 @@ mod tests {
         WorldModel::new(st, 3, &ModelPriors::default()).unwrap()
     }
 
+    /// A belief certain of joint state `s` (of the paper's 64).
+    fn one_hot(s: usize) -> Vec<f64> {
+        let mut q = vec![0.0; 64];
+        q[s] = 1.0;
+        q
+    }
+
     #[test]
     fn hand_worked_counts_and_memory() {
         let mut w = model();
@@ -310,9 +317,7 @@ mod tests {
         let mut bounded = StateGate::from_model(&w, "p", 5.0).unwrap();
         assert!((bounded.probability(1, &[1, 2]) - 2.0 / 7.0).abs() < 1e-12);
         // Learning three ticks at p = 1: 4:4 -> rescaled 2.5:2.5 -> (1 + 2.5) / 7 = 0.5.
-        let s = st.encode(&[2, 0, 1, 1]);
-        let mut q = vec![0.0; 64];
-        q[s] = 1.0;
+        let q = one_hot(st.encode(&[2, 0, 1, 1]));
         for _ in 0..3 {
             bounded.learn(&q, 1.0);
         }
@@ -348,11 +353,6 @@ mod tests {
             w.observe_transition(st.encode(&[3, 2, 1, 0]), 1, st.encode(&[2, 2, 1, usize::from(k < 5)]));
         }
         let (s_fast, s_slow) = (st.encode(&[2, 3, 1, 1]), st.encode(&[2, 0, 1, 1]));
-        let one_hot = |s: usize| {
-            let mut q = vec![0.0; 64];
-            q[s] = 1.0;
-            q
-        };
         let ln2 = 2f64.ln();
         let mut g = StateGate::from_model(&w, "p", 20.0).unwrap();
         g.set_endorsed(s_slow, 1.0);
@@ -384,11 +384,6 @@ mod tests {
         for k in 0..4 {
             w.observe_transition(st.encode(&[3, 2, 0, 0]), 1, st.encode(&[2, 2, 0, usize::from(k < 2)]));
         }
-        let one_hot = |s: usize| {
-            let mut q = vec![0.0; 64];
-            q[s] = 1.0;
-            q
-        };
         let ln2 = 2f64.ln();
         let (full, part, unseen) = (
             st.encode(&[2, 0, 1, 1]),
@@ -421,11 +416,6 @@ mod tests {
         }
         let mut g = StateGate::from_model(&w, "p", 20.0).unwrap();
         let (s_fast, s_slow) = (st.encode(&[2, 3, 1, 1]), st.encode(&[2, 0, 1, 1]));
-        let one_hot = |s: usize| {
-            let mut q = vec![0.0; 64];
-            q[s] = 1.0;
-            q
-        };
         let ln2 = 2f64.ln();
         let (q_fast, q_slow) = (one_hot(s_fast), one_hot(s_slow));
         assert!((g.surprise(&q_slow) - ln2).abs() < 1e-12);

@@ -44,8 +44,9 @@ def estimate(
     half-widths are at most ``target_rel_error``. Agents: ``agent`` (an agent file), one
     per training seed (``train_seeds``, trained on ``train_map``, a map file or an
     embedded name, for ``train_episodes`` and kept in ``cache`` when given), or, with
-    neither, one trained on ``train_map`` with ``seed``. ``jobs`` threads (None: every core; the results do not depend on it);
-    ``force`` replaces files in ``out`` an estimate did not write.
+    neither, one trained on ``train_map`` with ``seed``. ``jobs`` threads (None: every
+    core; the results do not depend on it); ``force`` replaces files in ``out`` an
+    estimate did not write.
 
     Writes the folder ``out`` and returns ``summary.json``'s contents. ``ValueError``
     names a bad argument (``target_rel_error: ...``), map or space before any work;

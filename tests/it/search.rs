@@ -541,7 +541,7 @@ fn the_junction_space_sets_the_vehicle_rules() {
 /// arrives, 30 m out at 9 m/s; the highest an oncoming left-turner that does not yield,
 /// started 5 s out, 55 m away at 12.9 m/s (values rounded to 0.001).
 #[test]
-fn the_timed_junction_space_keeps_the_vehicle_near_the_car() {
+fn the_timed_junction_space_sets_the_vehicle_rule() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let base = Map::load(&root.join("maps/junction/red_runner.ron")).unwrap();
     let space = Space::load(&root.join("maps/spaces/junction_timed.ron"), &base).expect("valid");

@@ -13,7 +13,9 @@ pub struct Process {
     state: Vec<usize>,
 }
 
-fn sample(p: impl Iterator<Item = f64>, rng: &mut impl RngExt) -> usize {
+/// An index drawn from the categorical distribution `p` (its cumulative sum against one
+/// uniform draw; the last index if rounding leaves the sum below the draw).
+pub fn sample(p: impl Iterator<Item = f64>, rng: &mut impl RngExt) -> usize {
     let r: f64 = rng.random();
     let mut acc = 0.0;
     let mut last = 0;
