@@ -45,6 +45,8 @@ pub struct Competence {
     /// `G_held(u)` per one-hot state, `[s * n_actions + u]`; NaN where not yet computed.
     memo: Vec<f64>,
     held: Vec<f64>,
+    part: Vec<f64>,
+    next: Vec<f64>,
 }
 
 impl Competence {
@@ -57,6 +59,8 @@ impl Competence {
             y: vec![0.0; n_states],
             memo: vec![f64::NAN; n_states * n_actions],
             held: vec![0.0; n_actions],
+            part: vec![0.0; n_states],
+            next: vec![0.0; n_states],
         }
     }
 
@@ -81,6 +85,34 @@ impl Competence {
         for k in 0..horizon {
             let step_model = if k == 0 { root } else { plan };
             (g, crashed) = self.step.step(plan, step_model, u, &self.x, &mut self.y, g, crashed);
+            std::mem::swap(&mut self.x, &mut self.y);
+        }
+        g
+    }
+
+    /// `G` of the habit followed for `horizon` steps from belief `q`: its action `a` now,
+    /// through `root`'s `B` (the habit acts on the belief), then from each predicted state
+    /// `s` the action `act[s]` it takes there, through `plan`'s
+    /// ([`StepScratch::step_feedback`]). With `act[s] = a` everywhere it is
+    /// [`Competence::held_efe`]'s `G`.
+    pub fn followed_efe(
+        &mut self,
+        plan: &GenerativeModel,
+        root: &GenerativeModel,
+        q: &[f64],
+        (a, act): (usize, &[usize]),
+        horizon: usize,
+    ) -> f64 {
+        self.x.copy_from_slice(q);
+        let (mut g, mut crashed) = (0.0, 0.0);
+        for k in 0..horizon {
+            (g, crashed) = if k == 0 {
+                self.step.step(plan, root, a, &self.x, &mut self.y, g, crashed)
+            } else {
+                let scratch = (self.part.as_mut_slice(), self.next.as_mut_slice());
+                self.step
+                    .step_feedback(plan, plan, act, &self.x, &mut self.y, scratch, g, crashed)
+            };
             std::mem::swap(&mut self.x, &mut self.y);
         }
         g
@@ -250,5 +282,47 @@ mod tests {
             memo.regret(plan, root, q, Some(5), 1, 2).to_bits(),
             fresh.regret(plan, root, q, None, 1, 2).to_bits()
         );
+    }
+
+    /// Following the habit: with one action everywhere it is holding that action, bit for
+    /// bit (with a transition cost and a crash model too); with the actions differing by
+    /// state, two steps worked by hand: the first through the learned `B` with the action
+    /// now, the second from each state with its own action, `to = Σ_s x[s] B[act[s]][·, s]`,
+    /// each step adding the risk and ambiguity of its prediction (Prop. 1).
+    #[test]
+    fn following_the_habit_is_holding_where_it_holds_and_mixes_its_actions_elsewhere() {
+        for (cost, crash) in [(false, false), (true, true)] {
+            let w = model(cost, crash);
+            let (plan, root) = (w.planning_generative(), w.generative());
+            let mut c = Competence::new(64, 64, 3);
+            for q in beliefs() {
+                for u in 0..3 {
+                    let held = c.held_efe(plan, root, &q, u, 5);
+                    let followed = c.followed_efe(plan, root, &q, (u, &[u; 64]), 5);
+                    assert_eq!(followed.to_bits(), held.to_bits(), "u {u}");
+                }
+            }
+        }
+        let w = model(false, false);
+        let (plan, root) = (w.planning_generative(), w.generative());
+        let act: Vec<usize> = (0..64).map(|s| s % 3).collect();
+        let mut c = Competence::new(64, 64, 3);
+        let mut obuf = vec![0.0; 64];
+        for s0 in [5, 21, 38] {
+            let first = 2;
+            let x: Vec<f64> = (0..64).map(|s| root.b[first][(s, s0)]).collect();
+            let to: Vec<f64> = (0..64)
+                .map(|s2| (0..64).map(|s| x[s] * plan.b[act[s]][(s2, s)]).sum())
+                .collect();
+            let (r1, a1) = crate::planning::step_efe(plan, &x, &mut obuf);
+            let (r2, a2) = crate::planning::step_efe(plan, &to, &mut obuf);
+            let mut q = vec![0.0; 64];
+            q[s0] = 1.0;
+            let followed = c.followed_efe(plan, root, &q, (first, &act), 2);
+            let want = r1 + a1 + r2 + a2;
+            assert!((followed - want).abs() < 1e-9, "s0 {s0}: {followed} against {want}");
+            let held = c.held_efe(plan, root, &q, first, 2);
+            assert!((followed - held).abs() > 1e-6, "s0 {s0}: following differs from holding");
+        }
     }
 }

@@ -277,6 +277,19 @@ param_enum! {
 }
 
 param_enum! {
+    /// How the competence check ([`crate::competence`]) rolls the habit out.
+    pub enum CompetenceRollout {
+        /// Holding its action for `competence_horizon` ticks, as every other action.
+        #[default]
+        Held = "held",
+        /// The better of holding its action and following it: its action now, then in each
+        /// predicted state the action it takes there (a habit that stops at a red line is
+        /// judged stopping there, not driving through it).
+        Feedback = "feedback",
+    }
+}
+
+param_enum! {
     /// Which model the EFE tree's first step from `q_t` goes through
     /// ([`crate::planning::EfeTree::evaluate`]).
     pub enum RootStep {
@@ -334,6 +347,7 @@ param_groups! {
     /// | `gate` | `competence` | `regret` | `regret`, `surprise-only` | where the gate leaves the habit in charge, the world model scores holding its action against holding the best one, and the agent reasons where it is worse by more than `competence_regret` (beyond the paper; `surprise-only` is the paper's agent) ([`CompetenceCheck`]) |
     /// | `gate` | `competence_regret` | 10.0 | finite and >= 0 | nats of expected free energy by which holding the habit's action may be worse than holding the best action before the agent reasons |
     /// | `gate` | `competence_horizon` | 8 | 1..=40 | ticks each action is held by the competence check |
+    /// | `gate` | `competence_rollout` | `held` | `held`, `feedback` | how the competence check rolls the habit out: holding its action, or the better of holding it and following the habit's action in each predicted state (beyond the paper) ([`CompetenceRollout`]) |
     /// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
     /// | `perception` | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
     /// | `perception` | `vmp_tol` | 1e-6 | finite and > 0 | VMP convergence threshold on max \|Δ q\| |
@@ -415,6 +429,8 @@ param_group! {
             MAX_COMPETENCE_HORIZON,
             "in 1..=40 (the competence check holds each action this many ticks where the habit acts)",
         ),
+        /// How the competence check rolls the habit out.
+        competence_rollout: CompetenceRollout = CompetenceRollout::Held => "competence_rollout",
     }
 }
 

@@ -364,6 +364,56 @@ impl StepScratch {
         }
         (g, crashed)
     }
+
+    /// One step of a feedback policy: from belief `from`, the mass in each state `s` takes
+    /// action `act[s]` (a state-feedback policy, as a habit is; with one action everywhere
+    /// this is [`StepScratch::step`]'s step). Each action's part of the belief crashes,
+    /// pays the transition cost and moves through `step_model`'s `B` on its own; `to` is
+    /// their sum, and the step's risk and ambiguity are those of `to` under `gm`'s
+    /// preferences. Returns as [`StepScratch::step`]. `part` and `next` are scratch of
+    /// `n_states`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn step_feedback(
+        &mut self,
+        gm: &GenerativeModel,
+        step_model: &GenerativeModel,
+        act: &[usize],
+        from: &[f64],
+        to: &mut [f64],
+        (part, next): (&mut [f64], &mut [f64]),
+        g: f64,
+        crashed: f64,
+    ) -> (f64, f64) {
+        to.fill(0.0);
+        let (mut hit, mut cost) = (0.0, 0.0);
+        for u in 0..gm.n_actions() {
+            let mut any = false;
+            for ((p, x), a) in part.iter_mut().zip(from).zip(act) {
+                *p = if *a == u { *x } else { 0.0 };
+                any |= *p != 0.0;
+            }
+            if !any {
+                continue;
+            }
+            if step_model.transition_cost.is_some() {
+                cost +=
+                    step_model.transition_cost_of(u, part, &mut self.masked, &mut self.masked_next, &mut self.scratch);
+            }
+            if let Some(cm) = &gm.crash {
+                hit += cm.split(u, part, &mut self.survive);
+                part.copy_from_slice(&self.survive);
+            }
+            step_model.transition_into(u, part, next, &mut self.scratch);
+            to.iter_mut().zip(next.iter()).for_each(|(t, n)| *t += n);
+        }
+        let crashed = crashed + hit;
+        let (r, a) = step_efe(gm, to, &mut self.obuf);
+        let mut g = g + r + a;
+        if let Some(cm) = &gm.crash {
+            g += cm.risk(crashed);
+        }
+        (g + cost, crashed)
+    }
 }
 
 /// Whether two slices hold the same bits.

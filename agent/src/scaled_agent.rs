@@ -23,8 +23,8 @@ use crate::learning;
 use crate::maths::argmax;
 use crate::model::WorldModel;
 use crate::params::{
-    ActionSelection, CheckedScaledParams, CompetenceCheck, CrashPlanning, GateBaseline, GateLearning, GateMode,
-    HandBackRule, ReasoningMode, RootStep, ScaledParams, ScalingMode, TieBreak,
+    ActionSelection, CheckedScaledParams, CompetenceCheck, CompetenceRollout, CrashPlanning, GateBaseline,
+    GateLearning, GateMode, HandBackRule, ReasoningMode, RootStep, ScaledParams, ScalingMode, TieBreak,
 };
 use crate::perception::{VmpWorkspace, vmp};
 use crate::planning::{EfeTree, q_s_into};
@@ -102,8 +102,11 @@ pub struct ScaledAgent<H: Habit = TableHabit> {
     /// Whether each tick's trigger fired only because of test-time learning and the habit
     /// acted, the check finding it safe.
     hist_declined: Vec<bool>,
-    /// The competence check's scratch: one action per state, the held action's policy.
+    /// The competence check's scratch: one action per state, the held action's policy or
+    /// the habit's.
     held_policy: Vec<usize>,
+    /// The habit's policy in one state (`competence_rollout = feedback`).
+    state_pi: Vec<f64>,
     /// This tick's `B[u] q_t` per action, `[u * n + s]` ([`ScaledAgent::predict_all`]), for
     /// [`ActionSelection::OutcomeMode`] and [`TieBreak::Safest`].
     next_pred: Vec<f64>,
@@ -250,6 +253,7 @@ impl<H: Habit> ScaledAgent<H> {
             hist_checked: Vec::with_capacity(256),
             hist_declined: Vec::with_capacity(256),
             held_policy: vec![0; n],
+            state_pi: vec![0.0; na],
             next_pred: vec![0.0; n * na],
             pred_scratch: Vec::new(),
             final_obs: None,
@@ -395,6 +399,27 @@ impl<H: Habit> ScaledAgent<H> {
         if regret <= self.params.gate.competence_regret {
             return None;
         }
+        let regret = match self.params.gate.competence_rollout {
+            CompetenceRollout::Held => regret,
+            CompetenceRollout::Feedback => {
+                // The habit judged as it drives: its action now, then its own action in
+                // each state it is predicted to reach.
+                let t = self.hist_obs.len();
+                for s in 0..self.held_policy.len() {
+                    self.habit.pi_o_state(t, s, &mut self.state_pi);
+                    self.held_policy[s] = argmax(&self.state_pi);
+                }
+                let followed =
+                    self.competence
+                        .followed_efe(plan, root, &self.q_cur, (habit, &self.held_policy), horizon);
+                let best = self.competence.held().iter().copied().fold(f64::INFINITY, f64::min);
+                let regret = regret.min(followed - best);
+                if regret <= self.params.gate.competence_regret {
+                    return None;
+                }
+                regret
+            }
+        };
         // Never for a riskier action: where holding the preferred action is predicted to
         // crash more often than holding the habit's, by more than ρ within the hand-back's
         // horizon (crash_risk, as the hand-back checks), the habit keeps the tick.
