@@ -90,24 +90,25 @@ impl Competence {
         g
     }
 
-    /// `G` of the habit followed for `horizon` steps from belief `q`: its action `a` now,
-    /// through `root`'s `B` (the habit acts on the belief), then from each predicted state
-    /// `s` the action `act[s]` it takes there, through `plan`'s
-    /// ([`StepScratch::step_feedback`]). With `act[s] = a` everywhere it is
-    /// [`Competence::held_efe`]'s `G`.
+    /// `G` of the habit followed for `horizon` steps from belief `q`: its action `a` now
+    /// and for the `commit - 1` steps after (the first through `root`'s `B`: the habit acts
+    /// on the belief), then from each predicted state `s` the action `act[s]` it takes
+    /// there, through `plan`'s ([`StepScratch::step_feedback`]). With `act[s] = a`
+    /// everywhere, or `commit >= horizon`, it is [`Competence::held_efe`]'s `G`.
     pub fn followed_efe(
         &mut self,
         plan: &GenerativeModel,
         root: &GenerativeModel,
         q: &[f64],
         (a, act): (usize, &[usize]),
-        horizon: usize,
+        (commit, horizon): (usize, usize),
     ) -> f64 {
         self.x.copy_from_slice(q);
         let (mut g, mut crashed) = (0.0, 0.0);
         for k in 0..horizon {
-            (g, crashed) = if k == 0 {
-                self.step.step(plan, root, a, &self.x, &mut self.y, g, crashed)
+            let step_model = if k == 0 { root } else { plan };
+            (g, crashed) = if k < commit.max(1) {
+                self.step.step(plan, step_model, a, &self.x, &mut self.y, g, crashed)
             } else {
                 let scratch = (self.part.as_mut_slice(), self.next.as_mut_slice());
                 self.step
@@ -298,7 +299,9 @@ mod tests {
             for q in beliefs() {
                 for u in 0..3 {
                     let held = c.held_efe(plan, root, &q, u, 5);
-                    let followed = c.followed_efe(plan, root, &q, (u, &[u; 64]), 5);
+                    let followed = c.followed_efe(plan, root, &q, (u, &[u; 64]), (1, 5));
+                    let committed = c.followed_efe(plan, root, &q, (u, &[(u + 1) % 3; 64]), (5, 5));
+                    assert_eq!(committed.to_bits(), held.to_bits(), "u {u}");
                     assert_eq!(followed.to_bits(), held.to_bits(), "u {u}");
                 }
             }
@@ -318,11 +321,14 @@ mod tests {
             let (r2, a2) = crate::planning::step_efe(plan, &to, &mut obuf);
             let mut q = vec![0.0; 64];
             q[s0] = 1.0;
-            let followed = c.followed_efe(plan, root, &q, (first, &act), 2);
+            let followed = c.followed_efe(plan, root, &q, (first, &act), (1, 2));
             let want = r1 + a1 + r2 + a2;
             assert!((followed - want).abs() < 1e-9, "s0 {s0}: {followed} against {want}");
             let held = c.held_efe(plan, root, &q, first, 2);
-            assert!((followed - held).abs() > 1e-6, "s0 {s0}: following differs from holding");
+            assert!(
+                (followed - held).abs() > 1e-6,
+                "s0 {s0}: following differs from holding"
+            );
         }
     }
 }

@@ -348,6 +348,7 @@ param_groups! {
     /// | `gate` | `competence_regret` | 10.0 | finite and >= 0 | nats of expected free energy by which holding the habit's action may be worse than holding the best action before the agent reasons |
     /// | `gate` | `competence_horizon` | 8 | 1..=40 | ticks each action is held by the competence check |
     /// | `gate` | `competence_rollout` | `held` | `held`, `feedback` | how the competence check rolls the habit out: holding its action, or the better of holding it and following the habit's action in each predicted state (beyond the paper) ([`CompetenceRollout`]) |
+    /// | `gate` | `competence_commit` | 2 | 1..=40 | ticks `feedback` holds the habit's action before following it: the car is committed to what it does now for that long |
     /// | `perception` | `vmp_window` W | 4 | 1..=1000 | VMP window (ticks), §III |
     /// | `perception` | `vmp_kappa` κ | 1.0 | (0, 1] | VMP step in logit coordinates (eq. "iterative") |
     /// | `perception` | `vmp_tol` | 1e-6 | finite and > 0 | VMP convergence threshold on max \|Δ q\| |
@@ -431,6 +432,11 @@ param_group! {
         ),
         /// How the competence check rolls the habit out.
         competence_rollout: CompetenceRollout = CompetenceRollout::Held => "competence_rollout",
+        /// Ticks the habit's action is held before `competence_rollout = feedback` follows it.
+        competence_commit: usize = 2 => "competence_commit" in count(
+            MAX_COMPETENCE_HORIZON,
+            "in 1..=40 (ticks the competence check holds the habit's action before following it)",
+        ),
     }
 }
 

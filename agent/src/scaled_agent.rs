@@ -409,9 +409,14 @@ impl<H: Habit> ScaledAgent<H> {
                     self.habit.pi_o_state(t, s, &mut self.state_pi);
                     self.held_policy[s] = argmax(&self.state_pi);
                 }
-                let followed =
-                    self.competence
-                        .followed_efe(plan, root, &self.q_cur, (habit, &self.held_policy), horizon);
+                let commit = self.params.gate.competence_commit;
+                let followed = self.competence.followed_efe(
+                    plan,
+                    root,
+                    &self.q_cur,
+                    (habit, &self.held_policy),
+                    (commit, horizon),
+                );
                 let best = self.competence.held().iter().copied().fold(f64::INFINITY, f64::min);
                 let regret = regret.min(followed - best);
                 if regret <= self.params.gate.competence_regret {

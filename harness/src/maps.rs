@@ -1,7 +1,8 @@
 //! Finding a map: a file path, or the name of a map embedded in the binary
 //! (`intersection`, `jaywalk`, ...), so the default run needs no files at all. Every
 //! map loaded here has its expectations' names checked against this program's
-//! [`Method`]s and [`Protocol`]s ([`check_expectation_names`]).
+//! [`Method`]s and [`Protocol`]s ([`check_expectation_names`]) and its agent settings
+//! against the scaled agent's parameters ([`check_agent_settings`]).
 
 use std::path::Path;
 use unforeseen_sim::embedded::{self, LookupError};
@@ -24,6 +25,7 @@ pub fn load(arg: &str) -> Result<Map, LookupError> {
         format!("{EMBEDDED_PREFIX}{}", arg.strip_suffix(".ron").unwrap_or(arg))
     };
     check_expectation_names(&map, &file)?;
+    check_agent_settings(&map, &file)?;
     Ok(map)
 }
 
@@ -32,6 +34,7 @@ pub fn load(arg: &str) -> Result<Map, LookupError> {
 pub fn load_file(path: &Path) -> Result<Map, MapError> {
     let map = Map::load(path)?;
     check_expectation_names(&map, &path.display().to_string())?;
+    check_agent_settings(&map, &path.display().to_string())?;
     Ok(map)
 }
 
@@ -59,6 +62,39 @@ pub fn check_expectation_names(map: &Map, file: &str) -> Result<(), MapError> {
             let allowed = Protocol::ALL.iter().map(|p| p.map_name()).collect();
             problems.push(diagnostic(format!("expect[{i}].protocol"), "protocol", p, allowed));
         }
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(MapError::new(problems))
+    }
+}
+
+/// Checks that every setting of `map`'s `agent` section is a parameter of the scaled
+/// agent with a value it takes, and that together they are consistent
+/// ([`crate::overrides::on_map`] applies them). `file` names the map in the diagnostics
+/// (one per bad setting, with its field, e.g. `agent.gate_baseline`, and what is allowed).
+pub fn check_agent_settings(map: &Map, file: &str) -> Result<(), MapError> {
+    let diagnostic = |path: String, e: &dyn std::fmt::Display| Diagnostic {
+        file: file.to_string(),
+        position: None,
+        path,
+        message: e.to_string(),
+        hint: Some(
+            "the keys and values of `--set` (unforeseen batch --help; maps/README.md, \"The agent's settings\")".into(),
+        ),
+    };
+    let mut p = unforeseen_agent::params::ScaledParams::default();
+    let mut problems = Vec::new();
+    for (key, value) in &map.agent {
+        if let Err(e) = p.set_str(key, value) {
+            problems.push(diagnostic(format!("agent.{key}"), &e));
+        }
+    }
+    if problems.is_empty()
+        && let Err(e) = p.check_ref()
+    {
+        problems.push(diagnostic("agent".into(), &e));
     }
     if problems.is_empty() {
         Ok(())
@@ -96,6 +132,28 @@ mod tests {
             lines[1],
             "bad.ron: expect[2].protocol: unknown protocol `Continuous` (hint: expected one of: ZeroShot, Continual)"
         );
+    }
+
+    #[test]
+    fn agent_settings_are_checked_against_the_scaled_agents_parameters() {
+        let map = parse(r#"Map(agent: {"gate_baseline": "foreseen", "competence_regret": "5"})"#);
+        assert_eq!(check_agent_settings(&map, "bad.ron"), Ok(()));
+        let map = parse(r#"Map(agent: {"gate_baseline": "forseen", "competense": "regret"})"#);
+        let err = check_agent_settings(&map, "bad.ron").unwrap_err();
+        let lines: Vec<String> = err.diagnostics().iter().map(ToString::to_string).collect();
+        assert_eq!(lines.len(), 2, "{lines:?}");
+        assert!(
+            lines[0].starts_with("bad.ron: agent.competense: unknown parameter `competense`"),
+            "{}",
+            lines[0]
+        );
+        assert!(lines[0].contains("competence"), "suggests the key: {}", lines[0]);
+        assert!(
+            lines[1].starts_with("bad.ron: agent.gate_baseline: parameter `gate_baseline` = forseen is invalid"),
+            "{}",
+            lines[1]
+        );
+        assert!(lines[1].contains("foreseen"), "lists the values: {}", lines[1]);
     }
 
     #[test]

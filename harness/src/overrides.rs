@@ -10,6 +10,7 @@ use unforeseen_agent::error::SetError;
 use unforeseen_agent::param_decl::ParamValue;
 use unforeseen_agent::param_table;
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_sim::Map;
 
 use crate::error::Error;
 
@@ -60,20 +61,26 @@ pub fn override_error(key: &str, value: &str, e: SetError) -> Error {
 /// Applies `KEY=VALUE` overrides in order, then checks the result (ranges and bounds
 /// of [`ScaledParams::check`]).
 pub fn apply(p: ScaledParams, sets: &[String]) -> Result<ScaledParams, Error> {
-    let mut pairs = Vec::with_capacity(sets.len());
-    for set in sets {
-        let (key, value) = set.split_once('=').ok_or_else(|| {
-            Error::flag(
-                format!("--set {set}"),
-                format!(
-                    "expected KEY=VALUE, e.g. --set omega=0.425 (keys: {})",
-                    keys().join(", ")
-                ),
-            )
-        })?;
-        pairs.push((key.trim(), value.trim()));
-    }
-    apply_pairs(p, pairs)
+    apply_pairs(p, pairs(sets)?)
+}
+
+/// `KEY=VALUE` overrides as `(key, value)` pairs; a setting without `=` is an error
+/// naming it and the keys.
+pub fn pairs(sets: &[String]) -> Result<Vec<(&str, &str)>, Error> {
+    sets.iter()
+        .map(|set| {
+            let (key, value) = set.split_once('=').ok_or_else(|| {
+                Error::flag(
+                    format!("--set {set}"),
+                    format!(
+                        "expected KEY=VALUE, e.g. --set omega=0.425 (keys: {})",
+                        keys().join(", ")
+                    ),
+                )
+            })?;
+            Ok((key.trim(), value.trim()))
+        })
+        .collect()
 }
 
 /// Applies `(key, value)` overrides in order (as [`set_one`]), then checks the result
@@ -92,6 +99,14 @@ pub fn apply_pairs<'a>(
     Ok(p)
 }
 
+/// The scaled agent's parameters on `map`: the defaults, then the map's own settings
+/// (its `agent` section, checked when it was loaded: [`crate::maps::check_agent_settings`]),
+/// then `pairs` (a run's `--set`), which win; checked as [`apply_pairs`].
+pub fn on_map<'a>(map: &'a Map, pairs: impl IntoIterator<Item = (&'a str, &'a str)>) -> Result<ScaledParams, Error> {
+    let own = map.agent.iter().map(|(k, v)| (k.as_str(), v.as_str()));
+    apply_pairs(ScaledParams::default(), own.chain(pairs))
+}
+
 /// Sets one parameter by name (as [`ScaledParams::set_str`]).
 pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), Error> {
     p.set_str(key, value).map_err(|e| override_error(key, value, e))
@@ -102,4 +117,29 @@ pub fn set_one(p: &mut ScaledParams, key: &str, value: &str) -> Result<(), Error
 pub fn set_value(p: &mut ScaledParams, key: &str, value: ParamValue) -> Result<(), Error> {
     let shown = value.to_string();
     p.set(key, value).map_err(|e| override_error(key, &shown, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use unforeseen_agent::params::{CompetenceRollout, GateBaseline};
+
+    /// The defaults, then the map's settings, then the run's: the run's win, and a map
+    /// without settings gives the defaults.
+    #[test]
+    fn a_maps_settings_lie_between_the_defaults_and_the_runs() {
+        let mut map = Map::default();
+        assert_eq!(on_map(&map, []).unwrap(), ScaledParams::default());
+        map.agent.insert("gate_baseline".into(), "foreseen".into());
+        map.agent.insert("competence_rollout".into(), "feedback".into());
+        let p = on_map(&map, []).unwrap();
+        assert_eq!(p.gate.gate_baseline, GateBaseline::Foreseen);
+        assert_eq!(p.gate.competence_rollout, CompetenceRollout::Feedback);
+        let p = on_map(&map, [("gate_baseline", "none")]).unwrap();
+        assert_eq!(p.gate.gate_baseline, GateBaseline::None);
+        assert_eq!(p.gate.competence_rollout, CompetenceRollout::Feedback);
+        map.agent.insert("competence_commit".into(), "0".into());
+        let e = on_map(&map, []).unwrap_err().to_string();
+        assert!(e.contains("competence_commit"), "{e}");
+    }
 }

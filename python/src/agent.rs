@@ -16,6 +16,7 @@ use unforeseen_harness::episodes::Method;
 use unforeseen_harness::episodes::Protocol;
 use unforeseen_harness::runs::evaluate::EvalRequest;
 use unforeseen_harness::training::TrainSeeds;
+use unforeseen_sim::Map;
 
 use crate::convert;
 use crate::errors;
@@ -63,10 +64,14 @@ fn param_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<ParamValue> {
     )))
 }
 
-/// The scaled agent's parameters: the defaults with the keyword arguments `params` set
-/// through the parameter table (the path `--set` takes, with its checks and messages).
-pub fn scaled_params(params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParams> {
-    let mut p = ScaledParams::default();
+/// The scaled agent's parameters: the defaults, or on `map` its settings
+/// (`overrides::on_map`), with the keyword arguments `params` set through the parameter
+/// table (the path `--set` takes, with its checks and messages).
+pub fn scaled_params(map: Option<&Map>, params: Option<&Bound<'_, PyDict>>) -> PyResult<ScaledParams> {
+    let mut p = match map {
+        Some(map) => unforeseen_harness::overrides::on_map(map, []).map_err(errors::to_py)?,
+        None => ScaledParams::default(),
+    };
     if let Some(d) = params {
         for (k, v) in d.iter() {
             let key: String = k.extract()?;
@@ -130,8 +135,8 @@ impl PyAgent {
     #[pyo3(signature = (method = "scaled", map = "jaywalk", **params))]
     fn controller(&self, method: &str, map: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<PyController> {
         let m = self::method(method)?;
-        let p = scaled_params(params)?;
         let map = crate::maps::load(map, None)?;
+        let p = scaled_params(Some(&map), params)?;
         let c = m.controller(&self.bundle, &p, &map).map_err(errors::to_py)?;
         Ok(PyController::new(c, self.factor_sizes(), m))
     }

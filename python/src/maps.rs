@@ -14,6 +14,7 @@ use crate::errors;
 /// Loads `arg` (a map file or an embedded name) and applies `overrides`.
 pub fn load(arg: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Map> {
     let map = unforeseen_sim::embedded::find(arg).map_err(errors::to_py)?;
+    unforeseen_harness::maps::check_agent_settings(&map, arg).map_err(errors::to_py)?;
     match overrides {
         Some(o) if !o.is_empty() => {
             let sections = Map::override_fields();

@@ -118,7 +118,7 @@ impl PyScaledHabitAgent {
         observation: &str,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let p = scaled_params(params)?;
+        let p = scaled_params(None, params)?;
         let learns = Method::Scaled.learns_across_episodes(&p);
         let form = crate::env::observation_form(observation)?;
         if habit_table.is_some() && habit.is_some() {
@@ -275,7 +275,7 @@ fn q_table_habit<'py>(
     agent: &PyAgent,
     params: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let p = scaled_params(params)?;
+    let p = scaled_params(None, params)?;
     let q = &agent.bundle.q_learning;
     let probs = unforeseen_agent::learning::nu_from_q(q.table(), q.n_actions(), 1.0, p.learning.nu_temperature);
     let rows: Vec<Vec<f64>> = probs.chunks(q.n_actions()).map(<[f64]>::to_vec).collect();

@@ -7,6 +7,7 @@
 //! cross along y.
 
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// Defines a configuration struct with documented defaults, plus a crate-private
 /// "patch" twin whose fields are all optional: a scenario built on a base map
@@ -912,6 +913,12 @@ pub struct Map {
     /// Default [] (not serialised when empty, as `junction`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub traffic: Vec<TrafficRule>,
+    /// The scaled agent's settings on this map, `{"KEY": "VALUE"}` with the keys and values
+    /// of `--set` (maps/README.md, "The agent's settings"): the defaults a world needs, e.g.
+    /// the junction's gate. A run's own `--set` wins over them. A map that sets this
+    /// replaces the base's. Default {} (not serialised when empty, as `junction`).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub agent: BTreeMap<String, String>,
     /// Discretizer bins.
     pub bins: Bins,
     /// Reward.
@@ -963,6 +970,8 @@ pub(crate) struct MapPatch {
     #[serde(default)]
     traffic: Option<Vec<TrafficRule>>,
     #[serde(default)]
+    agent: Option<BTreeMap<String, String>>,
+    #[serde(default)]
     bins: Option<BinsPatch>,
     #[serde(default)]
     reward: Option<RewardPatch>,
@@ -998,6 +1007,9 @@ impl MapPatch {
         }
         if let Some(p) = self.traffic {
             base.traffic = p;
+        }
+        if let Some(p) = self.agent {
+            base.agent = p;
         }
         if let Some(p) = self.bins {
             p.apply(&mut base.bins);

@@ -94,6 +94,16 @@ impl EvalScene {
         })
     }
 
+    /// The scaled agent's parameters in the scene: the map's settings (a stream's maps
+    /// agree on theirs), then `sets` ([`crate::overrides::on_map`]).
+    pub fn params(&self, sets: &[String]) -> Result<ScaledParams, Error> {
+        let map = match self {
+            EvalScene::Map(map) => map,
+            EvalScene::Stream(stream, _) => &stream.maps[0].0,
+        };
+        crate::overrides::on_map(map, crate::overrides::pairs(sets)?)
+    }
+
     /// The scene's input files for the output guard (the stream and its maps, or the
     /// map given as `map`), with the agent file `agent` if any.
     pub fn inputs(&self, map: &str, agent: Option<&PathBuf>) -> Outputs {
@@ -164,7 +174,7 @@ impl EvalRequest {
                 .files_in("out", dir, &[EVAL_FILE], &[Own::Evaluation])
                 .check(self.force)?;
         }
-        let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
+        let params = scene.params(&self.sets)?;
         // A scripted reference decodes the map's own observations: it needs no agent.
         let scripted = self.method.is_scripted().then_some(SCRIPTED_ONLY);
         let (agent, _, _) = fields.choose(given, scripted)?;

@@ -145,7 +145,7 @@ impl LearnRequest {
                 .files_in("out", dir, &LEARN_FILES, &LEARN_KINDS)
                 .check(self.force)?;
         }
-        let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
+        let params = scene.params(&self.sets)?;
         let (agent, _, _) = fields.choose(given, None)?;
         Ok(LearnJob {
             scene,

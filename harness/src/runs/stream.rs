@@ -186,6 +186,17 @@ impl Stream {
                     ),
                 ));
             }
+            if let Some((first, _)) = maps.first()
+                && first.agent != map.agent
+            {
+                return Err(invalid(
+                    format!("maps[{i}].map"),
+                    &format!(
+                        "map '{}' sets other agent settings than map '{}' (maps[0]): one agent runs the whole stream, so its maps must agree on `agent`",
+                        map.name, first.name
+                    ),
+                ));
+            }
             maps.push((map, e.weight));
             files.push(from_file.then_some(beside));
         }
@@ -493,6 +504,18 @@ mod tests {
             "Stream(maps: [(map: \"jaywalk\"), (map: \"jaywalk\")])",
         );
         assert!(Stream::load(&twice).unwrap_err().to_string().contains("again"));
+        write(
+            dir.path(),
+            "gated.ron",
+            "Map(base: \"jaywalk\", name: \"gated\", agent: {\"gate_baseline\": \"foreseen\"})",
+        );
+        let disagree = write(
+            dir.path(),
+            "d.ron",
+            "Stream(maps: [(map: \"jaywalk\"), (map: \"gated.ron\")])",
+        );
+        let e = Stream::load(&disagree).unwrap_err().to_string();
+        assert!(e.contains("maps[1].map") && e.contains("agent"), "{e}");
         let fraction = write(
             dir.path(),
             "f.ron",

@@ -200,7 +200,7 @@ impl TraceRequest {
             }
             guard.check(self.force)?;
         }
-        let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
+        let params = crate::overrides::on_map(&map, crate::overrides::pairs(&self.sets)?)?;
         let (agent, _, _) = fields.choose(given, None)?;
         Ok(TraceJob {
             map: Box::new(map),

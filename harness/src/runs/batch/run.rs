@@ -41,7 +41,11 @@ pub fn run_unit_with(cfg: &BatchConfig<'_>, unit: &Unit, cancel: &dyn Progress) 
         });
     }
     let bundle = agent.map(|a| &a.bundle);
-    let params = unit.params.scaled_params()?;
+    // A stream's maps agree on their agent settings ([`Stream::load`](crate::runs::stream::Stream::load)).
+    let params = match &scenario.kind {
+        ScenarioKind::Map(map) => unit.params.on_map(map)?,
+        ScenarioKind::Stream(stream) => unit.params.on_map(&stream.maps[0].0)?,
+    };
     let tree = unit.method.reasoning_tree(&params);
     let (agg, per_map_figures) = match &scenario.kind {
         ScenarioKind::Map(map) => {

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 use unforeseen_agent::param_table;
 use unforeseen_agent::params::ScaledParams;
+use unforeseen_sim::Map;
 
 use crate::error::Error;
 
@@ -110,7 +111,16 @@ pub fn checked_sweep(sets: &[String]) -> Result<Vec<ParamSet>, Error> {
 impl ParamSet {
     /// The scaled agent's parameters with these overrides applied (checked).
     pub fn scaled_params(&self) -> Result<ScaledParams, Error> {
-        let pairs = self.0.iter().map(|(k, v)| (k.as_str(), v.as_str()));
-        crate::overrides::apply_pairs(ScaledParams::default(), pairs)
+        crate::overrides::apply_pairs(ScaledParams::default(), self.pairs())
+    }
+
+    /// The scaled agent's parameters on `map`: its own settings, then these overrides
+    /// ([`crate::overrides::on_map`]).
+    pub fn on_map(&self, map: &Map) -> Result<ScaledParams, Error> {
+        crate::overrides::on_map(map, self.pairs())
+    }
+
+    fn pairs(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.0.iter().map(|(k, v)| (k.as_str(), v.as_str()))
     }
 }

@@ -143,7 +143,7 @@ impl CompareRequest {
         }
         let train_map = crate::maps::load(&self.train_map)?;
         let test_map = crate::maps::load(&self.test_map)?;
-        let params = crate::overrides::apply(ScaledParams::default(), &self.sets)?;
+        let params = crate::overrides::on_map(&test_map, crate::overrides::pairs(&self.sets)?)?;
         let agents = if given.is_empty() {
             fields.choose(None, None)?.0
         } else {

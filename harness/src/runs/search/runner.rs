@@ -196,7 +196,7 @@ pub fn evaluate_candidate(
     cancel: &dyn Progress,
 ) -> Result<Vec<CandidateLine>, Error> {
     let cancel = CancelOnly(cancel);
-    let params = ScaledParams::default();
+    let params = crate::overrides::on_map(map, [])?;
     let scripted = |m: Method| -> Result<Aggregate, Error> {
         Ok(Aggregate::of(&run_scripted_episodes(
             map,
