@@ -467,6 +467,8 @@ def run_estimate(
     episodes: int = 4,
     seed: int = 7,
     jobs: int | None = None,
+    shard: str | None = None,
+    resume: bool = False,
     out: str | os.PathLike[str] = "out/estimate",
     force: bool = False,
     agent: str | os.PathLike[str] | None = None,
@@ -487,13 +489,15 @@ def run_estimate(
     ``candidates_per_task`` draws (default: about 4 tasks per CPU), each draw evaluated
     as the search evaluates a candidate. On the cluster ``jobs`` is the threads, and
     CPUs, of each task (None: 1); agents train once per seed on the cluster and are not
-    cached (``cache`` is not used). Returns ``summary.json``'s contents.
+    cached (``cache`` is not used); ``shard`` is refused (the cluster deals the draws
+    itself), ``resume`` keeps the draws an earlier run of the same request left in
+    ``out`` and sends only the rest to the cluster. Returns ``summary.json``'s contents.
     """
     fields = {k: v for k, v in locals().items() if k in ESTIMATE_DEFAULTS}
     if space is None:
         fields.pop("space")
     threads, _ = _task_request("estimate", fields, "candidates_per_task", candidates_per_task, max_retries,
-                               "run it again")
+                               "concatenate their estimate.jsonl and finish with --resume")
     plan = json.loads(_unforeseen.plan_estimate(fields))
     stop = threading.Event()
     agents, evaluate = _candidate_tasks(plan, plan["search_spec"], plan["agent"] is not None, threads,
