@@ -264,6 +264,10 @@ fn resume_and_shards_refuse_what_they_cannot_continue() {
         2,
         &["line 5 (draw 3)", "not the draw this estimate derives", "point differs"],
     );
+    assert!(
+        !out.join("estimate.jsonl.part").exists(),
+        "a refusal leaves the folder as it was"
+    );
     // A valid draw again with another failure count.
     let (n, valid) = lines
         .iter()

@@ -339,7 +339,12 @@ struct Run<'a, 'b> {
     kept: BTreeMap<usize, resume::Kept>,
     /// The file the kept draws were read from, for errors.
     read: PathBuf,
-    sink: Mutex<Streamed>,
+    /// The part, created with `head` (the identity and the kept draws) at the first
+    /// fresh draw: a run that evaluates nothing, or refuses a kept draw before, leaves the
+    /// folder's files as they were.
+    part: PathBuf,
+    head: String,
+    sink: Mutex<Option<Streamed>>,
     shard: Option<Shard>,
     progress: &'a dyn Progress,
     remote: Option<&'a dyn Evaluator>,
@@ -413,7 +418,11 @@ impl Run<'_, '_> {
     /// Appends fresh draws to the part.
     fn append(&self, draws: &[Draw]) -> Result<(), Error> {
         let text = draws.iter().map(output::draw_line).collect::<Result<String, Error>>()?;
-        self.sink.lock().expect("part lock").append(text.as_bytes())
+        let mut sink = self.sink.lock().expect("part lock");
+        if sink.is_none() {
+            *sink = Some(Streamed::create(&self.part, self.head.as_bytes())?);
+        }
+        sink.as_mut().expect("created above").append(text.as_bytes())
     }
 
     /// The shard's part when the run has one and the draws `needed` are not all in the
@@ -550,7 +559,8 @@ impl Draw {
 /// the job's output guard, held while the run writes.
 ///
 /// The fresh draws are streamed to `estimate.jsonl.part` ([`output::DRAWS_PART`]) as
-/// they are evaluated (after the identity and the draws kept), and the set is committed
+/// they are evaluated (after the identity and the draws kept; the part is made at the
+/// first fresh draw), and the set is committed
 /// as one at the end ([`crate::files::all_or_none`]), the part removed with it: a run
 /// that fails or is killed partway leaves the earlier set as it was, and the part for
 /// `--resume`, which reads the part when there is one (the latest run into the folder)
@@ -575,12 +585,13 @@ pub(crate) fn run(
     let head = std::iter::once(Ok(output::identity_line(&identity)))
         .chain(kept.values().map(|k| output::draw_line(&k.draw)))
         .collect::<Result<String, Error>>()?;
-    let sink = Streamed::create(&part, head.as_bytes())?;
     let run = Run {
         cfg,
         kept,
         read,
-        sink: Mutex::new(sink),
+        part,
+        head,
+        sink: Mutex::new(None),
         shard: r.shard,
         progress,
         remote,
@@ -720,7 +731,9 @@ mod tests {
                     cfg: &cfg,
                     kept: BTreeMap::new(),
                     read: part.clone(),
-                    sink: Mutex::new(Streamed::create(&part, b"").unwrap()),
+                    part,
+                    head: String::new(),
+                    sink: Mutex::new(None),
                     shard: None,
                     progress: &NoProgress,
                     remote: None,
