@@ -295,7 +295,7 @@ pub fn blocks(estimator: Estimator, budget: usize) -> (Vec<usize>, Vec<usize>) {
 #[derive(Debug, Clone)]
 enum Ended {
     /// The estimate, finished.
-    Finished(Outcome),
+    Finished(Box<Outcome>),
     /// A shard's part of a stage, and the draws it evaluated.
     Shard(ShardPart, Vec<Draw>),
 }
@@ -669,13 +669,13 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
             };
             return Ok(Ended::Shard(part, Vec::new()));
         }
-        Ok(Ended::Finished(Outcome {
+        Ok(Ended::Finished(Box::new(Outcome {
             draws,
             estimates,
             proposal,
             reached,
             checkpoints,
-        }))
+        })))
     })
 }
 
@@ -739,7 +739,7 @@ mod tests {
                     remote: None,
                 };
                 match estimate(&run, estimator, estimator.min_budget(), 0.01).unwrap() {
-                    Ended::Finished(outcome) => outcome,
+                    Ended::Finished(outcome) => *outcome,
                     Ended::Shard(..) => unreachable!("no shard"),
                 }
             };
