@@ -65,8 +65,10 @@ How an estimate runs
 estimator's stages in Rust (through the binding's ``drive_estimate``): each block of
 draws (each cross-entropy round, each block of the final or Monte Carlo stage) goes to
 the same evaluator as a search's candidates, so ``estimate.jsonl`` and ``summary.json``
-equal ``unforeseen estimate``'s byte for byte. An interrupted estimate starts over (its
-files are written once, at the end).
+equal ``unforeseen estimate``'s byte for byte. The draws evaluated stream to
+``estimate.jsonl.part``: an interrupted estimate continues with ``resume=True``
+(``--resume``), whose blocks send only the missing draws to the cluster; ``shard`` is
+refused (the cluster deals the draws itself).
 """
 
 from __future__ import annotations
