@@ -222,6 +222,17 @@ fn resume_and_shards_refuse_what_they_cannot_continue() {
     assert_exit(&estimate(&out, &flags), 0, &[]);
     let file = out.join("estimate.jsonl");
     let whole = std::fs::read_to_string(&file).unwrap();
+    // `merge` joins batch runs: an estimate's shards are concatenated and resumed.
+    assert_exit(
+        &run_cli(&[
+            "merge",
+            file.to_str().unwrap(),
+            "--out",
+            d.path().join("m.jsonl").to_str().unwrap(),
+        ]),
+        2,
+        &["estimate.jsonl", "an estimate's draws", "unforeseen estimate --resume"],
+    );
     // Another request's file: its identity line says what differs.
     let run = estimate(&out, &["--budget", "50", "--seed", "6", "--resume"]);
     assert_exit(
