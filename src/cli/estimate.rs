@@ -52,8 +52,8 @@ pub struct EstimateArgs {
     /// --resume (for is, one --resume --shard round per stage).
     #[arg(long, value_name = "I/N")]
     pub shard: Option<Shard>,
-    /// Keep the draws in --out/estimate.jsonl (of the same request) and evaluate only the
-    /// rest.
+    /// Keep the draws of the same request in --out (estimate.jsonl.part, left by an
+    /// interrupted run, else estimate.jsonl) and evaluate only the rest.
     #[arg(long)]
     pub resume: bool,
     /// Output folder: estimate.jsonl and summary.json. No input may be inside it.
