@@ -417,6 +417,9 @@ impl Run<'_, '_> {
 
     /// Appends fresh draws to the part.
     fn append(&self, draws: &[Draw]) -> Result<(), Error> {
+        if draws.is_empty() {
+            return Ok(());
+        }
         let text = draws.iter().map(output::draw_line).collect::<Result<String, Error>>()?;
         let mut sink = self.sink.lock().expect("part lock");
         if sink.is_none() {
