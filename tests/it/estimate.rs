@@ -1,6 +1,9 @@
 //! `unforeseen estimate`: the same request gives the same files whatever `--jobs`, the
-//! summary states its estimates and threshold, and bad input is refused with exit 2.
-//! Budgets are the estimators' smallest, of one episode per draw.
+//! summary states its estimates and threshold, a killed run resumed (`--resume`) and
+//! shards concatenated and resumed (`--shard I/N`) give the files of one uninterrupted,
+//! unsharded run byte for byte, and bad input (a request, a shard, a file `--resume`
+//! cannot continue) is refused with exit 2, naming the flag or the file and line.
+//! Budgets are small, of one episode per draw.
 
 use crate::common::{assert_exit, run_cli};
 
