@@ -563,11 +563,11 @@ impl Draw {
 ///
 /// The fresh draws are streamed to `estimate.jsonl.part` ([`output::DRAWS_PART`]) as
 /// they are evaluated (after the identity and the draws kept; the part is made at the
-/// first fresh draw), and the set is committed
-/// as one at the end ([`crate::files::all_or_none`]), the part removed with it: a run
-/// that fails or is killed partway leaves the earlier set as it was, and the part for
-/// `--resume`, which reads the part when there is one (the latest run into the folder)
-/// and `estimate.jsonl` otherwise.
+/// first fresh draw), and the set is committed as one at the end
+/// ([`crate::files::all_or_none`]), the part removed with it: a run that fails or is
+/// killed partway leaves the earlier set as it was, and the part for `--resume`, which
+/// reads the part when there is one (the latest run into the folder) and
+/// `estimate.jsonl` otherwise.
 pub(crate) fn run(
     cfg: &SearchConfig<'_>,
     r: &EstimateRequest,
@@ -602,12 +602,12 @@ pub(crate) fn run(
     match estimate(&run, r.estimator, r.budget, r.target_rel_error)? {
         Ended::Finished(outcome) => crate::files::all_or_none(|| output::write_all(cfg, r, out, &outcome))
             .map(|s| Report::Estimate(Box::new(s))),
-        Ended::Shard(part, fresh) => {
+        Ended::Shard(shard_part, fresh) => {
             let mut draws: BTreeMap<usize, Draw> = run.kept.into_iter().map(|(i, k)| (i, k.draw)).collect();
             draws.extend(fresh.into_iter().map(|d| (d.draw, d)));
             let draws: Vec<Draw> = draws.into_values().collect();
             crate::files::all_or_none(|| output::write_shard(cfg, r, out, &draws))?;
-            Ok(Report::Shard(part))
+            Ok(Report::Shard(shard_part))
         }
     }
 }
