@@ -13,9 +13,10 @@
 //! may. Every temporary is locked while its writer lives, so [`recover`] tells a live
 //! writer's files from a dead one's.
 //!
-//! A file a run streams while it lasts ([`Streamed`], a search's candidates) is not an
-//! output: it is a part under its own name that `--resume` reads after a kill, committed
-//! (rewritten into the output) with the rest of the set at the end, and removed with it.
+//! A file a run streams while it lasts ([`Streamed`], a search's candidates, an
+//! estimate's draws) is not an output: it is a part under its own name that `--resume`
+//! reads after a kill, committed (rewritten into the output) with the rest of the set at
+//! the end, and removed with it.
 
 use std::collections::BTreeSet;
 use std::io::Write;

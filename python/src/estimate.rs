@@ -22,16 +22,17 @@ use crate::units::parse_agent;
 /// `unforeseen estimate` in this process: the estimate `request` (its fields, as
 /// `unforeseen.estimate` takes them) planned, its agents trained or loaded (the request's
 /// agent file, or its training seeds) and the estimate run by the library, writing the
-/// command line's files. Returns `summary.json`'s contents (JSON text). A bad field raises
-/// `ValueError` naming it; Ctrl-C raises `KeyboardInterrupt` at the next episode.
+/// command line's files. Returns `summary.json`'s contents (JSON text), or for a shard
+/// what it evaluated (`ShardPart`). A bad field raises `ValueError` naming it; Ctrl-C
+/// raises `KeyboardInterrupt` at the next episode.
 #[pyfunction]
 fn estimate(py: Python<'_>, request: &Bound<'_, PyDict>) -> PyResult<String> {
     let request: EstimateRequest = crate::convert::request(request)?;
     interruptible(py, |progress| {
         let job = request.plan()?;
         let agents = job.setup.search.agents(progress)?;
-        let summary = job.run(&agents, progress)?;
-        Ok(serde_json::to_string(&summary)?)
+        let report = job.run(&agents, progress)?;
+        Ok(serde_json::to_string(&report)?)
     })
 }
 
@@ -70,8 +71,9 @@ fn json_text<T: serde::Serialize>(value: &T) -> PyResult<String> {
 /// `unforeseen estimate` does, with each block of draws evaluated by `evaluate` (a
 /// callable given a list of candidate JSON texts of `search_spec`'s search, returning
 /// each one's lines, as `evaluate_search_candidates` does); `agents` are `(training seed,
-/// agent text)` pairs, the agent file's when the request gives one. Returns
-/// `summary.json`'s contents, the command line's byte for byte. The GIL is released
+/// agent text)` pairs, the agent file's when the request gives one; with the request's
+/// `resume`, the draws left in its folder are kept. Returns `summary.json`'s contents,
+/// the command line's byte for byte. The GIL is released
 /// while it runs; Ctrl-C raises `KeyboardInterrupt` once it stops, a call under way asked
 /// to return early by setting `stop` when given.
 #[pyfunction]
@@ -91,8 +93,8 @@ fn drive_estimate(
     let cfg = built.config(1, String::new());
     let remote = PyEvaluator::new(evaluate, request.out.clone());
     remote.drive(py, stop, |cancel| {
-        let summary = job.run_with(&cfg, cancel, Some(&remote))?;
-        Ok(serde_json::to_string(&summary)?)
+        let report = job.run_with(&cfg, cancel, Some(&remote))?;
+        Ok(serde_json::to_string(&report)?)
     })
 }
 

@@ -270,6 +270,53 @@ def test_one_estimate_request_gives_the_same_files_through_every_front(agent_fil
             assert [(tmp_path / f"{estimator}-{front}" / f).read_bytes() for f in files] == expected, (estimator, front)
 
 
+def test_an_interrupted_estimate_resumes_to_the_command_lines_files_through_every_front(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    """An estimate killed partway (its draws' part cut mid-line, no estimate.jsonl) resumed
+    by the library (``resume=True``) and by the Ray driver writes the command line's
+    uninterrupted files, byte for byte, for both estimators; shards run from Python,
+    concatenated and resumed, too. The Ray driver refuses a shard, and a bad one is named."""
+    space = str(REPO / "maps" / "spaces" / "jaywalk.ron")
+    monkeypatch.setitem(sys.modules, "ray", _InlineRay())
+    from unforeseen.distributed import run_estimate
+
+    files = ["estimate.jsonl", "summary.json"]
+    for estimator, budget in [("mc", 100), ("is", 200)]:
+        args = dict(space=space, method="never-brake", estimator=estimator, budget=budget, episodes=1, seed=5,
+                    target_rel_error=0.05)
+        cli_out = tmp_path / f"{estimator}-cli"
+        _cli("estimate", "--space", space, "--method", "never-brake", "--estimator", estimator, "--budget",
+             str(budget), "--episodes", "1", "--seed", "5", "--target-rel-error", "0.05", "--jobs", "1", "--quiet",
+             "--out", str(cli_out))
+        expected = [(cli_out / f).read_bytes() for f in files]
+        cut = expected[0][: len(expected[0]) * 3 // 5]
+        for front, run in [("py", unforeseen.estimate), ("ray", run_estimate)]:
+            out = tmp_path / f"{estimator}-{front}"
+            out.mkdir()
+            (out / "estimate.jsonl.part").write_bytes(cut)
+            summary = run(**args, out=out, resume=True)
+            assert summary["evaluations"] == json.loads(expected[1])["evaluations"]
+            assert [(out / f).read_bytes() for f in files] == expected, (estimator, front)
+            assert not (out / "estimate.jsonl.part").exists()
+
+    mc = dict(space=space, method="never-brake", budget=100, episodes=1, seed=5, target_rel_error=0.05)
+    joined = b""
+    for shard in ("1/2", "2/2"):
+        part = unforeseen.estimate(**mc, shard=shard, out=tmp_path / f"shard{shard[0]}")
+        assert (part["shard"], part["stage"], part["share"], part["evaluated"]) == (shard, "uniform", 50, 50)
+        joined += (tmp_path / f"shard{shard[0]}" / "estimate.jsonl").read_bytes()
+    (tmp_path / "joined").mkdir()
+    (tmp_path / "joined" / "estimate.jsonl").write_bytes(joined)
+    unforeseen.estimate(**mc, resume=True, out=tmp_path / "joined")
+    assert [(tmp_path / "joined" / f).read_bytes() for f in files] == [
+        (tmp_path / "mc-cli" / f).read_bytes() for f in files]
+
+    with pytest.raises(ValueError, match=r"shard 1/2: the cluster splits the run itself"):
+        run_estimate(**mc, shard="1/2", out=tmp_path / "ray-shard")
+    with pytest.raises(ValueError, match=r"^shard"):
+        unforeseen.estimate(**mc, shard="3/2", out=tmp_path / "bad-shard")
+
+
 def test_a_training_map_crosses_every_front(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
     """A search and an estimate whose agents train on a map file other than the default
     (``train_map``, ``--train-map``): the command line, the library and the Ray driver

@@ -134,7 +134,8 @@ WRITERS = [
                                  ("compare.svg", "svg")]),
     ("search", _search, True, [("candidates.jsonl", "candidates"), ("candidates.jsonl.part", "candidates"),
                                ("summary.json", None), ("search.svg", "svg")]),
-    ("estimate", _estimate, True, [("estimate.jsonl", "estimates"), ("summary.json", "estimate-summary")]),
+    ("estimate", _estimate, True, [("estimate.jsonl", "estimates"), ("estimate.jsonl.part", "estimates"),
+                                   ("summary.json", "estimate-summary")]),
 ]
 
 CASES = [(w, call, folder, name, kind) for (w, call, folder, outs) in WRITERS for (name, own) in outs

@@ -433,8 +433,10 @@ def search(request: dict[str, Any], agent: Agent | None = None, command: str = "
 def estimate(request: dict[str, Any]) -> str:
     """``unforeseen estimate`` in this process: the estimate request (its fields) planned,
     trained and run by the library as the command line runs it, writing ``estimate.jsonl``
-    and ``summary.json``; ``summary.json``'s contents (JSON text). A bad field raises
-    ``ValueError`` naming it; Ctrl-C raises KeyboardInterrupt at the next episode."""
+    and ``summary.json`` (``resume`` keeping the draws of the same request in its folder;
+    a ``shard`` writing ``estimate.jsonl`` alone); ``summary.json``'s contents, or a shard's
+    part (JSON text). A bad field raises ``ValueError`` naming it; Ctrl-C raises
+    KeyboardInterrupt at the next episode."""
 def plan_estimate(request: dict[str, Any]) -> str:
     """The estimate request (its fields) checked as ``unforeseen estimate`` checks it,
     writing nothing; JSON text of ``spec`` (the request), ``search_spec`` (the search
@@ -447,8 +449,9 @@ def drive_estimate(
     stop: Any | None = None,
 ) -> str:
     """Runs an estimate's stages in Rust (the request ``spec`` from :func:`plan_estimate`,
-    into its folder), each block of draws evaluated by ``evaluate`` (candidate JSON texts
-    of ``search_spec``'s search -> each one's lines); ``summary.json``'s contents."""
+    into its folder, from the draws left there with its ``resume``), each block of draws
+    evaluated by ``evaluate`` (candidate JSON texts of ``search_spec``'s search -> each
+    one's lines); ``summary.json``'s contents."""
 def evaluate_search_candidates(
     spec: str,
     agents: Sequence[tuple[int | None, bytes]],

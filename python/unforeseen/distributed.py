@@ -65,8 +65,10 @@ How an estimate runs
 estimator's stages in Rust (through the binding's ``drive_estimate``): each block of
 draws (each cross-entropy round, each block of the final or Monte Carlo stage) goes to
 the same evaluator as a search's candidates, so ``estimate.jsonl`` and ``summary.json``
-equal ``unforeseen estimate``'s byte for byte. An interrupted estimate starts over (its
-files are written once, at the end).
+equal ``unforeseen estimate``'s byte for byte. The draws evaluated stream to
+``estimate.jsonl.part``: an interrupted estimate continues with ``resume=True``
+(``--resume``), whose blocks send only the missing draws to the cluster; ``shard`` is
+refused (the cluster deals the draws itself).
 """
 
 from __future__ import annotations
@@ -467,6 +469,8 @@ def run_estimate(
     episodes: int = 4,
     seed: int = 7,
     jobs: int | None = None,
+    shard: str | None = None,
+    resume: bool = False,
     out: str | os.PathLike[str] = "out/estimate",
     force: bool = False,
     agent: str | os.PathLike[str] | None = None,
@@ -487,13 +491,15 @@ def run_estimate(
     ``candidates_per_task`` draws (default: about 4 tasks per CPU), each draw evaluated
     as the search evaluates a candidate. On the cluster ``jobs`` is the threads, and
     CPUs, of each task (None: 1); agents train once per seed on the cluster and are not
-    cached (``cache`` is not used). Returns ``summary.json``'s contents.
+    cached (``cache`` is not used); ``shard`` is refused (the cluster deals the draws
+    itself), ``resume`` keeps the draws an earlier run of the same request left in
+    ``out`` and sends only the rest to the cluster. Returns ``summary.json``'s contents.
     """
     fields = {k: v for k, v in locals().items() if k in ESTIMATE_DEFAULTS}
     if space is None:
         fields.pop("space")
     threads, _ = _task_request("estimate", fields, "candidates_per_task", candidates_per_task, max_retries,
-                               "run it again")
+                               "concatenate their estimate.jsonl and finish with --resume")
     plan = json.loads(_unforeseen.plan_estimate(fields))
     stop = threading.Event()
     agents, evaluate = _candidate_tasks(plan, plan["search_spec"], plan["agent"] is not None, threads,

@@ -27,6 +27,8 @@ def estimate(
     episodes: int = 4,
     seed: int = 7,
     jobs: int | None = None,
+    shard: str | None = None,
+    resume: bool = False,
     out: str | os.PathLike[str] = "out/estimate",
     force: bool = False,
     agent: str | os.PathLike[str] | None = None,
@@ -48,9 +50,17 @@ def estimate(
     core; the results do not depend on it); ``force`` replaces files in ``out`` an
     estimate did not write.
 
-    Writes the folder ``out`` and returns ``summary.json``'s contents. ``ValueError``
-    names a bad argument (``target_rel_error: ...``), map or space before any work;
-    Ctrl-C raises ``KeyboardInterrupt``."""
+    ``resume=True`` keeps the draws an earlier run of the same request left in ``out``
+    (interrupted, or shards' files concatenated there) and evaluates only the rest: the
+    files are those of a run never interrupted. ``shard="I/N"`` evaluates only shard I of
+    N of the next stage (the draws I-1 mod N of the first stage ``out`` does not complete)
+    and writes ``estimate.jsonl`` alone, as ``unforeseen estimate --shard`` does.
+
+    Writes the folder ``out`` and returns ``summary.json``'s contents (for a shard, what it
+    evaluated: ``shard``, ``stage``, ``share``, ``evaluated``, ``draws``). ``ValueError``
+    names a bad argument (``target_rel_error: ...``, ``shard: ...``), map or space before
+    any work, and a file in ``out`` that ``resume`` cannot continue (naming its line);
+    Ctrl-C raises ``KeyboardInterrupt``, the draws evaluated so far kept for ``resume``."""
     fields = dict(locals())
     if space is None:
         fields.pop("space")

@@ -10,8 +10,8 @@ use super::progress::{self, Bars};
 use super::train_seeds::TrainSeedArgs;
 use unforeseen_harness::episodes::Method;
 use unforeseen_harness::episodes::Protocol;
-use unforeseen_harness::runs::batch::AgentChoice;
-use unforeseen_harness::runs::estimate::{EstimateRequest, Estimator, Summary};
+use unforeseen_harness::runs::batch::{AgentChoice, Shard};
+use unforeseen_harness::runs::estimate::{DrawStage, EstimateRequest, Estimator, Report, ShardPart, Summary};
 
 /// Arguments of `estimate`.
 #[derive(Debug, Clone, Args)]
@@ -46,6 +46,16 @@ pub struct EstimateArgs {
     /// Worker threads (results do not depend on it); default: every core.
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// Evaluate only shard I of N of the next stage (the draws I-1 mod N of the first stage
+    /// --out does not complete: mc's draws, or is's next round or final draws); write
+    /// estimate.jsonl, no summary. Concatenate the shards' estimate.jsonl and finish with
+    /// --resume (for is, one --resume --shard round per stage).
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<Shard>,
+    /// Keep the draws of the same request in --out (estimate.jsonl.part, left by an
+    /// interrupted run, else estimate.jsonl) and evaluate only the rest.
+    #[arg(long)]
+    pub resume: bool,
     /// Output folder: estimate.jsonl and summary.json. No input may be inside it.
     #[arg(long, value_name = "DIR", default_value_os_t = EstimateRequest::default().out)]
     pub out: PathBuf,
@@ -90,6 +100,8 @@ impl EstimateArgs {
             episodes: self.episodes,
             seed: self.seed,
             jobs: self.jobs,
+            shard: self.shard,
+            resume: self.resume,
             out: self.out.clone(),
             force: self.force,
             agent: self.agent.clone(),
@@ -141,9 +153,39 @@ pub fn run(args: EstimateArgs) -> anyhow::Result<()> {
             args.out.display()
         ),
     );
-    let summary = job.run(&agents, &Bars::new(quiet))?;
-    print_summary(&summary, &args);
+    match job.run(&agents, &Bars::new(quiet))? {
+        Report::Estimate(summary) => print_summary(&summary, &args),
+        Report::Shard(part) => print_shard(&part, &args),
+    }
     Ok(())
+}
+
+fn print_shard(p: &ShardPart, args: &EstimateArgs) {
+    let out = args.out.display();
+    match p.stage {
+        None => outln!(
+            "shard {}: {out}/estimate.jsonl holds every draw the estimate needs ({}); finish it with --resume, without --shard",
+            String::from(p.shard),
+            p.draws
+        ),
+        Some(stage) => {
+            let stage = match stage {
+                DrawStage::Uniform => "the uniform draws".to_string(),
+                DrawStage::Round { round } => format!("cross-entropy round {}", round + 1),
+                DrawStage::Final => "the final draws".to_string(),
+            };
+            outln!(
+                "shard {} of {stage}: {} draws evaluated, {} were in the file; {out}/estimate.jsonl holds {} draws",
+                String::from(p.shard),
+                p.evaluated,
+                p.share - p.evaluated,
+                p.draws
+            );
+            outln!(
+                "next: concatenate the shards' estimate.jsonl into one --out and run with --resume (for is before the final draws: --resume --shard I/N again on it)"
+            );
+        }
+    }
 }
 
 fn print_summary(s: &Summary, args: &EstimateArgs) {

@@ -1,6 +1,9 @@
 //! `unforeseen estimate`: the same request gives the same files whatever `--jobs`, the
-//! summary states its estimates and threshold, and bad input is refused with exit 2.
-//! Budgets are the estimators' smallest, of one episode per draw.
+//! summary states its estimates and threshold, a killed run resumed (`--resume`) and
+//! shards concatenated and resumed (`--shard I/N`) give the files of one uninterrupted,
+//! unsharded run byte for byte, and bad input (a request, a shard, a file `--resume`
+//! cannot continue) is refused with exit 2, naming the flag or the file and line.
+//! Budgets are small, of one episode per draw.
 
 use crate::common::{assert_exit, run_cli};
 
@@ -126,4 +129,181 @@ fn bad_requests_are_refused_with_their_reason() {
     ]);
     assert_exit(&run, 2, &["--space", "none of the first 50 draws", "is fair"]);
     assert!(!out.join("summary.json").exists() && !out.join("estimate.jsonl").exists());
+}
+
+/// The two files of an estimate's folder.
+fn files(out: &std::path::Path) -> [Vec<u8>; 2] {
+    ["estimate.jsonl", "summary.json"].map(|f| std::fs::read(out.join(f)).unwrap())
+}
+
+#[test]
+fn a_killed_estimate_resumes_to_the_files_of_one_never_killed() {
+    let d = tempfile::tempdir().unwrap();
+    for (estimator, budget) in [("mc", "100"), ("is", "200")] {
+        let flags = [
+            "--estimator",
+            estimator,
+            "--budget",
+            budget,
+            "--target-rel-error",
+            "0.05",
+            "--jobs",
+            "2",
+        ];
+        let whole = d.path().join(format!("{estimator}-whole"));
+        assert_exit(&estimate(&whole, &flags), 0, &[]);
+        // A kill leaves the part, its last line cut, and no estimate.jsonl.
+        let killed = d.path().join(format!("{estimator}-killed"));
+        std::fs::create_dir_all(&killed).unwrap();
+        let draws = std::fs::read(whole.join("estimate.jsonl")).unwrap();
+        std::fs::write(killed.join("estimate.jsonl.part"), &draws[..draws.len() * 3 / 5]).unwrap();
+        let resume = [&flags[..], &["--resume"]].concat();
+        assert_exit(&estimate(&killed, &resume), 0, &["P(never-brake fails | fair)"]);
+        assert_eq!(files(&killed), files(&whole), "{estimator}");
+        assert!(!killed.join("estimate.jsonl.part").exists());
+        // A finished folder resumes to itself.
+        assert_exit(&estimate(&killed, &resume), 0, &[]);
+        assert_eq!(files(&killed), files(&whole), "{estimator}");
+    }
+}
+
+#[test]
+fn shards_concatenated_then_resumed_give_the_unsharded_files() {
+    let d = tempfile::tempdir().unwrap();
+    // `is` with 250 draws: three rounds of 50, then final blocks of 50 (two dealt at once).
+    for (estimator, budget, steps) in [("mc", "100", 1), ("is", "250", 4)] {
+        let flags = [
+            "--estimator",
+            estimator,
+            "--budget",
+            budget,
+            "--target-rel-error",
+            "0.05",
+        ];
+        let whole = d.path().join(format!("{estimator}-whole"));
+        assert_exit(&estimate(&whole, &flags), 0, &[]);
+        let joined = d.path().join(format!("{estimator}-joined"));
+        std::fs::create_dir_all(&joined).unwrap();
+        // Each step: every shard takes its share of the next stage of the joined draws.
+        for step in 0..=steps {
+            let mut concatenated = Vec::new();
+            for shard in ["1/2", "2/2"] {
+                let out = d.path().join(format!("{estimator}-shard{}", &shard[..1]));
+                std::fs::create_dir_all(&out).unwrap();
+                if let Ok(text) = std::fs::read(joined.join("estimate.jsonl")) {
+                    std::fs::write(out.join("estimate.jsonl"), text).unwrap();
+                }
+                let run = estimate(&out, &[&flags[..], &["--shard", shard, "--resume"]].concat());
+                let said = if step == steps {
+                    "holds every draw the estimate needs"
+                } else {
+                    "draws evaluated"
+                };
+                assert_exit(&run, 0, &[said]);
+                assert!(!out.join("summary.json").exists(), "a shard writes no summary");
+                concatenated.extend(std::fs::read(out.join("estimate.jsonl")).unwrap());
+            }
+            std::fs::write(joined.join("estimate.jsonl"), concatenated).unwrap();
+        }
+        assert_exit(&estimate(&joined, &[&flags[..], &["--resume"]].concat()), 0, &[]);
+        assert_eq!(files(&joined), files(&whole), "{estimator}");
+    }
+}
+
+#[test]
+fn resume_and_shards_refuse_what_they_cannot_continue() {
+    let d = tempfile::tempdir().unwrap();
+    for bad in ["0/0", "3/2", "1/0", "2"] {
+        assert_exit(
+            &estimate(&d.path().join("x"), &["--budget", "50", "--shard", bad]),
+            2,
+            &["--shard", bad],
+        );
+    }
+    let out = d.path().join("out");
+    let flags = ["--budget", "50", "--seed", "5"];
+    assert_exit(&estimate(&out, &flags), 0, &[]);
+    let file = out.join("estimate.jsonl");
+    let whole = std::fs::read_to_string(&file).unwrap();
+    // `merge` joins batch runs: an estimate's shards are concatenated and resumed.
+    assert_exit(
+        &run_cli(&[
+            "merge",
+            file.to_str().unwrap(),
+            "--out",
+            d.path().join("m.jsonl").to_str().unwrap(),
+        ]),
+        2,
+        &["estimate.jsonl", "an estimate's draws", "unforeseen estimate --resume"],
+    );
+    // Another request's file: its identity line says what differs.
+    let run = estimate(&out, &["--budget", "50", "--seed", "6", "--resume"]);
+    assert_exit(
+        &run,
+        2,
+        &[
+            "estimate.jsonl",
+            "line 1",
+            "another estimate",
+            "seed: the file has 5, this run 6",
+        ],
+    );
+    // A damaged line, an edited one, a draw moved, a draw twice: each named by its line.
+    let lines: Vec<String> = whole.lines().map(str::to_string).collect();
+    let resume_with = |changed: &[String]| {
+        std::fs::write(&file, changed.join("\n") + "\n").unwrap();
+        estimate(&out, &[&flags[..], &["--resume"]].concat())
+    };
+    let with_line = |line: usize, text: String| {
+        let mut l = lines.clone();
+        l[line - 1] = text;
+        l
+    };
+    assert_exit(
+        &resume_with(&with_line(3, "{\"draw\": 1, oops".into())),
+        2,
+        &["estimate.jsonl", "line 3: not a draw line"],
+    );
+    let extra = format!("{},\"note\":1}}", lines[3].strip_suffix('}').unwrap());
+    assert_exit(
+        &resume_with(&with_line(4, extra)),
+        2,
+        &["line 4 (draw 2)", "not a line this program writes"],
+    );
+    let at = lines[4].find("\"point\":[").unwrap() + "\"point\":[".len();
+    let end = at + lines[4][at..].find([',', ']']).unwrap();
+    let moved = format!("{}0.123{}", &lines[4][..at], &lines[4][end..]);
+    assert_exit(
+        &resume_with(&with_line(5, moved)),
+        2,
+        &["line 5 (draw 3)", "not the draw this estimate derives", "point differs"],
+    );
+    assert!(
+        !out.join("estimate.jsonl.part").exists(),
+        "a refusal leaves the folder as it was"
+    );
+    // A valid draw again with another failure count.
+    let (n, valid) = lines
+        .iter()
+        .enumerate()
+        .find(|(_, l)| l.contains("\"rejected\":null"))
+        .unwrap();
+    let flipped = if valid.contains("\"failed\":1") {
+        valid.replace("\"failed\":1", "\"failed\":0")
+    } else {
+        valid.replace("\"failed\":0", "\"failed\":1")
+    };
+    let twice = [&lines[..], &[flipped]].concat();
+    assert_exit(
+        &resume_with(&twice),
+        2,
+        &[
+            &format!("line {} (draw {})", lines.len() + 1, n - 1),
+            &format!("twice, line {} otherwise", n + 1),
+        ],
+    );
+    // The same draw twice, line for line (shards' files concatenated), is one draw.
+    let again = [&lines[..], &[lines[n].clone()]].concat();
+    assert_exit(&resume_with(&again), 0, &[]);
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), whole);
 }

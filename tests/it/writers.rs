@@ -441,6 +441,7 @@ fn writers() -> Vec<Writer> {
             folder: true,
             outputs: &[
                 ("estimate.jsonl", Some(Kind::Estimates)),
+                ("estimate.jsonl.part", Some(Kind::Estimates)),
                 ("summary.json", Some(Kind::EstimateSummary)),
             ],
             args: |_, out, x| estimate_args(out, x),

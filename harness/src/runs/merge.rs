@@ -11,6 +11,10 @@
 //! not). [`write_merged`] then writes the lines in canonical order, byte for byte as
 //! their parts hold them, and the summary over training seeds beside them, each file
 //! atomically: a merge that fails leaves no half-written file.
+//!
+//! A search's candidates and an estimate's draws are refused, saying how their shards
+//! are merged: concatenated, then finished by the command's `--resume`, which walks the
+//! run's stages again from the lines (each stage depends on the earlier ones' results).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -22,6 +26,7 @@ use crate::runs::batch::{
     KeptLine, ParamSet, ResultLine, RunIdentity, SummaryRow, Unit, UnitKey, read_results, stream_learning, summarize,
     units,
 };
+use crate::runs::file_kinds::Held;
 use crate::runs::outputs::summary_path;
 
 /// The merged results of one run.
@@ -287,6 +292,16 @@ pub fn merge(parts: &[PathBuf]) -> Result<Merged, Error> {
             ));
         }
         seen.push((real, part));
+        if let Some((command, file)) = merged_by_resume(part) {
+            return Err(Error::Results {
+                path: part.clone(),
+                problem: format!(
+                    "holds {}: `merge` joins a batch run's shards; concatenate the {command}'s shard files into \
+                     its --out as {file} and finish with `unforeseen {command} --resume`",
+                    Held::of(part).describe()
+                ),
+            });
+        }
         let file = read_results(part)?;
         let Some((first_line, first)) = file.identities.first() else {
             return Err(Error::Results {
@@ -385,6 +400,19 @@ pub fn merge(parts: &[PathBuf]) -> Result<Merged, Error> {
         identity,
         lines: found.into_values().map(|(_, _, l)| l).collect(),
     })
+}
+
+/// The command whose `--resume` merges the shards of the run that wrote `part`, and the
+/// file its shards are concatenated into, when that run is not a batch: a search's
+/// candidates and an estimate's draws come in stages that the command walks again from
+/// the lines (the later stages depend on the earlier ones' results), so their shards'
+/// files concatenated and resumed are the merge.
+fn merged_by_resume(part: &Path) -> Option<(&'static str, &'static str)> {
+    match Held::of(part) {
+        Held::Candidates => Some(("search", "candidates.jsonl")),
+        Held::Estimates => Some(("estimate", "estimate.jsonl")),
+        _ => None,
+    }
 }
 
 /// The summary file of a run's results (as `unforeseen batch` writes it beside

@@ -2,7 +2,8 @@
 //! scenario suites and sweeps ([`batch`]), deployment streams
 //! ([`stream`]), the paper's comparison over agents and protocols ([`compare`]),
 //! test-time learning curves ([`learn`]), one episode step by step ([`trace`]), the
-//! merge of shard files ([`merge`]), the search for fair failing scenarios
+//! merge of shard files ([`merge`]), the reading back of a run's file for `--resume`
+//! ([`resume`]), the search for fair failing scenarios
 //! ([`search`]), the failure probabilities of a space with their intervals ([`estimate`])
 //! and the methods given from outside the library, a Python policy, reported
 //! as batch result lines ([`outside_methods`]); the guard all of them pass before any work ([`outputs`]: no output
@@ -24,6 +25,7 @@ pub mod merge;
 pub mod outputs;
 pub mod outside_methods;
 pub mod request;
+pub mod resume;
 pub mod search;
 pub mod stream;
 pub mod trace;

@@ -15,8 +15,9 @@
 //! * once the run's own checks have passed ([`Guarded::clear_at_end`]), removes the
 //!   outputs of the set that the run rewrites at its end (the summary beside a results
 //!   file that is streamed in place), so the set on disk is never one run's file beside
-//!   another run's; a refusal before that changes no file. (A search streams to a part
-//!   and replaces its whole set at the end: it removes nothing before.)
+//!   another run's; a refusal before that changes no file. (A search and an estimate
+//!   stream to a part and replace their whole set at the end: they remove nothing
+//!   before.)
 //!
 //! Names that become file names (a space's name, a map's name in a search's outputs)
 //! are checked by [`file_name`].

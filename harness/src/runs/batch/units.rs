@@ -96,7 +96,8 @@ pub fn units(
     Ok(out)
 }
 
-/// A shard `i/n` (1-based): the contiguous slice `[(i-1)U/n, iU/n)` of `U` units. In a
+/// A shard `i/n` (1-based): the contiguous slice `[(i-1)U/n, iU/n)` of `U` units
+/// ([`Shard::range`]), or every `n`-th item from the `i`-th ([`Shard::deals`]). In a
 /// request (serde) it is the text `i/n`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(try_from = "String", into = "String")]
@@ -144,6 +145,12 @@ impl Shard {
     /// The range of unit positions this shard runs.
     pub fn range(self, total: usize) -> std::ops::Range<usize> {
         ((self.index - 1) * total / self.count)..(self.index * total / self.count)
+    }
+
+    /// Whether item `index` (0-based) is this shard's when the items are dealt in turn:
+    /// `index ≡ i − 1 (mod n)`.
+    pub fn deals(self, index: usize) -> bool {
+        index % self.count == self.index - 1
     }
 }
 

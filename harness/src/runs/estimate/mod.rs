@@ -37,20 +37,56 @@
 //! seeds, and draws are evaluated in parallel but taken in index order, so the same
 //! request gives the same files bit for bit whatever the number of threads.
 //!
+//! **Resume.** The state of a run is a function of its draws: each draw's point and
+//! density derive from (run seed, stage, index) and the proposal in force, and `is`'s
+//! proposals are refitted deterministically from the earlier rounds' draws. So `--resume`
+//! (`resume.rs`) reads the draws an earlier run of the same request left (its identity
+//! line checked, each line checked as this program writes it), walks the stages as a
+//! fresh run does, takes each kept draw where the walk reaches its index (checked against
+//! the draw derived there) and evaluates only the missing ones: the files are those of a
+//! run never interrupted, byte for byte. Kept draws the walk never reaches (past the
+//! block where the stopping rule stops it) are left out.
+//!
+//! **Shards.** A shard `I/N` evaluates the draws of index `≡ I − 1 (mod N)` of the first
+//! stage the draws in its folder do not complete (none, without `--resume`), writes
+//! `estimate.jsonl` (every draw it holds) and stops ([`ShardPart`]). The stages are:
+//! each cross-entropy round of `is` whole (its draws come from the proposal the rounds
+//! before it fitted, so a round can only be dealt once they are all in); then the
+//! estimating stage (`mc`'s uniform draws, `is`'s final ones) from its first incomplete
+//! block to the budget (the stopping rule needs every draw of a block, which no shard
+//! has; the draws dealt in turn put each shard's share in the earliest blocks, so little
+//! past the stopping point is wasted). The shards' files concatenated (a draw that
+//! several files hold, line for line the same, is one draw) are the input of the next
+//! step: `--resume --shard I/N` again for `is`'s next stage, and, once a shard finds
+//! every needed draw there, a run without `--shard` with `--resume`, which takes every
+//! draw, evaluates none, applies the stopping rule and writes what the unsharded run
+//! writes. So `mc` takes one round of shards, `is` one per round and one for the final
+//! stage; concatenation and `--resume` are the merge (`unforeseen merge` joins batch
+//! runs' units, whose files have no stages to walk).
+//!
 //! Outputs ([`output`]): `estimate.jsonl` (the run's identity, then one line per draw)
 //! and `summary.json` (the estimates, their intervals and diagnostics, the failure
-//! threshold), written together at the end.
+//! threshold), written together at the end; the draws stream to
+//! `estimate.jsonl.part` while the run lasts.
 
 pub mod estimators;
 pub mod output;
 pub mod proposal;
 pub mod request;
+mod resume;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::error::Error;
+use crate::files::Streamed;
 use crate::progress::Progress;
+use crate::runs::batch::Shard;
+use crate::runs::outputs::Guarded;
 use crate::runs::search::{
     Candidate, CandidateLine, CandidateWire, Evaluator, Fairness, Role, SearchConfig, Stage, Value, evaluate_candidate,
 };
@@ -255,52 +291,168 @@ pub fn blocks(estimator: Estimator, budget: usize) -> (Vec<usize>, Vec<usize>) {
     }
 }
 
-/// Evaluates the draws `range` of `stage` from `proposal`, one phase of `progress`: here
-/// in parallel (taken in index order), or by `remote` in one call (the draws' valid maps
-/// as the search's candidates, [`CandidateWire`]; the lines it returns checked as the
-/// search checks them). Either way the same draws.
-fn evaluate_block(
-    cfg: &SearchConfig<'_>,
-    proposal: &Proposal,
-    stage: DrawStage,
-    range: std::ops::Range<usize>,
-    progress: &dyn Progress,
-    remote: Option<&dyn Evaluator>,
-) -> Result<Vec<Draw>, Error> {
-    let dims = cfg.space.params.len();
-    let name = match stage {
-        DrawStage::Uniform => "estimate mc".to_string(),
-        DrawStage::Round { round } => format!("estimate is round {}", round + 1),
-        DrawStage::Final => "estimate is final".to_string(),
-    };
-    progress.phase(&name, range.len() as u64);
-    let stream = stage.stream();
-    let drawn: Vec<(Candidate, f64)> = range
-        .map(|i| {
+/// What a run ended with.
+#[derive(Debug, Clone)]
+enum Ended {
+    /// The estimate, finished.
+    Finished(Box<Outcome>),
+    /// A shard's part of a stage, and the draws it evaluated.
+    Shard(ShardPart, Vec<Draw>),
+}
+
+/// What a shard (`--shard I/N`) evaluated: its share of the first stage that its file
+/// (with `--resume`, the draws read back) does not complete, the draws of index
+/// `≡ I − 1 (mod N)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShardPart {
+    /// The shard.
+    pub shard: Shard,
+    /// The stage it took its share of: a cross-entropy round of `is` whole, or the
+    /// estimating stage (`mc`'s uniform draws, `is`'s final ones) from its first block
+    /// incomplete to the budget. None when the file holds every draw the estimate
+    /// needs: a run without `--shard` finishes it with `--resume`.
+    pub stage: Option<DrawStage>,
+    /// Its share of that stage.
+    pub share: usize,
+    /// Of its share, the draws evaluated now (the rest were in the file).
+    pub evaluated: usize,
+    /// The draws its file holds.
+    pub draws: usize,
+}
+
+/// What a run wrote: the estimate's summary, or a shard's part.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum Report {
+    /// The estimate, finished: `summary.json`.
+    Estimate(Box<Summary>),
+    /// A shard's part: only `estimate.jsonl` was written.
+    Shard(ShardPart),
+}
+
+/// One run of an estimate: its configuration, the draws of an earlier run of the same
+/// request read back (`--resume`, [`resume`]: each is checked against the draw the run
+/// derives at its index when it is taken), the part its fresh draws are appended to as
+/// they come, its shard, its progress and the evaluator of its draws when not here.
+struct Run<'a, 'b> {
+    cfg: &'a SearchConfig<'b>,
+    kept: BTreeMap<usize, resume::Kept>,
+    /// The file the kept draws were read from, for errors.
+    read: PathBuf,
+    /// The part, created with `head` (the identity and the kept draws) at the first
+    /// fresh draw: a run that evaluates nothing, or refuses a kept draw before, leaves the
+    /// folder's files as they were.
+    part: PathBuf,
+    head: String,
+    sink: Mutex<Option<Streamed>>,
+    shard: Option<Shard>,
+    progress: &'a dyn Progress,
+    remote: Option<&'a dyn Evaluator>,
+}
+
+impl Run<'_, '_> {
+    /// The draws `range` of `stage` from `proposal`, in index order: those kept, checked,
+    /// and the rest that `only` deals (all when none) evaluated, one phase of `progress`:
+    /// here in parallel (taken in index order), or by `remote` in one call (the draws'
+    /// valid maps as the search's candidates, [`CandidateWire`]; the lines it returns
+    /// checked as the search checks them). Either way the same draws, each appended to
+    /// the part as it comes.
+    fn block(
+        &self,
+        proposal: &Proposal,
+        stage: DrawStage,
+        range: Range<usize>,
+        only: Option<Shard>,
+    ) -> Result<Vec<Draw>, Error> {
+        let cfg = self.cfg;
+        let dims = cfg.space.params.len();
+        let stream = stage.stream();
+        let mut kept = Vec::new();
+        let mut fresh = Vec::new();
+        for i in range {
+            let taken = self.kept.get(&i);
+            if taken.is_none() && !only.is_none_or(|s| s.deals(i)) {
+                continue;
+            }
             let point = proposal.draw(cfg.seed, &stream, i, dims);
             let density = proposal.density(&point);
-            (Candidate::new(cfg.space, i, Stage::Sobol, point, None), density)
-        })
-        .collect();
-    let done = match remote {
-        None => drawn
-            .into_par_iter()
-            .map(|(candidate, density)| {
-                let lines = match &candidate.map {
-                    Ok(map) => {
-                        let values = candidate.named_values(cfg.space);
-                        Some(evaluate_candidate(cfg, &candidate, map, values, progress)?)
-                    }
-                    Err(_) => None,
-                };
-                crate::progress::step(progress)?;
-                Ok(Draw::of(cfg, stage, &candidate, density, lines.as_deref()))
-            })
-            .collect::<Result<Vec<_>, Error>>(),
-        Some(remote) => evaluate_remotely(cfg, stage, &drawn, progress, remote),
-    };
-    progress.finish();
-    done
+            let candidate = Candidate::new(cfg.space, i, Stage::Sobol, point, None);
+            match taken {
+                Some(k) => kept.push(k.check(cfg, stage, &candidate, density, &self.read)?),
+                None => fresh.push((candidate, density)),
+            }
+        }
+        let name = match stage {
+            DrawStage::Uniform => "estimate mc".to_string(),
+            DrawStage::Round { round } => format!("estimate is round {}", round + 1),
+            DrawStage::Final => "estimate is final".to_string(),
+        };
+        self.progress.phase(&name, fresh.len() as u64);
+        let done = match self.remote {
+            None => fresh
+                .into_par_iter()
+                .map(|(candidate, density)| {
+                    let lines = match &candidate.map {
+                        Ok(map) => {
+                            let values = candidate.named_values(cfg.space);
+                            Some(evaluate_candidate(cfg, &candidate, map, values, self.progress)?)
+                        }
+                        Err(_) => None,
+                    };
+                    let draw = Draw::of(cfg, stage, &candidate, density, lines.as_deref());
+                    self.append(std::slice::from_ref(&draw))?;
+                    crate::progress::step(self.progress)?;
+                    Ok(draw)
+                })
+                .collect::<Result<Vec<_>, Error>>(),
+            Some(remote) => evaluate_remotely(cfg, stage, &fresh, self.progress, remote)
+                .and_then(|draws| self.append(&draws).map(|()| draws)),
+        };
+        self.progress.finish();
+        let mut draws = done?;
+        draws.extend(kept);
+        draws.sort_by_key(|d| d.draw);
+        Ok(draws)
+    }
+
+    /// Appends fresh draws to the part.
+    fn append(&self, draws: &[Draw]) -> Result<(), Error> {
+        if draws.is_empty() {
+            return Ok(());
+        }
+        let text = draws.iter().map(output::draw_line).collect::<Result<String, Error>>()?;
+        let mut sink = self.sink.lock().expect("part lock");
+        if sink.is_none() {
+            *sink = Some(Streamed::create(&self.part, self.head.as_bytes())?);
+        }
+        sink.as_mut().expect("created above").append(text.as_bytes())
+    }
+
+    /// The shard's part when the run has one and the draws `needed` are not all in the
+    /// file: its share of `rest` (the stage from `needed` on) evaluated.
+    fn shard_part(
+        &self,
+        proposal: &Proposal,
+        stage: DrawStage,
+        needed: Range<usize>,
+        rest: Range<usize>,
+    ) -> Result<Option<Ended>, Error> {
+        let Some(shard) = self.shard else { return Ok(None) };
+        if needed.clone().all(|i| self.kept.contains_key(&i)) {
+            return Ok(None);
+        }
+        let share = rest.clone().filter(|&i| shard.deals(i)).count();
+        let drawn = self.block(proposal, stage, rest, Some(shard))?;
+        let fresh: Vec<Draw> = drawn.into_iter().filter(|d| !self.kept.contains_key(&d.draw)).collect();
+        let part = ShardPart {
+            shard,
+            stage: Some(stage),
+            share,
+            evaluated: fresh.len(),
+            draws: self.kept.len() + fresh.len(),
+        };
+        Ok(Some(Ended::Shard(part, fresh)))
+    }
 }
 
 /// The draws `drawn` evaluated by `remote` in one call.
@@ -402,33 +554,81 @@ impl Draw {
     }
 }
 
-/// Runs `estimator` on the search configuration `cfg` (its space, method, agents,
-/// episodes and seed; its budget and stages unused) with `budget` draws and the target
-/// relative half-width `target`, on `cfg.jobs` threads, each block's draws evaluated
-/// here or by `remote` (a distributed driver's), the same draws either way.
-pub fn estimate(
+/// Runs the estimate `r` on the search configuration `cfg` (its space, method, agents,
+/// episodes and seed; its budget and stages unused) into `r.out`, on `cfg.jobs` threads,
+/// each block's draws evaluated here or by `remote` (a distributed driver's), the same
+/// draws either way; with `r.resume`, from the draws an earlier run of the same request
+/// left there, and with `r.shard`, only the shard's part of the next stage. `guard` is
+/// the job's output guard, held while the run writes.
+///
+/// The fresh draws are streamed to `estimate.jsonl.part` ([`output::DRAWS_PART`]) as
+/// they are evaluated (after the identity and the draws kept; the part is made at the
+/// first fresh draw), and the set is committed as one at the end
+/// ([`crate::files::all_or_none`]), the part removed with it: a run that fails or is
+/// killed partway leaves the earlier set as it was, and the part for `--resume`, which
+/// reads the part when there is one (the latest run into the folder) and
+/// `estimate.jsonl` otherwise.
+pub(crate) fn run(
     cfg: &SearchConfig<'_>,
-    estimator: Estimator,
-    budget: usize,
-    target: f64,
+    r: &EstimateRequest,
+    _guard: &Guarded,
     progress: &dyn Progress,
     remote: Option<&dyn Evaluator>,
-) -> Result<Outcome, Error> {
+) -> Result<Report, Error> {
+    let out = Path::new(&r.out);
+    std::fs::create_dir_all(out).map_err(|e| Error::io("create folder", out, e))?;
+    let (file, part) = (out.join(output::DRAWS), out.join(output::DRAWS_PART));
+    let read = if part.is_file() { part.clone() } else { file };
+    let identity = output::identity(cfg, r);
+    let kept = if r.resume {
+        resume::kept_draws(cfg, r, &identity, &read)?
+    } else {
+        BTreeMap::new()
+    };
+    let head = std::iter::once(Ok(output::identity_line(&identity)))
+        .chain(kept.values().map(|k| output::draw_line(&k.draw)))
+        .collect::<Result<String, Error>>()?;
+    let run = Run {
+        cfg,
+        kept,
+        read,
+        part,
+        head,
+        sink: Mutex::new(None),
+        shard: r.shard,
+        progress,
+        remote,
+    };
+    match estimate(&run, r.estimator, r.budget, r.target_rel_error)? {
+        Ended::Finished(outcome) => crate::files::all_or_none(|| output::write_all(cfg, r, out, &outcome))
+            .map(|s| Report::Estimate(Box::new(s))),
+        Ended::Shard(shard_part, fresh) => {
+            let mut draws: BTreeMap<usize, Draw> = run.kept.into_iter().map(|(i, k)| (i, k.draw)).collect();
+            draws.extend(fresh.into_iter().map(|d| (d.draw, d)));
+            let draws: Vec<Draw> = draws.into_values().collect();
+            crate::files::all_or_none(|| output::write_shard(cfg, r, out, &draws))?;
+            Ok(Report::Shard(shard_part))
+        }
+    }
+}
+
+/// Runs `estimator` with `budget` draws and the target relative half-width `target`
+/// (see the module doc), taking the draws `run` kept; with a shard, stops at the first
+/// stage the kept draws do not complete, with the shard's part of it.
+fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64) -> Result<Ended, Error> {
+    let cfg = run.cfg;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(cfg.jobs.max(1)).build()?;
     pool.install(|| {
         let (rounds, finals) = blocks(estimator, budget);
         let mut draws: Vec<Draw> = Vec::new();
         let mut proposal = Proposal::uniform();
         for (round, size) in rounds.into_iter().enumerate() {
-            let next = draws.len();
-            draws.extend(evaluate_block(
-                cfg,
-                &proposal,
-                DrawStage::Round { round },
-                next..next + size,
-                progress,
-                remote,
-            )?);
+            let stage = DrawStage::Round { round };
+            let range = draws.len()..draws.len() + size;
+            if let Some(part) = run.shard_part(&proposal, stage, range.clone(), range.clone())? {
+                return Ok(part);
+            }
+            draws.extend(run.block(&proposal, stage, range, None)?);
             check_fair_mass(&draws)?;
             let scored: Vec<proposal::Scored<'_>> = draws
                 .iter()
@@ -445,15 +645,11 @@ pub fn estimate(
         let mut reached = false;
         let mut checkpoints = Vec::new();
         for size in finals {
-            let next = draws.len();
-            draws.extend(evaluate_block(
-                cfg,
-                &proposal,
-                stage,
-                next..next + size,
-                progress,
-                remote,
-            )?);
+            let range = draws.len()..draws.len() + size;
+            if let Some(part) = run.shard_part(&proposal, stage, range.clone(), range.start..budget)? {
+                return Ok(part);
+            }
+            draws.extend(run.block(&proposal, stage, range, None)?);
             check_fair_mass(&draws)?;
             estimates = Estimates::of(estimator, &draws[first..]);
             checkpoints.push(Checkpoint {
@@ -466,13 +662,23 @@ pub fn estimate(
                 break;
             }
         }
-        Ok(Outcome {
+        if let Some(shard) = run.shard {
+            let part = ShardPart {
+                shard,
+                stage: None,
+                share: 0,
+                evaluated: 0,
+                draws: run.kept.len(),
+            };
+            return Ok(Ended::Shard(part, Vec::new()));
+        }
+        Ok(Ended::Finished(Box::new(Outcome {
             draws,
             estimates,
             proposal,
             reached,
             checkpoints,
-        })
+        })))
     })
 }
 
@@ -520,9 +726,25 @@ mod tests {
     fn the_same_request_gives_the_same_draws_and_estimates_whatever_the_threads() {
         for estimator in Estimator::ALL {
             let s = setup(estimator);
+            let dir = tempfile::tempdir().unwrap();
             let run = |jobs| {
                 let cfg = s.search.config(&[], jobs, String::new());
-                estimate(&cfg, estimator, estimator.min_budget(), 0.01, &NoProgress, None).unwrap()
+                let part = dir.path().join(format!("{jobs}.part"));
+                let run = Run {
+                    cfg: &cfg,
+                    kept: BTreeMap::new(),
+                    read: part.clone(),
+                    part,
+                    head: String::new(),
+                    sink: Mutex::new(None),
+                    shard: None,
+                    progress: &NoProgress,
+                    remote: None,
+                };
+                match estimate(&run, estimator, estimator.min_budget(), 0.01).unwrap() {
+                    Ended::Finished(outcome) => *outcome,
+                    Ended::Shard(..) => unreachable!("no shard"),
+                }
             };
             let (one, two) = (run(1), run(2));
             assert_eq!(one.draws, two.draws, "{estimator}");
@@ -541,6 +763,53 @@ mod tests {
                     .iter()
                     .all(|d| d.weight() <= 1.0 / proposal::DEFENSIVE + 1e-12)
             );
+        }
+    }
+
+    /// Asks the run to stop once `limit` draws are done.
+    struct CancelAfter(std::sync::atomic::AtomicU64, u64);
+
+    impl Progress for CancelAfter {
+        fn phase(&self, _: &str, _: u64) {}
+        fn advance(&self, n: u64) {
+            self.0.fetch_add(n, std::sync::atomic::Ordering::SeqCst);
+        }
+        fn finish(&self) {}
+        fn message(&self, _: crate::progress::Message, _: &str) {}
+        fn cancelled(&self) -> bool {
+            self.0.load(std::sync::atomic::Ordering::SeqCst) >= self.1
+        }
+    }
+
+    #[test]
+    fn a_cancelled_estimate_resumes_to_the_files_of_one_never_cancelled() {
+        let dir = tempfile::tempdir().unwrap();
+        for estimator in Estimator::ALL {
+            let budget = if estimator == Estimator::Mc { 100 } else { 200 };
+            let request = |name: &str, resume: bool| EstimateRequest {
+                out: dir.path().join(format!("{estimator}-{name}")),
+                resume,
+                jobs: Some(2),
+                budget,
+                target_rel_error: 0.01,
+                ..setup(estimator).request
+            };
+            let files = |name: &str| {
+                let out = dir.path().join(format!("{estimator}-{name}"));
+                [output::DRAWS, output::SUMMARY].map(|f| std::fs::read(out.join(f)).unwrap())
+            };
+            request("whole", false).plan().unwrap().run(&[], &NoProgress).unwrap();
+            // Cancelled in the last block of 50 (for is, in its final draws, after three rounds).
+            let cancel = CancelAfter(Default::default(), budget as u64 - 30);
+            let e = request("cut", false).plan().unwrap().run(&[], &cancel).err().unwrap();
+            assert!(matches!(e, Error::Interrupted), "{e}");
+            let out = dir.path().join(format!("{estimator}-cut"));
+            assert!(!out.join(output::DRAWS).exists() && !out.join(output::SUMMARY).exists());
+            let part = std::fs::read_to_string(out.join(output::DRAWS_PART)).unwrap();
+            assert!(part.lines().count() > 1, "{estimator}: the part holds the draws done");
+            request("cut", true).plan().unwrap().run(&[], &NoProgress).unwrap();
+            assert_eq!(files("cut"), files("whole"), "{estimator}");
+            assert!(!out.join(output::DRAWS_PART).exists());
         }
     }
 

@@ -6,6 +6,10 @@
 //! * `summary.json` ([`Summary`]): the estimand and the failure threshold, the three
 //!   estimates with their intervals and diagnostics, the evaluations, whether the target
 //!   was reached, the final proposal, and the estimates after each block (`checkpoints`).
+//!
+//! While it runs, the draws go to `estimate.jsonl.part` as they come (what `--resume`
+//! reads after a kill), removed with the commit of the set. A shard writes
+//! `estimate.jsonl` alone (the draws it holds, in order) and removes the summary.
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -18,21 +22,27 @@ use crate::runs::search::{FailureThreshold, SearchConfig};
 
 /// The draws file's name.
 pub const DRAWS: &str = "estimate.jsonl";
+/// The draws a run streams while it lasts, committed into [`DRAWS`] with the rest of
+/// the set at its end.
+pub const DRAWS_PART: &str = "estimate.jsonl.part";
 /// The summary's name.
 pub const SUMMARY: &str = "summary.json";
 
 /// The output guard of an estimate into the folder `out` (the front adds the inputs):
-/// the draws are an estimate's, and the summary, written at the end, is removed when the
-/// run starts.
+/// the draws (and their part) are an estimate's, the summary too. The run replaces them
+/// as one set at its end.
 pub fn outputs(out: &Path) -> Outputs {
     Outputs::new()
         .folder("out", out)
         .file("out", out.join(DRAWS), Own::Estimates)
-        .file_at_end("out", out.join(SUMMARY), Own::EstimateSummary)
+        .file("out", out.join(DRAWS_PART), Own::Estimates)
+        .file("out", out.join(SUMMARY), Own::EstimateSummary)
 }
 
-/// What determines an estimate's results (the first line of `estimate.jsonl`).
+/// What determines an estimate's results (the first line of `estimate.jsonl`); the shard
+/// is not part of it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct EstimateIdentity {
     /// Program version and code fingerprint.
     pub program: String,
@@ -110,8 +120,43 @@ pub fn identity(cfg: &SearchConfig<'_>, r: &EstimateRequest) -> EstimateIdentity
     }
 }
 
-/// Writes `estimate.jsonl` and `summary.json` for `outcome` (in the caller's
-/// all-or-none set); returns the summary.
+/// `{"estimate": identity}` and a newline.
+pub fn identity_line(run: &EstimateIdentity) -> String {
+    let mut s = serde_json::json!({ "estimate": run }).to_string();
+    s.push('\n');
+    s
+}
+
+/// The line of a draw, newline included.
+pub(super) fn draw_line(d: &Draw) -> Result<String, Error> {
+    let mut s = serde_json::to_string(d)?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// Writes `estimate.jsonl`: the identity, then `draws`.
+fn write_draws(run: &EstimateIdentity, out: &Path, draws: &[Draw]) -> Result<(), Error> {
+    let text = std::iter::once(Ok(identity_line(run)))
+        .chain(draws.iter().map(draw_line))
+        .collect::<Result<String, Error>>()?;
+    crate::files::write_atomic(&out.join(DRAWS), text.as_bytes())
+}
+
+/// Writes a shard's `estimate.jsonl` (the draws it holds) and removes the summary and
+/// the part (in the caller's all-or-none set).
+pub(super) fn write_shard(
+    cfg: &SearchConfig<'_>,
+    r: &EstimateRequest,
+    out: &Path,
+    draws: &[Draw],
+) -> Result<(), Error> {
+    write_draws(&identity(cfg, r), out, draws)?;
+    crate::files::remove_with_set(&out.join(SUMMARY))?;
+    crate::files::remove_with_set(&out.join(DRAWS_PART))
+}
+
+/// Writes `estimate.jsonl` and `summary.json` for `outcome` and removes the part (in the
+/// caller's all-or-none set); returns the summary.
 pub(super) fn write_all(
     cfg: &SearchConfig<'_>,
     r: &EstimateRequest,
@@ -119,13 +164,7 @@ pub(super) fn write_all(
     outcome: &Outcome,
 ) -> Result<Summary, Error> {
     let run = identity(cfg, r);
-    let mut text = serde_json::json!({ "estimate": run }).to_string();
-    text.push('\n');
-    for d in &outcome.draws {
-        text.push_str(&serde_json::to_string(d)?);
-        text.push('\n');
-    }
-    crate::files::write_atomic(&out.join(DRAWS), text.as_bytes())?;
+    write_draws(&run, out, &outcome.draws)?;
     let counted = |d: &&Draw| r.estimator == Estimator::Mc || d.stage == super::DrawStage::Final;
     let summary = Summary {
         schema: 1,
@@ -148,5 +187,6 @@ pub(super) fn write_all(
         checkpoints: outcome.checkpoints.clone(),
     };
     crate::files::write_json(&out.join(SUMMARY), &summary)?;
+    crate::files::remove_with_set(&out.join(DRAWS_PART))?;
     Ok(summary)
 }

@@ -5,19 +5,19 @@
 //! output guard and returns the job.
 
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use crate::episodes::Method;
 use crate::episodes::Protocol;
 use crate::error::Error;
 use crate::progress::Progress;
-use crate::runs::batch::AgentChoice;
+use crate::runs::batch::{AgentChoice, Shard};
 use crate::runs::outputs::Guarded;
 use crate::runs::search::{Evaluator, SearchConfig, SearchRequest, SearchSetup};
 use crate::training::TimeoutAs;
 use crate::training::seed_agents::{Agent, TrainSeeds};
 
-use super::{MAX_BUDGET, MIN_BLOCK, ROUNDS, Summary};
+use super::{MAX_BUDGET, MIN_BLOCK, ROUNDS, Report};
 
 /// An estimator of a failure probability (module doc of [`super`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -102,6 +102,12 @@ pub struct EstimateRequest {
     pub seed: u64,
     /// Worker threads; results do not depend on it. Default: every core.
     pub jobs: Option<usize>,
+    /// Evaluate only this shard's part of the next stage (module doc of [`super`],
+    /// "Shards"): the draws `≡ I − 1 (mod N)` of the first stage that the draws in `out`
+    /// (with `resume`) do not complete. Default: none.
+    pub shard: Option<Shard>,
+    /// Keep the draws of the same request in `out` and evaluate the rest. Default false.
+    pub resume: bool,
     /// Output folder. Default `out/estimate`.
     pub out: PathBuf,
     /// Replace files in `out` that an estimate did not write. Default false.
@@ -137,6 +143,8 @@ impl Default for EstimateRequest {
             episodes: 4,
             seed: search.seed,
             jobs: None,
+            shard: None,
+            resume: false,
             out: PathBuf::from("out/estimate"),
             force: false,
             agent: None,
@@ -240,8 +248,9 @@ pub struct EstimateJob {
 
 impl EstimateJob {
     /// Runs the estimate with `agents` ([`SearchSetup::agents`]) into the request's `out`
-    /// (`estimate.jsonl` and `summary.json`, [`super::output`]).
-    pub fn run(&self, agents: &[Agent], progress: &dyn Progress) -> Result<Summary, Error> {
+    /// (`estimate.jsonl` and `summary.json`, [`super::output`]; a shard's
+    /// `estimate.jsonl` alone).
+    pub fn run(&self, agents: &[Agent], progress: &dyn Progress) -> Result<Report, Error> {
         let s = &self.setup.search;
         self.run_with(&s.config(agents, s.jobs, String::new()), progress, None)
     }
@@ -254,14 +263,9 @@ impl EstimateJob {
         cfg: &SearchConfig<'_>,
         progress: &dyn Progress,
         remote: Option<&dyn Evaluator>,
-    ) -> Result<Summary, Error> {
-        let r = &self.setup.request;
+    ) -> Result<Report, Error> {
         cfg.check()?;
-        self.guard.clear_at_end()?;
-        let outcome = super::estimate(cfg, r.estimator, r.budget, r.target_rel_error, progress, remote)?;
-        let out = Path::new(&r.out);
-        std::fs::create_dir_all(out).map_err(|e| Error::io("create folder", out, e))?;
-        crate::files::all_or_none(|| super::output::write_all(cfg, r, out, &outcome))
+        super::run(cfg, &self.setup.request, &self.guard, progress, remote)
     }
 }
 

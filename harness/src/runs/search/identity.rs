@@ -39,16 +39,6 @@ pub struct SearchIdentity {
 impl SearchIdentity {
     /// One phrase per field that differs from `other` (`self` is the file's).
     pub fn differences(&self, other: &SearchIdentity) -> Vec<String> {
-        let a = serde_json::to_value(self).unwrap_or_default();
-        let b = serde_json::to_value(other).unwrap_or_default();
-        let mut out = Vec::new();
-        if let (Some(a), Some(b)) = (a.as_object(), b.as_object()) {
-            for (k, va) in a {
-                if *va != b[k] {
-                    out.push(format!("{k}: the file has {va}, this run {}", b[k]));
-                }
-            }
-        }
-        out
+        crate::runs::resume::differences(self, other)
     }
 }

@@ -2,6 +2,7 @@
 //! line by line.
 
 use super::*;
+use crate::runs::resume::{ReadLine, START_OVER, read_lines};
 
 /// The lines of a candidate, complete: two witnesses and one method line per seed.
 pub(super) fn lines_per_candidate(cfg: &SearchConfig<'_>) -> usize {
@@ -14,51 +15,14 @@ pub(super) fn resume_lines(cfg: &SearchConfig<'_>, out: &Path) -> Result<BTreeMa
         path: out.to_path_buf(),
         problem,
     };
-    let fix = "give another --out, or leave out --resume to start it over";
-    let bytes = match std::fs::read(out) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(BTreeMap::new()),
-        Err(e) => return Err(Error::io("read", out, e)),
-        Ok(b) => b,
-    };
-    let identity = cfg.identity();
+    let fix = START_OVER;
+    let lines = read_lines::<SearchIdentity, CandidateLine>(out, "search", &cfg.identity(), "a candidate line")?;
     let mut by: BTreeMap<usize, Vec<RawLine>> = BTreeMap::new();
-    let mut seen_identity = false;
-    for (i, raw) in bytes.split_inclusive(|&b| b == b'\n').enumerate() {
-        if !raw.ends_with(b"\n") {
-            break; // cut by a kill: that candidate runs again
-        }
-        let raw = std::str::from_utf8(raw).map_err(|_| bad(format!("line {}: not text; {fix}", i + 1)))?;
-        if raw.starts_with("{\"search\":") {
-            #[derive(Deserialize)]
-            #[serde(deny_unknown_fields)]
-            struct Head {
-                search: SearchIdentity,
-            }
-            let head: Head = serde_json::from_str(raw.trim_end())
-                .map_err(|e| bad(format!("line {}: not a search identity ({e}); {fix}", i + 1)))?;
-            if head.search != identity {
-                return Err(bad(format!(
-                    "--resume: line {} was written by another search ({}); {fix}",
-                    i + 1,
-                    head.search.differences(&identity).join("; ")
-                )));
-            }
-            seen_identity = true;
-            continue;
-        }
-        if !seen_identity {
+    for ReadLine { line, raw, parsed } in lines {
+        if let Some(problem) = kept_line_problem(cfg, &parsed, &raw) {
             return Err(bad(format!(
-                "--resume: the file does not start with a search identity line; {fix}"
-            )));
-        }
-        let parsed: CandidateLine = serde_json::from_str(raw.trim_end())
-            .map_err(|e| bad(format!("line {}: not a candidate line ({e}); {fix}", i + 1)))?;
-        if let Some(problem) = kept_line_problem(cfg, &parsed, raw) {
-            return Err(bad(format!(
-                "--resume: line {} (candidate {}, {:?}) {problem}; {fix}",
-                i + 1,
-                parsed.candidate,
-                parsed.role
+                "--resume: line {line} (candidate {}, {:?}) {problem}; {fix}",
+                parsed.candidate, parsed.role
             )));
         }
         let entry = by.entry(parsed.candidate).or_default();
@@ -67,16 +31,11 @@ pub(super) fn resume_lines(cfg: &SearchConfig<'_>, out: &Path) -> Result<BTreeMa
             .any(|l| (l.parsed.role, l.parsed.result.train_seed) == (parsed.role, parsed.result.train_seed))
         {
             return Err(bad(format!(
-                "line {}: candidate {} {:?} is in the file twice; remove one of its lines",
-                i + 1,
-                parsed.candidate,
-                parsed.role
+                "line {line}: candidate {} {:?} is in the file twice; remove one of its lines",
+                parsed.candidate, parsed.role
             )));
         }
-        entry.push(RawLine {
-            raw: raw.to_string(),
-            parsed,
-        });
+        entry.push(RawLine { raw, parsed });
     }
     // Only complete candidates are kept: a candidate cut by a kill runs again.
     let need = lines_per_candidate(cfg);
