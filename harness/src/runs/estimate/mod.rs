@@ -146,14 +146,21 @@ impl Draw {
         1.0 / self.density
     }
 
-    /// The cross-entropy stage's score, lower nearer a failure: minus the failed share
-    /// when an episode failed, else the smallest clearance; +∞ when unfair, rejected or
-    /// without a pedestrian.
-    pub fn score(&self) -> f64 {
-        if !self.fair() {
+    /// The cross-entropy stage's score, lower nearer a failure: +∞ when rejected; minus
+    /// the failed share when an episode failed. Otherwise, aiming at P(fails) (`is-fails`,
+    /// `fair_only` false), the smallest clearance car–pedestrian (+∞ without a
+    /// pedestrian); aiming at P(fails | fair) (`is`, `fair_only`), +∞ when unfair and 0
+    /// when fair, so that the elite is every fair draw until the fair failures alone fill
+    /// it (the levels "fair", then "fair and failed": on the jaywalk space the fair draws
+    /// that came closest did not lie where the fair failures lie, EXPERIMENTS.md, "How
+    /// rare is a failure").
+    pub fn score(&self, fair_only: bool) -> f64 {
+        if !self.valid() || (fair_only && !self.fair()) {
             f64::INFINITY
         } else if self.failed > 0 {
             -self.failed_share()
+        } else if fair_only {
+            0.0
         } else {
             self.min_clearance_m.unwrap_or(f64::INFINITY)
         }
@@ -172,8 +179,9 @@ pub struct Estimates {
 }
 
 impl Estimates {
-    /// `mc`'s estimates of uniform draws, or `is`'s of weighted final-stage draws.
-    pub fn of(estimator: Estimator, draws: &[Draw]) -> Estimates {
+    /// `mc`'s estimates of uniform draws, or `is`'s of every stage's draws, each weighted
+    /// by one over the density of `mixture`, the stages' proposals pooled ([`proposal::Mixture`]).
+    pub fn of(estimator: Estimator, draws: &[Draw], mixture: &proposal::Mixture) -> Estimates {
         let valid: Vec<&Draw> = draws.iter().filter(|d| d.valid()).collect();
         let fair: Vec<&Draw> = valid.iter().copied().filter(|d| d.fair()).collect();
         match estimator {
@@ -187,15 +195,16 @@ impl Estimates {
                     ),
                 }
             }
-            Estimator::Is => {
-                let weighted = |set: &[&Draw]| set.iter().map(|d| (d.weight(), d.failed_share())).collect::<Vec<_>>();
+            Estimator::Is | Estimator::IsFails => {
+                let weight = |d: &Draw| mixture.weight(&d.point);
+                let weighted = |set: &[&Draw]| set.iter().map(|d| (weight(d), d.failed_share())).collect::<Vec<_>>();
                 Estimates {
                     p_fail: estimators::importance(&weighted(&valid)),
                     p_fail_given_fair: estimators::importance(&weighted(&fair)),
                     fair_share: estimators::importance(
                         &valid
                             .iter()
-                            .map(|d| (d.weight(), f64::from(u8::from(d.fair()))))
+                            .map(|d| (weight(d), f64::from(u8::from(d.fair()))))
                             .collect::<Vec<_>>(),
                     ),
                 }
@@ -218,6 +227,9 @@ pub struct Outcome {
     pub estimates: Estimates,
     /// The proposal of the final stage (the uniform cube for `mc`).
     pub proposal: Proposal,
+    /// Every stage's proposal with its number of draws, whose mixture weighs `is`'s draws
+    /// (none for `mc`).
+    pub mixture: Option<proposal::Mixture>,
     /// Whether the target was reached (else the budget was spent).
     pub reached: bool,
     /// The estimates after each block of the estimating stage, as the stopping rule saw them.
@@ -247,7 +259,7 @@ pub fn blocks(estimator: Estimator, budget: usize) -> (Vec<usize>, Vec<usize>) {
     let block = (budget / 20).max(MIN_BLOCK);
     match estimator {
         Estimator::Mc => (Vec::new(), split(budget, block)),
-        Estimator::Is => {
+        Estimator::Is | Estimator::IsFails => {
             let round = (budget / 10).max(MIN_BLOCK);
             let rest = budget - ROUNDS * round;
             (vec![round; ROUNDS], split(rest, block.min(rest)))
@@ -419,6 +431,7 @@ pub fn estimate(
         let (rounds, finals) = blocks(estimator, budget);
         let mut draws: Vec<Draw> = Vec::new();
         let mut proposal = Proposal::uniform();
+        let mut mixture = proposal::Mixture::default();
         for (round, size) in rounds.into_iter().enumerate() {
             let next = draws.len();
             draws.extend(evaluate_block(
@@ -430,18 +443,21 @@ pub fn estimate(
                 remote,
             )?);
             check_fair_mass(&draws)?;
+            mixture.add(size, &proposal);
             let scored: Vec<proposal::Scored<'_>> = draws
                 .iter()
-                .map(|d| (d.point.as_slice(), d.weight(), d.score()))
+                .map(|d| {
+                    let score = d.score(estimator == Estimator::Is);
+                    (d.point.as_slice(), mixture.weight(&d.point), score)
+                })
                 .collect();
             proposal = proposal.refit(cfg.space, &scored);
         }
         let stage = match estimator {
             Estimator::Mc => DrawStage::Uniform,
-            Estimator::Is => DrawStage::Final,
+            Estimator::Is | Estimator::IsFails => DrawStage::Final,
         };
-        let first = draws.len();
-        let mut estimates = Estimates::of(estimator, &[]);
+        let mut estimates = Estimates::of(estimator, &[], &mixture);
         let mut reached = false;
         let mut checkpoints = Vec::new();
         for size in finals {
@@ -455,7 +471,8 @@ pub fn estimate(
                 remote,
             )?);
             check_fair_mass(&draws)?;
-            estimates = Estimates::of(estimator, &draws[first..]);
+            mixture.add(size, &proposal);
+            estimates = Estimates::of(estimator, &draws, &mixture);
             checkpoints.push(Checkpoint {
                 evaluations: draws.len(),
                 p_fail: estimates.p_fail.clone(),
@@ -470,6 +487,7 @@ pub fn estimate(
             draws,
             estimates,
             proposal,
+            mixture: estimator.weighted().then_some(mixture),
             reached,
             checkpoints,
         })
@@ -532,7 +550,7 @@ mod tests {
             // scenario's episodes): near 1, or for `is` on its 50 final draws, a refusal.
             let e = &one.estimates.p_fail_given_fair;
             assert!(
-                e.p.is_some_and(|p| p > 0.8) || (estimator == Estimator::Is && e.refused.is_some()),
+                e.p.is_some_and(|p| p > 0.8) || (estimator.weighted() && e.refused.is_some()),
                 "{estimator}: {e:#?}"
             );
             // The defensive mixture bounds every weight by 1/α.

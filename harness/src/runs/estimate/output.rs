@@ -1,7 +1,7 @@
 //! What an estimate writes into its folder, together at the end of the run:
 //!
 //! * `estimate.jsonl`: the run's identity (`{"estimate": {...}}`), then one line per draw
-//!   ([`Draw`]) in order: its stage, point, parameter values, proposal density, fairness,
+//!   ([`super::Draw`]) in order: its stage, point, parameter values, proposal density, fairness,
 //!   the method's episodes and failures, and their smallest margins;
 //! * `summary.json` ([`Summary`]): the estimand and the failure threshold, the three
 //!   estimates with their intervals and diagnostics, the evaluations, whether the target
@@ -10,7 +10,7 @@
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-use super::{Checkpoint, Draw, EstimateRequest, Estimates, Estimator, Outcome, Proposal};
+use super::{Checkpoint, EstimateRequest, Estimates, Estimator, Outcome, Proposal};
 use crate::episodes::Protocol;
 use crate::error::Error;
 use crate::runs::outputs::{Outputs, Own};
@@ -79,14 +79,18 @@ pub struct Summary {
     pub evaluations: usize,
     /// Of them, those that were no valid map.
     pub rejected: usize,
-    /// Draws the estimates are over (the final stage's for `is`, all for `mc`).
+    /// Draws the estimates are over: all (`is` pools every stage's, [`super::proposal::Mixture`]).
     pub estimate_draws: usize,
     /// Episodes of the method run, over all draws (the witnesses' come on top).
     pub method_episodes: u64,
     /// Whether both probabilities reached the target (else the budget was spent).
     pub target_reached: bool,
-    /// The proposal the estimates' draws came from.
+    /// The proposal of the last stage (the uniform cube for `mc`).
     pub proposal: Proposal,
+    /// `is`: every stage's proposal with its number of draws; a draw's weight is one over
+    /// their mixture's density at its point (absent for `mc`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mixture: Option<super::proposal::Mixture>,
     /// The estimates after each block of the estimating stage.
     pub checkpoints: Vec<Checkpoint>,
 }
@@ -126,7 +130,6 @@ pub(super) fn write_all(
         text.push('\n');
     }
     crate::files::write_atomic(&out.join(DRAWS), text.as_bytes())?;
-    let counted = |d: &&Draw| r.estimator == Estimator::Mc || d.stage == super::DrawStage::Final;
     let summary = Summary {
         schema: 1,
         run,
@@ -141,10 +144,11 @@ pub(super) fn write_all(
         estimates: outcome.estimates.clone(),
         evaluations: outcome.draws.len(),
         rejected: outcome.draws.iter().filter(|d| d.rejected.is_some()).count(),
-        estimate_draws: outcome.draws.iter().filter(counted).count(),
+        estimate_draws: outcome.draws.len(),
         method_episodes: outcome.draws.iter().map(|d| d.episodes).sum(),
         target_reached: outcome.reached,
         proposal: outcome.proposal.clone(),
+        mixture: outcome.mixture.clone(),
         checkpoints: outcome.checkpoints.clone(),
     };
     crate::files::write_json(&out.join(SUMMARY), &summary)?;

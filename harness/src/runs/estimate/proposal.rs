@@ -1,10 +1,19 @@
 //! The importance-sampling proposal over the space's unit cube: the uniform cube at
 //! first, then a defensive mixture (Hesterberg 1995) `q = α + (1 − α) ∏ f_d`, `α =`
-//! [`DEFENSIVE`], of one marginal per parameter (a normal truncated to [0, 1] for a range,
-//! cell probabilities spread evenly within each cell for a count or a choice), refitted
-//! by the cross-entropy method (Rubinstein 1999) to the draws with the smallest margins.
-//! The uniform part keeps every point of the cube in the proposal's support and bounds
-//! every weight `1/q` by `1/α`.
+//! [`DEFENSIVE`], of one marginal per parameter (uniform, a normal truncated to [0, 1] for
+//! a range, or cell probabilities spread evenly within each cell for a count or a choice),
+//! refitted by the cross-entropy method (Rubinstein 1999) to the draws with the smallest
+//! scores. A refit moves only the marginals whose elite departs from the uniform beyond
+//! its noise ([`MOVE_Z`] standard errors, at the elite's effective size); every other
+//! parameter stays uniform, so a 17-parameter space whose failures depend on three is
+//! fitted in three (a product of 17 refitted marginals makes weights vary in every
+//! dimension, noise included). The uniform part keeps every point of the cube in the
+//! proposal's support and bounds every weight `1/q` by `1/α`.
+//!
+//! The estimate pools every stage's draws ([`Mixture`]): a draw's weight is the target's
+//! density over the *mixture* of the proposals weighted by their numbers of draws (the
+//! balance heuristic of multiple importance sampling, Veach & Guibas 1995; Owen & Zhou
+//! 2000), bounded by the total draws over the uniform round's.
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -27,11 +36,19 @@ pub const SMOOTHING: f64 = 0.7;
 pub const MIN_SD: f64 = 0.05;
 /// Smallest probability of a cell.
 pub const MIN_CELL: f64 = 0.02;
+/// Standard errors by which an elite's marginal must depart from the uniform for a refit
+/// to move it (its mean, its spread, or a cell's frequency).
+pub const MOVE_Z: f64 = 3.0;
+/// The fourth central moment of the uniform interval minus its variance squared
+/// (`1/80 − 1/144`): `n` times the variance of the variance of `n` uniform points.
+const VAR_OF_VAR: f64 = 1.0 / 80.0 - 1.0 / 144.0;
 
 /// One parameter's part of a fitted proposal.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Marginal {
+    /// The uniform interval (the target's own marginal: weight 1).
+    Uniform,
     /// A normal (mean, standard deviation) truncated to [0, 1].
     Normal {
         /// Mean, on the unit interval.
@@ -83,37 +100,67 @@ impl Proposal {
 
     /// The cross-entropy refit to the elite of `scored`: the [`ELITE_SHARE`] of the draws
     /// with a finite score (at least [`MIN_ELITE`]; fewer: no refit), lowest first, ties
-    /// by order; each marginal moves [`SMOOTHING`] of the way to the elite's weighted
-    /// mean and standard deviation (or cell frequencies), floored at [`MIN_SD`] (or
-    /// [`MIN_CELL`]).
+    /// by order, and every failure (a negative score) when there are more (the multilevel
+    /// method's level: the elite's threshold is the larger of the quantile and the
+    /// failure level); every draw scoring the threshold joins. A parameter's marginal moves only when the elite's weighted
+    /// marginal departs from the uniform by more than [`MOVE_Z`] standard errors at the
+    /// elite's effective size (Kish's): its mean, its variance (smaller only) or a cell's
+    /// frequency; it then moves [`SMOOTHING`] of the way from the current marginal to the
+    /// elite's weighted mean and standard deviation (or cell frequencies), floored at
+    /// [`MIN_SD`] (or [`MIN_CELL`]). Any other marginal is the uniform.
     pub fn refit(&self, space: &Space, scored: &[Scored<'_>]) -> Proposal {
         let mut order: Vec<usize> = (0..scored.len()).filter(|&i| scored[i].2.is_finite()).collect();
         if order.len() < MIN_ELITE {
             return self.clone();
         }
         order.sort_by(|&a, &b| scored[a].2.total_cmp(&scored[b].2).then(a.cmp(&b)));
-        let n = ((order.len() as f64 * ELITE_SHARE).ceil() as usize).max(MIN_ELITE);
+        let failures = order.iter().filter(|&&i| scored[i].2 < 0.0).count();
+        let n = ((order.len() as f64 * ELITE_SHARE).ceil() as usize)
+            .max(MIN_ELITE)
+            .max(failures)
+            .min(order.len());
+        // Every draw at the threshold joins (the elite is {score ≤ γ}).
+        let threshold = scored[order[n - 1]].2;
+        let n = order.iter().take_while(|&&i| scored[i].2 <= threshold).count();
         let elite: Vec<(&[f64], f64)> = order[..n].iter().map(|&i| (scored[i].0, scored[i].1)).collect();
         let total: f64 = elite.iter().map(|e| e.1).sum();
+        let n_eff = total * total / elite.iter().map(|e| e.1 * e.1).sum::<f64>();
         let before = self.marginals.clone().unwrap_or_else(|| uniform_marginals(space));
-        let marginals = before
+        let marginals: Vec<Marginal> = before
             .into_iter()
             .enumerate()
-            .map(|(d, m)| match m {
-                Marginal::Normal { mean, sd } => {
+            .map(|(d, m)| match space.params[d].cells() {
+                None => {
                     let mu = elite.iter().map(|(x, w)| w * x[d]).sum::<f64>() / total;
                     let var = elite.iter().map(|(x, w)| w * (x[d] - mu).powi(2)).sum::<f64>() / total;
+                    let z_mean = (mu - 0.5) / (1.0 / 12.0 / n_eff).sqrt();
+                    let z_var = (var - 1.0 / 12.0) / (VAR_OF_VAR / n_eff).sqrt();
+                    if z_mean.abs() <= MOVE_Z && z_var >= -MOVE_Z {
+                        return Marginal::Uniform;
+                    }
+                    let (mean, sd) = match m {
+                        Marginal::Normal { mean, sd } => (mean, sd),
+                        _ => (0.5, (1.0f64 / 12.0).sqrt()),
+                    };
                     Marginal::Normal {
                         mean: SMOOTHING * mu + (1.0 - SMOOTHING) * mean,
                         sd: (SMOOTHING * var.sqrt() + (1.0 - SMOOTHING) * sd).max(MIN_SD),
                     }
                 }
-                Marginal::Cells(p) => {
-                    let k = p.len();
+                Some(k) => {
+                    let even = 1.0 / k as f64;
                     let mut freq = vec![0.0; k];
                     for (x, w) in &elite {
                         freq[cell(x[d], k)] += w / total;
                     }
+                    let noise = MOVE_Z * (even * (1.0 - even) / n_eff).sqrt();
+                    if freq.iter().all(|f| (f - even).abs() <= noise) {
+                        return Marginal::Cells(vec![even; k]);
+                    }
+                    let p = match m {
+                        Marginal::Cells(p) => p,
+                        _ => vec![even; k],
+                    };
                     let p: Vec<f64> = p
                         .iter()
                         .zip(freq)
@@ -124,23 +171,58 @@ impl Proposal {
                 }
             })
             .collect();
+        let moved = marginals.iter().any(|m| match m {
+            Marginal::Uniform => false,
+            Marginal::Normal { .. } => true,
+            Marginal::Cells(p) => p.iter().any(|&x| x != 1.0 / p.len() as f64),
+        });
         Proposal {
-            marginals: Some(marginals),
+            marginals: moved.then_some(marginals),
         }
     }
 }
 
-/// The marginals that start a refit: the uniform interval's mean and standard deviation
-/// for a range, even cells for a count or a choice.
+/// The proposals of an estimate's stages, each with its number of draws: the pooled draws
+/// are a stratified sample of their mixture `Σ n_k q_k / Σ n_k`, and each draw's weight
+/// is the target's density (1) over the mixture's.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Mixture {
+    /// Each proposal and its number of draws.
+    pub parts: Vec<(usize, Proposal)>,
+}
+
+impl Mixture {
+    /// Adds `n` draws of `q` (to its part when `q` is the last part's proposal).
+    pub fn add(&mut self, n: usize, q: &Proposal) {
+        match self.parts.last_mut() {
+            Some((m, last)) if last == q => *m += n,
+            _ => self.parts.push((n, q.clone())),
+        }
+    }
+
+    /// The mixture's density at `x` (1 with no part).
+    pub fn density(&self, x: &[f64]) -> f64 {
+        let total: usize = self.parts.iter().map(|p| p.0).sum();
+        if total == 0 {
+            return 1.0;
+        }
+        self.parts.iter().map(|(n, q)| *n as f64 * q.density(x)).sum::<f64>() / total as f64
+    }
+
+    /// The weight of a draw at `x`: one over the mixture's density.
+    pub fn weight(&self, x: &[f64]) -> f64 {
+        1.0 / self.density(x)
+    }
+}
+
+/// The marginals that start a refit: the uniform interval for a range, even cells for a
+/// count or a choice.
 fn uniform_marginals(space: &Space) -> Vec<Marginal> {
     space
         .params
         .iter()
         .map(|p| match p.domain {
-            Domain::Range(..) => Marginal::Normal {
-                mean: 0.5,
-                sd: (1.0f64 / 12.0).sqrt(),
-            },
+            Domain::Range(..) => Marginal::Uniform,
             _ => {
                 let k = p.cells().unwrap_or(1);
                 Marginal::Cells(vec![1.0 / k as f64; k])
@@ -163,6 +245,7 @@ fn truncated(mean: f64, sd: f64) -> (Normal, f64, f64) {
 
 fn marginal_density(m: &Marginal, u: f64) -> f64 {
     match m {
+        Marginal::Uniform => 1.0,
         Marginal::Normal { mean, sd } => {
             let (n, _, mass) = truncated(*mean, *sd);
             n.pdf(u) / mass
@@ -174,6 +257,7 @@ fn marginal_density(m: &Marginal, u: f64) -> f64 {
 fn marginal_draw(m: &Marginal, rng: &mut ChaCha8Rng) -> f64 {
     let u: f64 = rng.random_range(0.0..1.0);
     let x = match m {
+        Marginal::Uniform => u,
         // Inverse CDF within [0, 1].
         Marginal::Normal { mean, sd } => {
             let (n, lo, mass) = truncated(*mean, *sd);
