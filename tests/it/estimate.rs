@@ -25,7 +25,7 @@ fn estimate(out: &std::path::Path, extra: &[&str]) -> std::process::Output {
 #[test]
 fn estimates_are_the_same_whatever_the_jobs() {
     let d = tempfile::tempdir().unwrap();
-    for (estimator, budget) in [("mc", "50"), ("is", "200")] {
+    for (estimator, budget) in [("mc", "50"), ("is", "200"), ("is-fails", "200")] {
         let files = |jobs: &str| {
             let out = d.path().join(format!("{estimator}-{jobs}"));
             let run = estimate(&out, &["--estimator", estimator, "--budget", budget, "--jobs", jobs]);

@@ -213,8 +213,14 @@ mod tests {
         let e = importance(&s);
         assert_eq!(e.p, Some(0.2));
         let mc = monte_carlo(&s.iter().map(|x| x.1).collect::<Vec<_>>());
-        assert!((e.ci95_low.unwrap() - mc.ci95_low.unwrap()).abs() < 1e-12, "{e:?} {mc:?}");
-        assert!((e.ci95_high.unwrap() - mc.ci95_high.unwrap()).abs() < 1e-12, "{e:?} {mc:?}");
+        assert!(
+            (e.ci95_low.unwrap() - mc.ci95_low.unwrap()).abs() < 1e-12,
+            "{e:?} {mc:?}"
+        );
+        assert!(
+            (e.ci95_high.unwrap() - mc.ci95_high.unwrap()).abs() < 1e-12,
+            "{e:?} {mc:?}"
+        );
         assert_eq!(e.ess, Some(100.0));
         assert_eq!(e.largest_weight_share, Some(0.01));
         assert!((e.effective_failures.unwrap() - 20.0).abs() < 1e-9);
@@ -243,5 +249,29 @@ mod tests {
                 .unwrap()
                 .contains("effective sample size")
         );
+    }
+
+    /// By hand: 10 failures of weight 0.5 and 90 successes of weight 1. Σw = 95, μ̂ = 5/95
+    /// = 0.0526316; V = (10 · 0.25 · 0.9473684² + 90 · 0.0526316²)/95² = 2.4930748/9025 =
+    /// 2.762410e-4; n* = 0.0526316 · 0.9473684 / 2.762410e-4 = 180.5; the interval is
+    /// Wilson's at 180.5 draws: centre (0.0526316 + 3.841459/361)/(1 + 3.841459/180.5) =
+    /// 0.0619542, half 1.959964 · √(2.762410e-4 + 3.841459/130321)/1.0212820 = 0.0335554.
+    #[test]
+    fn importance_sampling_is_wilson_at_the_effective_size_by_hand() {
+        let s: Vec<(f64, f64)> = (0..100).map(|i| if i < 10 { (0.5, 1.0) } else { (1.0, 0.0) }).collect();
+        let e = importance(&s);
+        assert!((e.p.unwrap() - 0.052_631_6).abs() < 1e-7, "{e:?}");
+        assert!(
+            (e.ci95_low.unwrap() - (0.061_954_2 - 0.033_555_4)).abs() < 1e-6,
+            "{e:?}"
+        );
+        assert!(
+            (e.ci95_high.unwrap() - (0.061_954_2 + 0.033_555_4)).abs() < 1e-6,
+            "{e:?}"
+        );
+        // Skewed upward as a proportion's: farther above the estimate than below.
+        assert!(e.ci95_high.unwrap() - e.p.unwrap() > e.p.unwrap() - e.ci95_low.unwrap());
+        assert_eq!(wilson(0.0, 10.0).0, 0.0);
+        assert_eq!(wilson(1.0, 10.0).1, 1.0);
     }
 }

@@ -310,4 +310,142 @@ mod tests {
         assert!((mean_weight - 1.0).abs() < 0.05, "{mean_weight}");
         assert_eq!(q.draw(7, "test", 3, 2), draws[3]);
     }
+
+    fn space(params: &str) -> Space {
+        let base = crate::maps::load("jaywalk").unwrap();
+        let text = format!("Space(name: \"t\", params: [{params}])");
+        Space::parse("test", &text, &base).unwrap()
+    }
+
+    /// Two ranges and a choice of two.
+    fn three() -> Space {
+        space(
+            r#"(field: "pedestrians[0].trigger.value", range: (2.5, 6.5)),
+               (field: "vehicle.max_brake", range: (2.0, 5.0)),
+               (field: "pedestrians[0].side", choose: ["Near", "Far"])"#,
+        )
+    }
+
+    /// By hand: a mixture of 1 uniform draw and 3 of a proposal whose one marginal is a
+    /// normal (0.5, 0.1) truncated to [0, 1]: its mass in [0, 1] is Φ(5) − Φ(−5) ≈ 1, so at
+    /// 0.5 its density is 1/(0.1 √(2π)) = 3.98942, the proposal's 0.2 + 0.8 × 3.98942 =
+    /// 3.39154, and the mixture's (1 × 1 + 3 × 3.39154)/4 = 2.79365.
+    #[test]
+    fn the_mixture_density_is_the_draw_weighted_sum_by_hand() {
+        let q = Proposal {
+            marginals: Some(vec![Marginal::Normal { mean: 0.5, sd: 0.1 }]),
+        };
+        assert!((q.density(&[0.5]) - 3.391_54).abs() < 1e-5, "{}", q.density(&[0.5]));
+        let mut m = Mixture::default();
+        m.add(1, &Proposal::uniform());
+        m.add(2, &q);
+        m.add(1, &q);
+        assert_eq!(m.parts.len(), 2, "the same proposal's draws are one part");
+        assert!((m.density(&[0.5]) - 2.793_65).abs() < 1e-5, "{}", m.density(&[0.5]));
+        assert!((m.weight(&[0.5]) - 1.0 / 2.793_65).abs() < 1e-5);
+        // Truncation: the normal (0.9, 0.2) keeps Φ(0.5) − Φ(−4.5) = 0.691459 of its mass,
+        // so at 0.9 its density is 1.994711/0.691459 = 2.884786.
+        let t = Proposal {
+            marginals: Some(vec![Marginal::Normal { mean: 0.9, sd: 0.2 }]),
+        };
+        assert!(
+            (t.density(&[0.9]) - (0.2 + 0.8 * 2.884_786)).abs() < 1e-5,
+            "{}",
+            t.density(&[0.9])
+        );
+        // A uniform marginal is the cube's own: the density stays 1.
+        let u = Proposal {
+            marginals: Some(vec![Marginal::Uniform, Marginal::Cells(vec![0.5, 0.5])]),
+        };
+        assert_eq!(u.density(&[0.3, 0.7]), 1.0);
+        assert_eq!(Mixture::default().density(&[0.3]), 1.0);
+    }
+
+    /// Parameters the elite does not depend on stay uniform; one it depends on moves.
+    #[test]
+    fn a_refit_moves_only_the_marginals_the_elite_departs_in() {
+        let space = three();
+        // 400 draws of a uniform grid-like sequence; a failure wherever trigger < 0.1.
+        let points: Vec<Vec<f64>> = (0..400)
+            .map(|i| {
+                let q = Proposal::uniform();
+                q.draw(3, "refit", i, 3)
+            })
+            .collect();
+        let scored: Vec<Scored<'_>> = points
+            .iter()
+            .map(|x| (x.as_slice(), 1.0, if x[0] < 0.1 { -1.0 } else { 1.0 + x[0] }))
+            .collect();
+        let q = Proposal::uniform().refit(&space, &scored);
+        let ms = q.marginals.expect("the trigger moved");
+        match ms[0] {
+            Marginal::Normal { mean, .. } => assert!(mean < 0.2, "{mean}"),
+            ref m => panic!("{m:?}"),
+        }
+        assert_eq!(ms[1], Marginal::Uniform);
+        assert_eq!(ms[2], Marginal::Cells(vec![0.5, 0.5]));
+        // Scores that depend on nothing: no marginal moves, the proposal stays the cube.
+        let flat: Vec<Scored<'_>> = points
+            .iter()
+            .enumerate()
+            .map(|(i, x)| (x.as_slice(), 1.0, ((i * 7919) % 400) as f64))
+            .collect();
+        assert_eq!(Proposal::uniform().refit(&space, &flat), Proposal::uniform());
+    }
+
+    /// The elite is every failure when they outnumber the quantile, and every draw tied
+    /// at the threshold: with 30 failures among 100 (over 10%) the refit fits the 30.
+    #[test]
+    fn the_elite_is_every_failure_and_every_tie() {
+        let space = three();
+        let points: Vec<Vec<f64>> = (0..100).map(|i| vec![(i as f64 + 0.5) / 100.0, 0.5, 0.25]).collect();
+        let failing: Vec<Scored<'_>> = points
+            .iter()
+            .map(|x| (x.as_slice(), 1.0, if x[0] < 0.3 { -1.0 } else { 1.0 }))
+            .collect();
+        let q = Proposal::uniform().refit(&space, &failing);
+        // The 30 failures' mean is 0.15: the marginal moves 0.7 of the way from 0.5.
+        match q.marginals.unwrap()[0] {
+            Marginal::Normal { mean, .. } => assert!((mean - (0.7 * 0.15 + 0.3 * 0.5)).abs() < 1e-9, "{mean}"),
+            ref m => panic!("{m:?}"),
+        }
+        // No failure, 60 draws tied at 0 (the fair ones, for `is`): all 60 are the elite.
+        let tied: Vec<Scored<'_>> = points
+            .iter()
+            .map(|x| (x.as_slice(), 1.0, if x[0] >= 0.4 { 0.0 } else { f64::INFINITY }))
+            .collect();
+        match Proposal::uniform().refit(&space, &tied).marginals.unwrap()[0] {
+            Marginal::Normal { mean, .. } => assert!((mean - (0.7 * 0.7 + 0.3 * 0.5)).abs() < 1e-9, "{mean}"),
+            ref m => panic!("{m:?}"),
+        }
+    }
+
+    proptest::proptest! {
+        /// Under any fitted proposal, the weights of its own draws average to 1 (the
+        /// cube's volume), and so do the mixture weights of draws from the mixture.
+        #[test]
+        fn weights_average_to_one_under_the_proposal(
+            mean in 0.0f64..1.0,
+            sd in MIN_SD..0.5,
+            p0 in 0.05f64..0.95,
+            seed in 0u64..1000,
+        ) {
+            let q = Proposal {
+                marginals: Some(vec![Marginal::Normal { mean, sd }, Marginal::Cells(vec![p0, 1.0 - p0]), Marginal::Uniform]),
+            };
+            let n = 4000;
+            let own = (0..n).map(|i| 1.0 / q.density(&q.draw(seed, "p", i, 3))).sum::<f64>() / n as f64;
+            proptest::prop_assert!((own - 1.0).abs() < 0.08, "{}", own);
+            let mut m = Mixture::default();
+            m.add(n / 4, &Proposal::uniform());
+            m.add(3 * n / 4, &q);
+            let pooled = (0..n / 4)
+                .map(|i| Proposal::uniform().draw(seed, "u", i, 3))
+                .chain((0..3 * n / 4).map(|i| q.draw(seed, "q", i, 3)))
+                .map(|x| m.weight(&x))
+                .sum::<f64>()
+                / n as f64;
+            proptest::prop_assert!((pooled - 1.0).abs() < 0.05, "{}", pooled);
+        }
+    }
 }
