@@ -42,7 +42,8 @@
 //!
 //! What these measured (EXPERIMENTS.md, "How rare is a failure"): on the jaywalk space,
 //! whose fair failures have no structure a product of marginals can fit, `is` is about
-//! as precise as `mc` at equal draws; its intervals cover.
+//! as precise as `mc` at equal draws on P(fails | fair) (its intervals covered the
+//! reference in 17 of 20 repetitions of 2000 draws, one refused), so `mc` is the default.
 //!
 //! Every draw has its own generator (run seed, stage, index) and its episodes their own
 //! seeds, and draws are evaluated in parallel but taken in index order, so the same
