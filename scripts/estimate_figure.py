@@ -51,9 +51,9 @@ def main() -> None:
                             color=line.get_color(), alpha=0.2)
             if refused:
                 ax.plot(refused, [0.0] * len(refused), "x", color=line.get_color(),
-                        label=f"{label}: refused (weights degenerate)")
+                        label=f"{label}: refused (too few effective failures or degenerate weights)")
         if ref is not None:
-            ax.axhline(ref[0], color="black", lw=1, label="reference (MC, 10x budget)")
+            ax.axhline(ref[0], color="black", lw=1, label="reference (Monte Carlo, its 95% interval grey)")
             ax.axhspan(ref[1], ref[2], color="black", alpha=0.1)
         ax.set_title(title)
         ax.set_xlabel("evaluations (draws of the space)")

@@ -248,13 +248,13 @@ def test_one_search_request_gives_the_same_outputs_through_every_front(agent_fil
 def test_one_estimate_request_gives_the_same_files_through_every_front(agent_file: Path, tmp_path: Path,
                                                                        monkeypatch: pytest.MonkeyPatch):
     """The command line, the library and the Ray driver write the same estimate.jsonl and
-    summary.json, byte for byte, for both estimators (importance sampling's rounds refit
+    summary.json, byte for byte, for every estimator (importance sampling's rounds refit
     the proposal from the draws, so a draw evaluated otherwise would change every later one)."""
     space = REPO / "maps" / "spaces" / "jaywalk.ron"
     monkeypatch.setitem(sys.modules, "ray", _InlineRay())
     from unforeseen.distributed import run_estimate
 
-    for estimator, budget in [("mc", 50), ("is", 200)]:
+    for estimator, budget in [("mc", 50), ("is", 200), ("is-fails", 200)]:
         args = dict(space=str(space), method="q-learning", agent=str(agent_file), estimator=estimator, budget=budget,
                     episodes=1, seed=5)
         cli_out = tmp_path / f"{estimator}-cli"
@@ -274,14 +274,15 @@ def test_an_interrupted_estimate_resumes_to_the_command_lines_files_through_ever
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
     """An estimate killed partway (its draws' part cut mid-line, no estimate.jsonl) resumed
     by the library (``resume=True``) and by the Ray driver writes the command line's
-    uninterrupted files, byte for byte, for both estimators; shards run from Python,
+    uninterrupted files, byte for byte, for every estimator (for `is` and `is-fails` the
+    rounds' refits redone from the kept draws); shards run from Python,
     concatenated and resumed, too. The Ray driver refuses a shard, and a bad one is named."""
     space = str(REPO / "maps" / "spaces" / "jaywalk.ron")
     monkeypatch.setitem(sys.modules, "ray", _InlineRay())
     from unforeseen.distributed import run_estimate
 
     files = ["estimate.jsonl", "summary.json"]
-    for estimator, budget in [("mc", 100), ("is", 200)]:
+    for estimator, budget in [("mc", 100), ("is", 200), ("is-fails", 200)]:
         args = dict(space=space, method="never-brake", estimator=estimator, budget=budget, episodes=1, seed=5,
                     target_rel_error=0.05)
         cli_out = tmp_path / f"{estimator}-cli"

@@ -41,7 +41,8 @@ def estimate(
     """Estimates P(an episode of ``method`` fails) and P(fails | fair) when the scenario is
     drawn uniformly from ``space`` (a space file over the base ``map``), as ``unforeseen
     estimate`` does: by ``estimator`` (``"mc"``, plain Monte Carlo with the Wilson
-    interval, or ``"is"``, cross-entropy importance sampling with a weighted interval), at
+    interval, or ``"is"`` / ``"is-fails"``, cross-entropy importance sampling aimed at
+    P(fails | fair) / P(fails), with a weighted interval), at
     most ``budget`` draws of ``episodes`` episodes each, stopping once both relative
     half-widths are at most ``target_rel_error``. Agents: ``agent`` (an agent file), one
     per training seed (``train_seeds``, trained on ``train_map``, a map file or an

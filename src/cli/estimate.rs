@@ -34,7 +34,7 @@ pub struct EstimateArgs {
     /// Stop once both probabilities' relative half-widths are at most this, in (0, 1).
     #[arg(long, value_name = "R", default_value_t = EstimateRequest::default().target_rel_error)]
     pub target_rel_error: f64,
-    /// Most draws (points of the space evaluated); mc needs 50 at least, is 200.
+    /// Most draws (points of the space evaluated); mc needs 50 at least, is and is-fails 200.
     #[arg(long, value_name = "N", default_value_t = EstimateRequest::default().budget)]
     pub budget: usize,
     /// Episodes per draw, for each witness and for the method (per training seed).
@@ -47,9 +47,9 @@ pub struct EstimateArgs {
     #[arg(long)]
     pub jobs: Option<usize>,
     /// Evaluate only shard I of N of the next stage (the draws I-1 mod N of the first stage
-    /// --out does not complete: mc's draws, or is's next round or final draws); write
+    /// --out does not complete: mc's draws, or the next round or final draws of is and is-fails); write
     /// estimate.jsonl, no summary. Concatenate the shards' estimate.jsonl and finish with
-    /// --resume (for is, one --resume --shard round per stage).
+    /// --resume (for is and is-fails, one --resume --shard round per stage).
     #[arg(long, value_name = "I/N")]
     pub shard: Option<Shard>,
     /// Keep the draws of the same request in --out (estimate.jsonl.part, left by an
@@ -182,7 +182,7 @@ fn print_shard(p: &ShardPart, args: &EstimateArgs) {
                 p.draws
             );
             outln!(
-                "next: concatenate the shards' estimate.jsonl into one --out and run with --resume (for is before the final draws: --resume --shard I/N again on it)"
+                "next: concatenate the shards' estimate.jsonl into one --out and run with --resume (for is and is-fails before the final draws: --resume --shard I/N again on it)"
             );
         }
     }

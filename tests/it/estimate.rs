@@ -28,7 +28,7 @@ fn estimate(out: &std::path::Path, extra: &[&str]) -> std::process::Output {
 #[test]
 fn estimates_are_the_same_whatever_the_jobs() {
     let d = tempfile::tempdir().unwrap();
-    for (estimator, budget) in [("mc", "50"), ("is", "200")] {
+    for (estimator, budget) in [("mc", "50"), ("is", "200"), ("is-fails", "200")] {
         let files = |jobs: &str| {
             let out = d.path().join(format!("{estimator}-{jobs}"));
             let run = estimate(&out, &["--estimator", estimator, "--budget", budget, "--jobs", jobs]);
@@ -139,7 +139,7 @@ fn files(out: &std::path::Path) -> [Vec<u8>; 2] {
 #[test]
 fn a_killed_estimate_resumes_to_the_files_of_one_never_killed() {
     let d = tempfile::tempdir().unwrap();
-    for (estimator, budget) in [("mc", "100"), ("is", "200")] {
+    for (estimator, budget) in [("mc", "100"), ("is", "200"), ("is-fails", "200")] {
         let flags = [
             "--estimator",
             estimator,
@@ -170,8 +170,9 @@ fn a_killed_estimate_resumes_to_the_files_of_one_never_killed() {
 #[test]
 fn shards_concatenated_then_resumed_give_the_unsharded_files() {
     let d = tempfile::tempdir().unwrap();
-    // `is` with 250 draws: three rounds of 50, then final blocks of 50 (two dealt at once).
-    for (estimator, budget, steps) in [("mc", "100", 1), ("is", "250", 4)] {
+    // `is` and `is-fails` with 250 draws: three rounds of 50, then final blocks of 50 (two
+    // dealt at once); each round's proposal refitted from the joined draws, as the whole run did.
+    for (estimator, budget, steps) in [("mc", "100", 1), ("is", "250", 4), ("is-fails", "250", 4)] {
         let flags = [
             "--estimator",
             estimator,

@@ -1,7 +1,7 @@
 //! The two estimators of a probability from evaluated draws, each with its 95% interval
 //! (module doc of [`super`]): plain Monte Carlo with the Wilson score interval, and
-//! self-normalised importance sampling with the delta-method interval, its diagnostics
-//! and its refusals.
+//! self-normalised importance sampling with the Wilson interval at the delta method's
+//! effective sample size (Korn & Graubard 1998), its diagnostics and its refusals.
 
 use serde::{Deserialize, Serialize};
 
@@ -114,15 +114,20 @@ pub fn monte_carlo(ys: &[f64]) -> Estimate {
     Estimate::with(p, low, high, n, KIND)
 }
 
-/// The self-normalised importance-sampling estimate `Σ wᵢyᵢ / Σ wᵢ` of `E_p[y]` from
-/// `(wᵢ, yᵢ)` (weights `p/q` of draws from the proposal `q`, `yᵢ` in [0, 1]), with the
-/// delta-method normal 95% interval, variance `Σ wᵢ²(yᵢ − μ̂)² / (Σ wᵢ)²` (Owen 2013,
-/// *Monte Carlo theory, methods and examples*, §9.2), cut to [0, 1]. Refused, with the
-/// reason, when the weights degenerate: an ESS under [`MIN_ESS`], a weight holding over
-/// [`MAX_WEIGHT_SHARE`] of the total, or fewer than [`MIN_EFFECTIVE_FAILURES`] effective
-/// failures (none at all included).
+/// The self-normalised importance-sampling estimate `μ̂ = Σ wᵢyᵢ / Σ wᵢ` of `E_p[y]` from
+/// `(wᵢ, yᵢ)` (weights `p/q` of draws from the proposal `q`, `yᵢ` in [0, 1]). Its variance
+/// is the delta method's, `V = Σ wᵢ²(yᵢ − μ̂)² / (Σ wᵢ)²` (Owen 2013, *Monte Carlo theory,
+/// methods and examples*, §9.2); the interval is the Wilson score interval at the
+/// effective sample size `n* = μ̂(1 − μ̂)/V`, the plain draws that would give the same
+/// variance (Korn & Graubard 1998, *Survey Methodology* 24: intervals for proportions
+/// with a small expected number of positives under weighting). With equal weights `n*` is
+/// the number of draws and the interval is [`monte_carlo`]'s; unlike the normal interval
+/// `μ̂ ± 1.96 √V`, it is skewed upward as a proportion's with few failures is. Refused,
+/// with the reason, when the weights degenerate: an ESS under [`MIN_ESS`], a weight
+/// holding over [`MAX_WEIGHT_SHARE`] of the total, or fewer than
+/// [`MIN_EFFECTIVE_FAILURES`] effective failures (none at all included).
 pub fn importance(samples: &[(f64, f64)]) -> Estimate {
-    const KIND: &str = "self-normalised importance sampling, delta-method normal 95%";
+    const KIND: &str = "self-normalised importance sampling, Wilson 95% at the delta method's effective sample size";
     let n = samples.len();
     let sum_w: f64 = samples.iter().map(|s| s.0).sum();
     if n == 0 || sum_w <= 0.0 {
@@ -163,8 +168,21 @@ pub fn importance(samples: &[(f64, f64)]) -> Estimate {
     }
     let mu = sum_wy / sum_w;
     let var = samples.iter().map(|s| (s.0 * (s.1 - mu)).powi(2)).sum::<f64>() / (sum_w * sum_w);
-    let half = Z95 * var.sqrt();
-    diagnose(Estimate::with(mu, mu - half, mu + half, n, KIND))
+    let n_star = if var > 0.0 { mu * (1.0 - mu) / var } else { ess };
+    let (low, high) = wilson(mu, n_star);
+    diagnose(Estimate::with(mu, low, high, n, KIND))
+}
+
+/// The 95% Wilson score interval of a proportion `p` observed in `n` (not necessarily
+/// whole) draws; its ends are exactly 0 at `p = 0` and 1 at `p = 1`.
+pub fn wilson(p: f64, n: f64) -> (f64, f64) {
+    let z2 = Z95 * Z95;
+    let denom = 1.0 + z2 / n;
+    let centre = (p + z2 / (2.0 * n)) / denom;
+    let half = Z95 * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / denom;
+    let low = if p == 0.0 { 0.0 } else { centre - half };
+    let high = if p == 1.0 { 1.0 } else { centre + half };
+    (low, high)
 }
 
 #[cfg(test)]
@@ -189,11 +207,20 @@ mod tests {
 
     #[test]
     fn importance_sampling_with_equal_weights_is_the_plain_mean() {
-        // 20 failures in 100 draws of weight 2: mean 0.2, variance 4·(20·0.64 + 80·0.04)/200² = 0.0016.
+        // 20 failures in 100 draws of weight 2: mean 0.2, variance 4·(20·0.64 + 80·0.04)/200² = 0.0016,
+        // so n* = 0.2·0.8/0.0016 = 100 draws and the interval is the Wilson interval of 20 in 100.
         let s: Vec<(f64, f64)> = (0..100).map(|i| (2.0, if i < 20 { 1.0 } else { 0.0 })).collect();
         let e = importance(&s);
         assert_eq!(e.p, Some(0.2));
-        assert!((e.ci95_high.unwrap() - (0.2 + Z95 * 0.04)).abs() < 1e-12, "{e:?}");
+        let mc = monte_carlo(&s.iter().map(|x| x.1).collect::<Vec<_>>());
+        assert!(
+            (e.ci95_low.unwrap() - mc.ci95_low.unwrap()).abs() < 1e-12,
+            "{e:?} {mc:?}"
+        );
+        assert!(
+            (e.ci95_high.unwrap() - mc.ci95_high.unwrap()).abs() < 1e-12,
+            "{e:?} {mc:?}"
+        );
         assert_eq!(e.ess, Some(100.0));
         assert_eq!(e.largest_weight_share, Some(0.01));
         assert!((e.effective_failures.unwrap() - 20.0).abs() < 1e-9);
@@ -222,5 +249,29 @@ mod tests {
                 .unwrap()
                 .contains("effective sample size")
         );
+    }
+
+    /// By hand: 10 failures of weight 0.5 and 90 successes of weight 1. Σw = 95, μ̂ = 5/95
+    /// = 0.0526316; V = (10 · 0.25 · 0.9473684² + 90 · 0.0526316²)/95² = 2.4930748/9025 =
+    /// 2.762410e-4; n* = 0.0526316 · 0.9473684 / 2.762410e-4 = 180.5; the interval is
+    /// Wilson's at 180.5 draws: centre (0.0526316 + 3.841459/361)/(1 + 3.841459/180.5) =
+    /// 0.0619542, half 1.959964 · √(2.762410e-4 + 3.841459/130321)/1.0212820 = 0.0335554.
+    #[test]
+    fn importance_sampling_is_wilson_at_the_effective_size_by_hand() {
+        let s: Vec<(f64, f64)> = (0..100).map(|i| if i < 10 { (0.5, 1.0) } else { (1.0, 0.0) }).collect();
+        let e = importance(&s);
+        assert!((e.p.unwrap() - 0.052_631_6).abs() < 1e-7, "{e:?}");
+        assert!(
+            (e.ci95_low.unwrap() - (0.061_954_2 - 0.033_555_4)).abs() < 1e-6,
+            "{e:?}"
+        );
+        assert!(
+            (e.ci95_high.unwrap() - (0.061_954_2 + 0.033_555_4)).abs() < 1e-6,
+            "{e:?}"
+        );
+        // Skewed upward as a proportion's: farther above the estimate than below.
+        assert!(e.ci95_high.unwrap() - e.p.unwrap() > e.p.unwrap() - e.ci95_low.unwrap());
+        assert_eq!(wilson(0.0, 10.0).0, 0.0);
+        assert_eq!(wilson(1.0, 10.0).1, 1.0);
     }
 }

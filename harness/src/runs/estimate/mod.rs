@@ -24,50 +24,66 @@
 //! * **mc**: independent uniform draws; the mean with its Wilson interval, over the valid
 //!   draws and over the fair ones (conditionally on their number, the fair draws are
 //!   independent draws of the distribution restricted to the fair part).
-//! * **is**: cross-entropy importance sampling. [`ROUNDS`] rounds of draws, the first
-//!   uniform, each refitting the proposal ([`proposal`]) to the draws so far with the
-//!   smallest margins (a draw's *score*: minus its failed share when it failed, else the
-//!   smallest clearance car–pedestrian of its episodes, `min_clearance_m`; unfair and
-//!   rejected draws never count), each draw weighted by its likelihood ratio; then a
-//!   final stage from the last proposal, whose draws alone give the estimates, weighted
-//!   by `1/q` (self-normalised, delta-method interval, with ESS, the largest weight's
-//!   share and refusals when the weights degenerate).
+//! * **is**, **is-fails**: cross-entropy importance sampling. [`ROUNDS`] rounds of draws,
+//!   the first uniform, each refitting the proposal ([`proposal`]: a defensive mixture of
+//!   the uniform and a product of marginals, of which only those the elite departs in
+//!   move) to the elite of the draws so far, each draw weighted as below. A draw's
+//!   *score* ([`Draw::score`]) is minus its failed share when it failed; otherwise `is`,
+//!   aimed at P(fails | fair), scores a fair draw 0 and an unfair one +∞ (its elite is
+//!   every fair draw until the fair failures alone fill it), and `is-fails`, aimed at
+//!   P(fails), scores a valid draw by its smallest clearance car–pedestrian. Then a final
+//!   stage from the last proposal. The estimates pool every stage's draws, rounds
+//!   included, each weighted by one over the density of the mixture of the stages'
+//!   proposals in proportion to their draws ([`proposal::Mixture`], the balance
+//!   heuristic): self-normalised, P(fails | fair) the ratio of the weighted fair failures
+//!   to the weighted fair draws, with the Wilson interval at the delta method's effective
+//!   sample size, the ESS, the largest weight's share and refusals when the weights
+//!   degenerate or carry under 5 effective failures ([`estimators::importance`]).
+//!
+//! What these measured (EXPERIMENTS.md, "How rare is a failure"): on the jaywalk space,
+//! whose fair failures have no structure a product of marginals can fit, `is` is about
+//! as precise as `mc` at equal draws on P(fails | fair) (its intervals covered the
+//! reference in 17 of 20 repetitions of 2000 draws, one refused), so `mc` is the default.
 //!
 //! Every draw has its own generator (run seed, stage, index) and its episodes their own
 //! seeds, and draws are evaluated in parallel but taken in index order, so the same
 //! request gives the same files bit for bit whatever the number of threads.
 //!
 //! **Resume.** The state of a run is a function of its draws: each draw's point and
-//! density derive from (run seed, stage, index) and the proposal in force, and `is`'s
-//! proposals are refitted deterministically from the earlier rounds' draws. So `--resume`
-//! (`resume.rs`) reads the draws an earlier run of the same request left (its identity
-//! line checked, each line checked as this program writes it), walks the stages as a
-//! fresh run does, takes each kept draw where the walk reaches its index (checked against
-//! the draw derived there) and evaluates only the missing ones: the files are those of a
-//! run never interrupted, byte for byte. Kept draws the walk never reaches (past the
-//! block where the stopping rule stops it) are left out.
+//! density (its own stage's proposal's) derive from (run seed, stage, index) and the
+//! proposal in force, and the proposals of `is` and `is-fails` are refitted
+//! deterministically from the earlier rounds' draws (their mixture weights included,
+//! which depend only on the stages' sizes and proposals). So `--resume` (`resume.rs`)
+//! reads the draws an earlier run of the same request left (its identity line checked,
+//! each line checked as this program writes it), walks the stages as a fresh run does,
+//! takes each kept draw where the walk reaches its index (checked against the draw
+//! derived there) and evaluates only the missing ones: the files are those of a run never
+//! interrupted, byte for byte (the walk refits each round's proposal from the kept draws
+//! as the first run did, so the mixture that weighs the draws is the same). Kept draws
+//! the walk never reaches (past the block where the stopping rule stops it) are left out.
 //!
 //! **Shards.** A shard `I/N` evaluates the draws of index `≡ I − 1 (mod N)` of the first
 //! stage the draws in its folder do not complete (none, without `--resume`), writes
-//! `estimate.jsonl` (every draw it holds) and stops ([`ShardPart`]). The stages are:
-//! each cross-entropy round of `is` whole (its draws come from the proposal the rounds
-//! before it fitted, so a round can only be dealt once they are all in); then the
-//! estimating stage (`mc`'s uniform draws, `is`'s final ones) from its first incomplete
-//! block to the budget (the stopping rule needs every draw of a block, which no shard
-//! has; the draws dealt in turn put each shard's share in the earliest blocks, so little
-//! past the stopping point is wasted). The shards' files concatenated (a draw that
-//! several files hold, line for line the same, is one draw) are the input of the next
-//! step: `--resume --shard I/N` again for `is`'s next stage, and, once a shard finds
-//! every needed draw there, a run without `--shard` with `--resume`, which takes every
-//! draw, evaluates none, applies the stopping rule and writes what the unsharded run
-//! writes. So `mc` takes one round of shards, `is` one per round and one for the final
-//! stage; concatenation and `--resume` are the merge (`unforeseen merge` joins batch
-//! runs' units, whose files have no stages to walk).
+//! `estimate.jsonl` (every draw it holds) and stops ([`ShardPart`]). The stages are: each
+//! cross-entropy round of `is` and `is-fails` whole (its draws come from the proposal the
+//! rounds before it fitted, so a round can only be dealt once they are all in); then the
+//! estimating stage (`mc`'s uniform draws, the final ones of `is` and `is-fails`) from
+//! its first incomplete block to the budget (the stopping rule needs every draw of a
+//! block, which no shard has; the draws dealt in turn put each shard's share in the
+//! earliest blocks, so little past the stopping point is wasted). The shards' files
+//! concatenated (a draw that several files hold, line for line the same, is one draw) are
+//! the input of the next step: `--resume --shard I/N` again for the next stage of `is` or
+//! `is-fails`, and, once a shard finds every needed draw there, a run without `--shard`
+//! with `--resume`, which takes every draw, evaluates none, applies the stopping rule and
+//! writes what the unsharded run writes. So `mc` takes one round of shards, `is` and
+//! `is-fails` one per round and one for the final stage; concatenation and `--resume` are
+//! the merge (`unforeseen merge` joins batch runs' units, whose files have no stages to
+//! walk).
 //!
 //! Outputs ([`output`]): `estimate.jsonl` (the run's identity, then one line per draw)
 //! and `summary.json` (the estimates, their intervals and diagnostics, the failure
-//! threshold), written together at the end; the draws stream to
-//! `estimate.jsonl.part` while the run lasts.
+//! threshold, the stages' mixture for `is` and `is-fails`), written together at the end;
+//! the draws stream to `estimate.jsonl.part` while the run lasts.
 
 pub mod estimators;
 pub mod output;
@@ -97,9 +113,9 @@ pub use output::{EstimateIdentity, Summary};
 pub use proposal::Proposal;
 pub use request::{EstimateJob, EstimateRequest, EstimateSetup, Estimator};
 
-/// Rounds of the cross-entropy stage of `is` (the first from the uniform cube).
+/// Rounds of the cross-entropy stage of `is` and `is-fails` (the first from the uniform cube).
 pub const ROUNDS: usize = 3;
-/// Fewest draws of one block (one round of `is`, one check of the stopping rule).
+/// Fewest draws of one block (one cross-entropy round, one check of the stopping rule).
 pub const MIN_BLOCK: usize = 50;
 /// Most draws one estimate may have.
 pub const MAX_BUDGET: usize = 1_000_000;
@@ -110,12 +126,12 @@ pub const MAX_BUDGET: usize = 1_000_000;
 pub enum DrawStage {
     /// A uniform draw of `mc`.
     Uniform,
-    /// Round `round` of the cross-entropy stage of `is`.
+    /// Round `round` of the cross-entropy stage of `is` or `is-fails`.
     Round {
         /// 0-based round.
         round: usize,
     },
-    /// The final, weighted stage of `is`.
+    /// The final stage of `is` or `is-fails`.
     Final,
 }
 
@@ -182,14 +198,21 @@ impl Draw {
         1.0 / self.density
     }
 
-    /// The cross-entropy stage's score, lower nearer a failure: minus the failed share
-    /// when an episode failed, else the smallest clearance; +∞ when unfair, rejected or
-    /// without a pedestrian.
-    pub fn score(&self) -> f64 {
-        if !self.fair() {
+    /// The cross-entropy stage's score, lower nearer a failure: +∞ when rejected; minus
+    /// the failed share when an episode failed. Otherwise, aiming at P(fails) (`is-fails`,
+    /// `fair_only` false), the smallest clearance car–pedestrian (+∞ without a
+    /// pedestrian); aiming at P(fails | fair) (`is`, `fair_only`), +∞ when unfair and 0
+    /// when fair, so that the elite is every fair draw until the fair failures alone fill
+    /// it (the levels "fair", then "fair and failed": on the jaywalk space the fair draws
+    /// that came closest did not lie where the fair failures lie, EXPERIMENTS.md, "How
+    /// rare is a failure").
+    pub fn score(&self, fair_only: bool) -> f64 {
+        if !self.valid() || (fair_only && !self.fair()) {
             f64::INFINITY
         } else if self.failed > 0 {
             -self.failed_share()
+        } else if fair_only {
+            0.0
         } else {
             self.min_clearance_m.unwrap_or(f64::INFINITY)
         }
@@ -208,8 +231,10 @@ pub struct Estimates {
 }
 
 impl Estimates {
-    /// `mc`'s estimates of uniform draws, or `is`'s of weighted final-stage draws.
-    pub fn of(estimator: Estimator, draws: &[Draw]) -> Estimates {
+    /// `mc`'s estimates of uniform draws, or those of `is` and `is-fails` of every stage's
+    /// draws, each weighted by one over the density of `mixture`, the stages' proposals
+    /// pooled ([`proposal::Mixture`]).
+    pub fn of(estimator: Estimator, draws: &[Draw], mixture: &proposal::Mixture) -> Estimates {
         let valid: Vec<&Draw> = draws.iter().filter(|d| d.valid()).collect();
         let fair: Vec<&Draw> = valid.iter().copied().filter(|d| d.fair()).collect();
         match estimator {
@@ -223,15 +248,16 @@ impl Estimates {
                     ),
                 }
             }
-            Estimator::Is => {
-                let weighted = |set: &[&Draw]| set.iter().map(|d| (d.weight(), d.failed_share())).collect::<Vec<_>>();
+            Estimator::Is | Estimator::IsFails => {
+                let weight = |d: &Draw| mixture.weight(&d.point);
+                let weighted = |set: &[&Draw]| set.iter().map(|d| (weight(d), d.failed_share())).collect::<Vec<_>>();
                 Estimates {
                     p_fail: estimators::importance(&weighted(&valid)),
                     p_fail_given_fair: estimators::importance(&weighted(&fair)),
                     fair_share: estimators::importance(
                         &valid
                             .iter()
-                            .map(|d| (d.weight(), f64::from(u8::from(d.fair()))))
+                            .map(|d| (weight(d), f64::from(u8::from(d.fair()))))
                             .collect::<Vec<_>>(),
                     ),
                 }
@@ -254,6 +280,9 @@ pub struct Outcome {
     pub estimates: Estimates,
     /// The proposal of the final stage (the uniform cube for `mc`).
     pub proposal: Proposal,
+    /// Every stage's proposal with its number of draws, whose mixture weighs the draws of
+    /// `is` and `is-fails` (none for `mc`).
+    pub mixture: Option<proposal::Mixture>,
     /// Whether the target was reached (else the budget was spent).
     pub reached: bool,
     /// The estimates after each block of the estimating stage, as the stopping rule saw them.
@@ -266,15 +295,16 @@ pub struct Outcome {
 pub struct Checkpoint {
     /// Draws evaluated so far (the cross-entropy rounds' included).
     pub evaluations: usize,
-    /// P(an episode fails) over the estimating stage's draws so far.
+    /// P(an episode fails) over the draws so far (`mc`'s; every stage's for `is` and
+    /// `is-fails`).
     pub p_fail: Estimate,
     /// P(fails | fair) over them.
     pub p_fail_given_fair: Estimate,
 }
 
 /// The sizes of the stages of `estimator` with `budget` draws: for `mc` its blocks;
-/// for `is` the cross-entropy rounds, then the final stage's blocks. Every block has
-/// at least [`MIN_BLOCK`] draws (`budget` at least [`Estimator::min_budget`]).
+/// for `is` and `is-fails` the cross-entropy rounds, then the final stage's blocks. Every
+/// block has at least [`MIN_BLOCK`] draws (`budget` at least [`Estimator::min_budget`]).
 pub fn blocks(estimator: Estimator, budget: usize) -> (Vec<usize>, Vec<usize>) {
     let split = |total: usize, size: usize| {
         let n = (total / size).max(1);
@@ -283,7 +313,7 @@ pub fn blocks(estimator: Estimator, budget: usize) -> (Vec<usize>, Vec<usize>) {
     let block = (budget / 20).max(MIN_BLOCK);
     match estimator {
         Estimator::Mc => (Vec::new(), split(budget, block)),
-        Estimator::Is => {
+        Estimator::Is | Estimator::IsFails => {
             let round = (budget / 10).max(MIN_BLOCK);
             let rest = budget - ROUNDS * round;
             (vec![round; ROUNDS], split(rest, block.min(rest)))
@@ -307,8 +337,8 @@ enum Ended {
 pub struct ShardPart {
     /// The shard.
     pub shard: Shard,
-    /// The stage it took its share of: a cross-entropy round of `is` whole, or the
-    /// estimating stage (`mc`'s uniform draws, `is`'s final ones) from its first block
+    /// The stage it took its share of: a cross-entropy round whole, or the estimating
+    /// stage (`mc`'s uniform draws, the final ones of `is` and `is-fails`) from its first block
     /// incomplete to the budget. None when the file holds every draw the estimate
     /// needs: a run without `--shard` finishes it with `--resume`.
     pub stage: Option<DrawStage>,
@@ -622,6 +652,7 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
         let (rounds, finals) = blocks(estimator, budget);
         let mut draws: Vec<Draw> = Vec::new();
         let mut proposal = Proposal::uniform();
+        let mut mixture = proposal::Mixture::default();
         for (round, size) in rounds.into_iter().enumerate() {
             let stage = DrawStage::Round { round };
             let range = draws.len()..draws.len() + size;
@@ -630,18 +661,21 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
             }
             draws.extend(run.block(&proposal, stage, range, None)?);
             check_fair_mass(&draws)?;
+            mixture.add(size, &proposal);
             let scored: Vec<proposal::Scored<'_>> = draws
                 .iter()
-                .map(|d| (d.point.as_slice(), d.weight(), d.score()))
+                .map(|d| {
+                    let score = d.score(estimator == Estimator::Is);
+                    (d.point.as_slice(), mixture.weight(&d.point), score)
+                })
                 .collect();
             proposal = proposal.refit(cfg.space, &scored);
         }
         let stage = match estimator {
             Estimator::Mc => DrawStage::Uniform,
-            Estimator::Is => DrawStage::Final,
+            Estimator::Is | Estimator::IsFails => DrawStage::Final,
         };
-        let first = draws.len();
-        let mut estimates = Estimates::of(estimator, &[]);
+        let mut estimates = Estimates::of(estimator, &[], &mixture);
         let mut reached = false;
         let mut checkpoints = Vec::new();
         for size in finals {
@@ -651,7 +685,8 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
             }
             draws.extend(run.block(&proposal, stage, range, None)?);
             check_fair_mass(&draws)?;
-            estimates = Estimates::of(estimator, &draws[first..]);
+            mixture.add(size, &proposal);
+            estimates = Estimates::of(estimator, &draws, &mixture);
             checkpoints.push(Checkpoint {
                 evaluations: draws.len(),
                 p_fail: estimates.p_fail.clone(),
@@ -676,6 +711,7 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
             draws,
             estimates,
             proposal,
+            mixture: estimator.weighted().then_some(mixture),
             reached,
             checkpoints,
         })))
@@ -754,7 +790,7 @@ mod tests {
             // scenario's episodes): near 1, or for `is` on its 50 final draws, a refusal.
             let e = &one.estimates.p_fail_given_fair;
             assert!(
-                e.p.is_some_and(|p| p > 0.8) || (estimator == Estimator::Is && e.refused.is_some()),
+                e.p.is_some_and(|p| p > 0.8) || (estimator.weighted() && e.refused.is_some()),
                 "{estimator}: {e:#?}"
             );
             // The defensive mixture bounds every weight by 1/α.
@@ -799,7 +835,8 @@ mod tests {
                 [output::DRAWS, output::SUMMARY].map(|f| std::fs::read(out.join(f)).unwrap())
             };
             request("whole", false).plan().unwrap().run(&[], &NoProgress).unwrap();
-            // Cancelled in the last block of 50 (for is, in its final draws, after three rounds).
+            // Cancelled in the last block of 50 (for is and is-fails, in its final draws, after
+            // three rounds whose refits the resumed run redoes from the kept draws).
             let cancel = CancelAfter(Default::default(), budget as u64 - 30);
             let e = request("cut", false).plan().unwrap().run(&[], &cancel).err().unwrap();
             assert!(matches!(e, Error::Interrupted), "{e}");

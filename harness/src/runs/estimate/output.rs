@@ -5,7 +5,9 @@
 //!   the method's episodes and failures, and their smallest margins;
 //! * `summary.json` ([`Summary`]): the estimand and the failure threshold, the three
 //!   estimates with their intervals and diagnostics, the evaluations, whether the target
-//!   was reached, the final proposal, and the estimates after each block (`checkpoints`).
+//!   was reached, the final proposal, for `is` and `is-fails` every stage's proposal with
+//!   its draws (`mixture`, which weighs the draws), and the estimates after each block
+//!   (`checkpoints`).
 //!
 //! While it runs, the draws go to `estimate.jsonl.part` as they come (what `--resume`
 //! reads after a kill), removed with the commit of the set. A shard writes
@@ -89,14 +91,19 @@ pub struct Summary {
     pub evaluations: usize,
     /// Of them, those that were no valid map.
     pub rejected: usize,
-    /// Draws the estimates are over (the final stage's for `is`, all for `mc`).
+    /// Draws the estimates are over: all (`is` and `is-fails` pool every stage's,
+    /// [`super::proposal::Mixture`]).
     pub estimate_draws: usize,
     /// Episodes of the method run, over all draws (the witnesses' come on top).
     pub method_episodes: u64,
     /// Whether both probabilities reached the target (else the budget was spent).
     pub target_reached: bool,
-    /// The proposal the estimates' draws came from.
+    /// The proposal of the last stage (the uniform cube for `mc`).
     pub proposal: Proposal,
+    /// `is`, `is-fails`: every stage's proposal with its number of draws; a draw's weight
+    /// is one over their mixture's density at its point (absent for `mc`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mixture: Option<super::proposal::Mixture>,
     /// The estimates after each block of the estimating stage.
     pub checkpoints: Vec<Checkpoint>,
 }
@@ -165,7 +172,6 @@ pub(super) fn write_all(
 ) -> Result<Summary, Error> {
     let run = identity(cfg, r);
     write_draws(&run, out, &outcome.draws)?;
-    let counted = |d: &&Draw| r.estimator == Estimator::Mc || d.stage == super::DrawStage::Final;
     let summary = Summary {
         schema: 1,
         run,
@@ -180,10 +186,11 @@ pub(super) fn write_all(
         estimates: outcome.estimates.clone(),
         evaluations: outcome.draws.len(),
         rejected: outcome.draws.iter().filter(|d| d.rejected.is_some()).count(),
-        estimate_draws: outcome.draws.iter().filter(counted).count(),
+        estimate_draws: outcome.draws.len(),
         method_episodes: outcome.draws.iter().map(|d| d.episodes).sum(),
         target_reached: outcome.reached,
         proposal: outcome.proposal.clone(),
+        mixture: outcome.mixture.clone(),
         checkpoints: outcome.checkpoints.clone(),
     };
     crate::files::write_json(&out.join(SUMMARY), &summary)?;

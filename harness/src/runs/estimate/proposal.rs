@@ -1,10 +1,19 @@
 //! The importance-sampling proposal over the space's unit cube: the uniform cube at
 //! first, then a defensive mixture (Hesterberg 1995) `q = α + (1 − α) ∏ f_d`, `α =`
-//! [`DEFENSIVE`], of one marginal per parameter (a normal truncated to [0, 1] for a range,
-//! cell probabilities spread evenly within each cell for a count or a choice), refitted
-//! by the cross-entropy method (Rubinstein 1999) to the draws with the smallest margins.
-//! The uniform part keeps every point of the cube in the proposal's support and bounds
-//! every weight `1/q` by `1/α`.
+//! [`DEFENSIVE`], of one marginal per parameter (uniform, a normal truncated to [0, 1] for
+//! a range, or cell probabilities spread evenly within each cell for a count or a choice),
+//! refitted by the cross-entropy method (Rubinstein 1999) to the draws with the smallest
+//! scores. A refit moves only the marginals whose elite departs from the uniform beyond
+//! its noise ([`MOVE_Z`] standard errors, at the elite's effective size); every other
+//! parameter stays uniform, so a 17-parameter space whose failures depend on three is
+//! fitted in three (a product of 17 refitted marginals makes weights vary in every
+//! dimension, noise included). The uniform part keeps every point of the cube in the
+//! proposal's support and bounds every weight `1/q` by `1/α`.
+//!
+//! The estimate pools every stage's draws ([`Mixture`]): a draw's weight is the target's
+//! density over the *mixture* of the proposals weighted by their numbers of draws (the
+//! balance heuristic of multiple importance sampling, Veach & Guibas 1995; Owen & Zhou
+//! 2000), bounded by the total draws over the uniform round's.
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -27,11 +36,19 @@ pub const SMOOTHING: f64 = 0.7;
 pub const MIN_SD: f64 = 0.05;
 /// Smallest probability of a cell.
 pub const MIN_CELL: f64 = 0.02;
+/// Standard errors by which an elite's marginal must depart from the uniform for a refit
+/// to move it (its mean, its spread, or a cell's frequency).
+pub const MOVE_Z: f64 = 3.0;
+/// The fourth central moment of the uniform interval minus its variance squared
+/// (`1/80 − 1/144`): `n` times the variance of the variance of `n` uniform points.
+const VAR_OF_VAR: f64 = 1.0 / 80.0 - 1.0 / 144.0;
 
 /// One parameter's part of a fitted proposal.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Marginal {
+    /// The uniform interval (the target's own marginal: weight 1).
+    Uniform,
     /// A normal (mean, standard deviation) truncated to [0, 1].
     Normal {
         /// Mean, on the unit interval.
@@ -83,37 +100,67 @@ impl Proposal {
 
     /// The cross-entropy refit to the elite of `scored`: the [`ELITE_SHARE`] of the draws
     /// with a finite score (at least [`MIN_ELITE`]; fewer: no refit), lowest first, ties
-    /// by order; each marginal moves [`SMOOTHING`] of the way to the elite's weighted
-    /// mean and standard deviation (or cell frequencies), floored at [`MIN_SD`] (or
-    /// [`MIN_CELL`]).
+    /// by order, and every failure (a negative score) when there are more (the multilevel
+    /// method's level: the elite's threshold is the larger of the quantile and the
+    /// failure level); every draw scoring the threshold joins. A parameter's marginal moves only when the elite's weighted
+    /// marginal departs from the uniform by more than [`MOVE_Z`] standard errors at the
+    /// elite's effective size (Kish's): its mean, its variance (smaller only) or a cell's
+    /// frequency; it then moves [`SMOOTHING`] of the way from the current marginal to the
+    /// elite's weighted mean and standard deviation (or cell frequencies), floored at
+    /// [`MIN_SD`] (or [`MIN_CELL`]). Any other marginal is the uniform.
     pub fn refit(&self, space: &Space, scored: &[Scored<'_>]) -> Proposal {
         let mut order: Vec<usize> = (0..scored.len()).filter(|&i| scored[i].2.is_finite()).collect();
         if order.len() < MIN_ELITE {
             return self.clone();
         }
         order.sort_by(|&a, &b| scored[a].2.total_cmp(&scored[b].2).then(a.cmp(&b)));
-        let n = ((order.len() as f64 * ELITE_SHARE).ceil() as usize).max(MIN_ELITE);
+        let failures = order.iter().filter(|&&i| scored[i].2 < 0.0).count();
+        let n = ((order.len() as f64 * ELITE_SHARE).ceil() as usize)
+            .max(MIN_ELITE)
+            .max(failures)
+            .min(order.len());
+        // Every draw at the threshold joins (the elite is {score ≤ γ}).
+        let threshold = scored[order[n - 1]].2;
+        let n = order.iter().take_while(|&&i| scored[i].2 <= threshold).count();
         let elite: Vec<(&[f64], f64)> = order[..n].iter().map(|&i| (scored[i].0, scored[i].1)).collect();
         let total: f64 = elite.iter().map(|e| e.1).sum();
+        let n_eff = total * total / elite.iter().map(|e| e.1 * e.1).sum::<f64>();
         let before = self.marginals.clone().unwrap_or_else(|| uniform_marginals(space));
-        let marginals = before
+        let marginals: Vec<Marginal> = before
             .into_iter()
             .enumerate()
-            .map(|(d, m)| match m {
-                Marginal::Normal { mean, sd } => {
+            .map(|(d, m)| match space.params[d].cells() {
+                None => {
                     let mu = elite.iter().map(|(x, w)| w * x[d]).sum::<f64>() / total;
                     let var = elite.iter().map(|(x, w)| w * (x[d] - mu).powi(2)).sum::<f64>() / total;
+                    let z_mean = (mu - 0.5) / (1.0 / 12.0 / n_eff).sqrt();
+                    let z_var = (var - 1.0 / 12.0) / (VAR_OF_VAR / n_eff).sqrt();
+                    if z_mean.abs() <= MOVE_Z && z_var >= -MOVE_Z {
+                        return Marginal::Uniform;
+                    }
+                    let (mean, sd) = match m {
+                        Marginal::Normal { mean, sd } => (mean, sd),
+                        _ => (0.5, (1.0f64 / 12.0).sqrt()),
+                    };
                     Marginal::Normal {
                         mean: SMOOTHING * mu + (1.0 - SMOOTHING) * mean,
                         sd: (SMOOTHING * var.sqrt() + (1.0 - SMOOTHING) * sd).max(MIN_SD),
                     }
                 }
-                Marginal::Cells(p) => {
-                    let k = p.len();
+                Some(k) => {
+                    let even = 1.0 / k as f64;
                     let mut freq = vec![0.0; k];
                     for (x, w) in &elite {
                         freq[cell(x[d], k)] += w / total;
                     }
+                    let noise = MOVE_Z * (even * (1.0 - even) / n_eff).sqrt();
+                    if freq.iter().all(|f| (f - even).abs() <= noise) {
+                        return Marginal::Cells(vec![even; k]);
+                    }
+                    let p = match m {
+                        Marginal::Cells(p) => p,
+                        _ => vec![even; k],
+                    };
                     let p: Vec<f64> = p
                         .iter()
                         .zip(freq)
@@ -124,23 +171,58 @@ impl Proposal {
                 }
             })
             .collect();
+        let moved = marginals.iter().any(|m| match m {
+            Marginal::Uniform => false,
+            Marginal::Normal { .. } => true,
+            Marginal::Cells(p) => p.iter().any(|&x| x != 1.0 / p.len() as f64),
+        });
         Proposal {
-            marginals: Some(marginals),
+            marginals: moved.then_some(marginals),
         }
     }
 }
 
-/// The marginals that start a refit: the uniform interval's mean and standard deviation
-/// for a range, even cells for a count or a choice.
+/// The proposals of an estimate's stages, each with its number of draws: the pooled draws
+/// are a stratified sample of their mixture `Σ n_k q_k / Σ n_k`, and each draw's weight
+/// is the target's density (1) over the mixture's.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Mixture {
+    /// Each proposal and its number of draws.
+    pub parts: Vec<(usize, Proposal)>,
+}
+
+impl Mixture {
+    /// Adds `n` draws of `q` (to its part when `q` is the last part's proposal).
+    pub fn add(&mut self, n: usize, q: &Proposal) {
+        match self.parts.last_mut() {
+            Some((m, last)) if last == q => *m += n,
+            _ => self.parts.push((n, q.clone())),
+        }
+    }
+
+    /// The mixture's density at `x` (1 with no part).
+    pub fn density(&self, x: &[f64]) -> f64 {
+        let total: usize = self.parts.iter().map(|p| p.0).sum();
+        if total == 0 {
+            return 1.0;
+        }
+        self.parts.iter().map(|(n, q)| *n as f64 * q.density(x)).sum::<f64>() / total as f64
+    }
+
+    /// The weight of a draw at `x`: one over the mixture's density.
+    pub fn weight(&self, x: &[f64]) -> f64 {
+        1.0 / self.density(x)
+    }
+}
+
+/// The marginals that start a refit: the uniform interval for a range, even cells for a
+/// count or a choice.
 fn uniform_marginals(space: &Space) -> Vec<Marginal> {
     space
         .params
         .iter()
         .map(|p| match p.domain {
-            Domain::Range(..) => Marginal::Normal {
-                mean: 0.5,
-                sd: (1.0f64 / 12.0).sqrt(),
-            },
+            Domain::Range(..) => Marginal::Uniform,
             _ => {
                 let k = p.cells().unwrap_or(1);
                 Marginal::Cells(vec![1.0 / k as f64; k])
@@ -163,6 +245,7 @@ fn truncated(mean: f64, sd: f64) -> (Normal, f64, f64) {
 
 fn marginal_density(m: &Marginal, u: f64) -> f64 {
     match m {
+        Marginal::Uniform => 1.0,
         Marginal::Normal { mean, sd } => {
             let (n, _, mass) = truncated(*mean, *sd);
             n.pdf(u) / mass
@@ -174,6 +257,7 @@ fn marginal_density(m: &Marginal, u: f64) -> f64 {
 fn marginal_draw(m: &Marginal, rng: &mut ChaCha8Rng) -> f64 {
     let u: f64 = rng.random_range(0.0..1.0);
     let x = match m {
+        Marginal::Uniform => u,
         // Inverse CDF within [0, 1].
         Marginal::Normal { mean, sd } => {
             let (n, lo, mass) = truncated(*mean, *sd);
@@ -225,5 +309,143 @@ mod tests {
         let mean_weight = draws.iter().map(|x| 1.0 / q.density(x)).sum::<f64>() / 4000.0;
         assert!((mean_weight - 1.0).abs() < 0.05, "{mean_weight}");
         assert_eq!(q.draw(7, "test", 3, 2), draws[3]);
+    }
+
+    fn space(params: &str) -> Space {
+        let base = crate::maps::load("jaywalk").unwrap();
+        let text = format!("Space(name: \"t\", params: [{params}])");
+        Space::parse("test", &text, &base).unwrap()
+    }
+
+    /// Two ranges and a choice of two.
+    fn three() -> Space {
+        space(
+            r#"(field: "pedestrians[0].trigger.value", range: (2.5, 6.5)),
+               (field: "vehicle.max_brake", range: (2.0, 5.0)),
+               (field: "pedestrians[0].side", choose: ["Near", "Far"])"#,
+        )
+    }
+
+    /// By hand: a mixture of 1 uniform draw and 3 of a proposal whose one marginal is a
+    /// normal (0.5, 0.1) truncated to [0, 1]: its mass in [0, 1] is Φ(5) − Φ(−5) ≈ 1, so at
+    /// 0.5 its density is 1/(0.1 √(2π)) = 3.98942, the proposal's 0.2 + 0.8 × 3.98942 =
+    /// 3.39154, and the mixture's (1 × 1 + 3 × 3.39154)/4 = 2.79365.
+    #[test]
+    fn the_mixture_density_is_the_draw_weighted_sum_by_hand() {
+        let q = Proposal {
+            marginals: Some(vec![Marginal::Normal { mean: 0.5, sd: 0.1 }]),
+        };
+        assert!((q.density(&[0.5]) - 3.391_54).abs() < 1e-5, "{}", q.density(&[0.5]));
+        let mut m = Mixture::default();
+        m.add(1, &Proposal::uniform());
+        m.add(2, &q);
+        m.add(1, &q);
+        assert_eq!(m.parts.len(), 2, "the same proposal's draws are one part");
+        assert!((m.density(&[0.5]) - 2.793_65).abs() < 1e-5, "{}", m.density(&[0.5]));
+        assert!((m.weight(&[0.5]) - 1.0 / 2.793_65).abs() < 1e-5);
+        // Truncation: the normal (0.9, 0.2) keeps Φ(0.5) − Φ(−4.5) = 0.691459 of its mass,
+        // so at 0.9 its density is 1.994711/0.691459 = 2.884786.
+        let t = Proposal {
+            marginals: Some(vec![Marginal::Normal { mean: 0.9, sd: 0.2 }]),
+        };
+        assert!(
+            (t.density(&[0.9]) - (0.2 + 0.8 * 2.884_786)).abs() < 1e-5,
+            "{}",
+            t.density(&[0.9])
+        );
+        // A uniform marginal is the cube's own: the density stays 1.
+        let u = Proposal {
+            marginals: Some(vec![Marginal::Uniform, Marginal::Cells(vec![0.5, 0.5])]),
+        };
+        assert_eq!(u.density(&[0.3, 0.7]), 1.0);
+        assert_eq!(Mixture::default().density(&[0.3]), 1.0);
+    }
+
+    /// Parameters the elite does not depend on stay uniform; one it depends on moves.
+    #[test]
+    fn a_refit_moves_only_the_marginals_the_elite_departs_in() {
+        let space = three();
+        // 400 draws of a uniform grid-like sequence; a failure wherever trigger < 0.1.
+        let points: Vec<Vec<f64>> = (0..400)
+            .map(|i| {
+                let q = Proposal::uniform();
+                q.draw(3, "refit", i, 3)
+            })
+            .collect();
+        let scored: Vec<Scored<'_>> = points
+            .iter()
+            .map(|x| (x.as_slice(), 1.0, if x[0] < 0.1 { -1.0 } else { 1.0 + x[0] }))
+            .collect();
+        let q = Proposal::uniform().refit(&space, &scored);
+        let ms = q.marginals.expect("the trigger moved");
+        match ms[0] {
+            Marginal::Normal { mean, .. } => assert!(mean < 0.2, "{mean}"),
+            ref m => panic!("{m:?}"),
+        }
+        assert_eq!(ms[1], Marginal::Uniform);
+        assert_eq!(ms[2], Marginal::Cells(vec![0.5, 0.5]));
+        // Scores that depend on nothing: no marginal moves, the proposal stays the cube.
+        let flat: Vec<Scored<'_>> = points
+            .iter()
+            .enumerate()
+            .map(|(i, x)| (x.as_slice(), 1.0, ((i * 7919) % 400) as f64))
+            .collect();
+        assert_eq!(Proposal::uniform().refit(&space, &flat), Proposal::uniform());
+    }
+
+    /// The elite is every failure when they outnumber the quantile, and every draw tied
+    /// at the threshold: with 30 failures among 100 (over 10%) the refit fits the 30.
+    #[test]
+    fn the_elite_is_every_failure_and_every_tie() {
+        let space = three();
+        let points: Vec<Vec<f64>> = (0..100).map(|i| vec![(i as f64 + 0.5) / 100.0, 0.5, 0.25]).collect();
+        let failing: Vec<Scored<'_>> = points
+            .iter()
+            .map(|x| (x.as_slice(), 1.0, if x[0] < 0.3 { -1.0 } else { 1.0 }))
+            .collect();
+        let q = Proposal::uniform().refit(&space, &failing);
+        // The 30 failures' mean is 0.15: the marginal moves 0.7 of the way from 0.5.
+        match q.marginals.unwrap()[0] {
+            Marginal::Normal { mean, .. } => assert!((mean - (0.7 * 0.15 + 0.3 * 0.5)).abs() < 1e-9, "{mean}"),
+            ref m => panic!("{m:?}"),
+        }
+        // No failure, 60 draws tied at 0 (the fair ones, for `is`): all 60 are the elite.
+        let tied: Vec<Scored<'_>> = points
+            .iter()
+            .map(|x| (x.as_slice(), 1.0, if x[0] >= 0.4 { 0.0 } else { f64::INFINITY }))
+            .collect();
+        match Proposal::uniform().refit(&space, &tied).marginals.unwrap()[0] {
+            Marginal::Normal { mean, .. } => assert!((mean - (0.7 * 0.7 + 0.3 * 0.5)).abs() < 1e-9, "{mean}"),
+            ref m => panic!("{m:?}"),
+        }
+    }
+
+    proptest::proptest! {
+        /// Under any fitted proposal, the weights of its own draws average to 1 (the
+        /// cube's volume), and so do the mixture weights of draws from the mixture.
+        #[test]
+        fn weights_average_to_one_under_the_proposal(
+            mean in 0.0f64..1.0,
+            sd in MIN_SD..0.5,
+            p0 in 0.05f64..0.95,
+            seed in 0u64..1000,
+        ) {
+            let q = Proposal {
+                marginals: Some(vec![Marginal::Normal { mean, sd }, Marginal::Cells(vec![p0, 1.0 - p0]), Marginal::Uniform]),
+            };
+            let n = 4000;
+            let own = (0..n).map(|i| 1.0 / q.density(&q.draw(seed, "p", i, 3))).sum::<f64>() / n as f64;
+            proptest::prop_assert!((own - 1.0).abs() < 0.08, "{}", own);
+            let mut m = Mixture::default();
+            m.add(n / 4, &Proposal::uniform());
+            m.add(3 * n / 4, &q);
+            let pooled = (0..n / 4)
+                .map(|i| Proposal::uniform().draw(seed, "u", i, 3))
+                .chain((0..3 * n / 4).map(|i| q.draw(seed, "q", i, 3)))
+                .map(|x| m.weight(&x))
+                .sum::<f64>()
+                / n as f64;
+            proptest::prop_assert!((pooled - 1.0).abs() < 0.05, "{}", pooled);
+        }
     }
 }

@@ -25,19 +25,27 @@ use super::{MAX_BUDGET, MIN_BLOCK, ROUNDS, Report};
 pub enum Estimator {
     /// Plain Monte Carlo, the reference.
     Mc,
-    /// Cross-entropy importance sampling.
+    /// Cross-entropy importance sampling aimed at failures on fair scenarios (P(fails | fair)).
     Is,
+    /// Cross-entropy importance sampling aimed at failures on any scenario (P(fails)).
+    IsFails,
 }
 
 impl Estimator {
     /// Every estimator.
-    pub const ALL: [Estimator; 2] = [Estimator::Mc, Estimator::Is];
+    pub const ALL: [Estimator; 3] = [Estimator::Mc, Estimator::Is, Estimator::IsFails];
 
-    /// Its name (`mc`, `is`).
+    /// Whether it samples by importance (`is`, `is-fails`).
+    pub fn weighted(self) -> bool {
+        self != Estimator::Mc
+    }
+
+    /// Its name (`mc`, `is`, `is-fails`).
     pub fn name(self) -> &'static str {
         match self {
             Estimator::Mc => "mc",
             Estimator::Is => "is",
+            Estimator::IsFails => "is-fails",
         }
     }
 
@@ -45,7 +53,13 @@ impl Estimator {
     pub fn summary(self) -> &'static str {
         match self {
             Estimator::Mc => "plain Monte Carlo: uniform draws, Wilson interval",
-            Estimator::Is => "cross-entropy importance sampling toward small margins, weighted interval",
+            Estimator::Is => {
+                "cross-entropy importance sampling toward failures on fair scenarios (P(fails | fair)), \
+                 weighted interval"
+            }
+            Estimator::IsFails => {
+                "cross-entropy importance sampling toward failures on any scenario (P(fails)), weighted interval"
+            }
         }
     }
 
@@ -54,7 +68,7 @@ impl Estimator {
     pub fn min_budget(self) -> usize {
         match self {
             Estimator::Mc => MIN_BLOCK,
-            Estimator::Is => (ROUNDS + 1) * MIN_BLOCK,
+            Estimator::Is | Estimator::IsFails => (ROUNDS + 1) * MIN_BLOCK,
         }
     }
 }
@@ -71,7 +85,7 @@ impl std::str::FromStr for Estimator {
         Estimator::ALL
             .into_iter()
             .find(|e| e.name() == s)
-            .ok_or_else(|| format!("unknown estimator '{s}': expected mc or is"))
+            .ok_or_else(|| format!("unknown estimator '{s}': expected mc, is or is-fails"))
     }
 }
 
@@ -297,7 +311,7 @@ mod tests {
         assert!(e.to_string().contains("50"), "{e}");
         assert_eq!(
             "splitting".parse::<Estimator>().unwrap_err(),
-            "unknown estimator 'splitting': expected mc or is"
+            "unknown estimator 'splitting': expected mc, is or is-fails"
         );
         let e = EstimateRequest::default().setup().unwrap_err();
         assert!(e.to_string().starts_with("space: "), "{e}");
