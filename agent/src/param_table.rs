@@ -157,7 +157,7 @@ mod tests {
         for (i, k) in names.iter().enumerate() {
             assert!(!names[..i].contains(k), "key {k} twice");
         }
-        assert_eq!(names.len(), 35);
+        assert_eq!(names.len(), 37);
         for k in keys() {
             if matches!(k.kind, ValueKind::Number | ValueKind::Whole) {
                 assert!(k.bound.is_some(), "{} has no range", k.name);
