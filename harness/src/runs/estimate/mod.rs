@@ -413,9 +413,9 @@ impl Run<'_, '_> {
             }
         }
         let name = match stage {
-            DrawStage::Uniform => "estimate mc".to_string(),
-            DrawStage::Round { round } => format!("estimate is round {}", round + 1),
-            DrawStage::Final => "estimate is final".to_string(),
+            DrawStage::Uniform => "estimate: uniform draws".to_string(),
+            DrawStage::Round { round } => format!("estimate: cross-entropy round {}", round + 1),
+            DrawStage::Final => "estimate: weighted draws".to_string(),
         };
         self.progress.phase(&name, fresh.len() as u64);
         let done = match self.remote {
