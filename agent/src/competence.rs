@@ -28,6 +28,10 @@
 //! planner's, since it costs `U H_c` predictions, not `U + U² + … + U^H`: long enough to
 //! see the goal from a standstill before the crosswalk.
 //!
+//! With `competence_rollout = feedback` the habit's own score is the better of holding its
+//! action and following it (its action for `competence_commit` ticks, then its action in
+//! each predicted state, [`Competence::followed_efe`]); the alternatives stay held.
+//!
 //! The models change only where test-time learning ends an episode, so for a one-hot belief
 //! (an identity `A`, the MDP of §VI) the held scores are kept per state until then
 //! ([`Competence::invalidate`]).

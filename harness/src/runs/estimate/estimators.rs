@@ -103,14 +103,8 @@ pub fn monte_carlo(ys: &[f64]) -> Estimate {
     if n == 0 {
         return Estimate::refused(0, KIND, "no draw in the set".into());
     }
-    let (nf, p) = (n as f64, ys.iter().sum::<f64>() / n as f64);
-    let z2 = Z95 * Z95;
-    let denom = 1.0 + z2 / nf;
-    let centre = (p + z2 / (2.0 * nf)) / denom;
-    let half = Z95 * (p * (1.0 - p) / nf + z2 / (4.0 * nf * nf)).sqrt() / denom;
-    // At p = 0 (or 1) the interval's end is exactly 0 (or 1); rounding would leave 1e-18.
-    let low = if p == 0.0 { 0.0 } else { centre - half };
-    let high = if p == 1.0 { 1.0 } else { centre + half };
+    let p = ys.iter().sum::<f64>() / n as f64;
+    let (low, high) = wilson(p, n as f64);
     Estimate::with(p, low, high, n, KIND)
 }
 
@@ -174,7 +168,8 @@ pub fn importance(samples: &[(f64, f64)]) -> Estimate {
 }
 
 /// The 95% Wilson score interval of a proportion `p` observed in `n` (not necessarily
-/// whole) draws; its ends are exactly 0 at `p = 0` and 1 at `p = 1`.
+/// whole) draws; its ends are exactly 0 at `p = 0` and 1 at `p = 1` (rounding would leave
+/// 1e-18).
 pub fn wilson(p: f64, n: f64) -> (f64, f64) {
     let z2 = Z95 * Z95;
     let denom = 1.0 + z2 / n;
