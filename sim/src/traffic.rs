@@ -517,6 +517,15 @@ impl Traffic {
         }
     }
 
+    /// Every vehicle's collider with its velocity (its speed along its heading), for the
+    /// margins ([`crate::margins`]).
+    pub fn movers(&self) -> impl Iterator<Item = (ColliderHandle, Vector)> + '_ {
+        self.others.iter().map(|o| {
+            let (_, u) = o.front();
+            (o.collider, Vector::new((u.0 * o.v) as Real, (u.1 * o.v) as Real))
+        })
+    }
+
     /// Whether the collider `car` overlaps a vehicle's on the current poses (parry's
     /// intersection test, as for pedestrians).
     pub fn hits(&self, phys: &PhysicsWorld, car: ColliderHandle) -> bool {

@@ -11,7 +11,7 @@ use crate::draw::uniform;
 use crate::dynamics::{Drivetrain, Pedal};
 use crate::light::{LightPhase, light_at};
 use crate::map::{Dynamics, LightCondition, Map, Offset, Pause, Side, SurfacePatch, Trigger};
-use crate::margins::Margins;
+use crate::margins::{Margins, Measure};
 use crate::signals::{Aspect, Controller, SignalState, TriggerView};
 use crate::traffic::{Body, Traffic, VehicleSnapshot};
 
@@ -215,7 +215,7 @@ pub struct World {
     /// Which of `road.surface` lie on the road now (a triggered patch appears later).
     surface_on: Vec<bool>,
     /// The episode's margins so far, when measured ([`World::measure_margins`]).
-    margins: Option<Margins>,
+    margins: Option<Measure>,
 }
 
 impl World {
@@ -291,12 +291,12 @@ impl World {
     /// Measures the episode's margins after every sub-step from now on
     /// ([`crate::margins`]); they change nothing in the episode.
     pub fn measure_margins(&mut self) {
-        self.margins.get_or_insert_with(Margins::default);
+        self.margins.get_or_insert_with(Measure::default);
     }
 
     /// The episode's smallest margins so far (none unless [`World::measure_margins`]).
     pub fn margins(&self) -> Option<Margins> {
-        self.margins
+        self.margins.as_ref().map(Measure::margins)
     }
 
     /// The surface patches on the road now, in the map's order (a later one lies over
@@ -458,29 +458,36 @@ impl World {
         })
     }
 
-    /// Takes in this sub-step's margins of every pedestrian ([`crate::margins`]), when
-    /// measured: the clearance of the colliders on the current poses, and on a collision
-    /// course within the episode's remaining time its time-to-collision and stopping
-    /// margin.
+    /// Takes in this sub-step's margins of every pedestrian and vehicle
+    /// ([`crate::margins`]), when measured: the clearance of the colliders on the current
+    /// poses, on a collision course within the episode's remaining time its
+    /// time-to-collision and stopping margin, and the tracks of the post-encroachment time.
     fn measure(&mut self) {
-        let Some(mut margins) = self.margins else { return };
+        let Some(mut measure) = self.margins.take() else { return };
         let car = &self.phys.colliders[self.car_collider];
         let speed = self.car_speed();
         let stop = crate::dynamics::stopping_distance(&self.map.vehicle, speed, self.car_friction());
+        let now = self.time_at(self.substep);
         let episode_end = f64::from(self.map.episode.max_steps) * self.map.episode.decision_dt;
-        let horizon = (episode_end - self.time_at(self.substep)).max(0.0) as Real;
+        let horizon = (episode_end - now).max(0.0) as Real;
         let car_velocity = Vector::new(speed as Real, 0.0);
-        for p in &self.peds {
-            let ped = &self.phys.colliders[p.collider];
-            let Ok(clearance) =
-                rapier2d::parry::query::distance(car.position(), car.shape(), ped.position(), ped.shape())
-            else {
-                continue;
-            };
+        let (lane, half_width) = (self.map.road.car_lane_y(), self.map.vehicle.width / 2.0);
+        measure.car_at(now, self.car_front());
+        let peds = self.peds.iter().map(|p| {
             let walking = if p.moving && p.pause_left <= 0.0 {
                 p.dir * p.speed
             } else {
                 0.0
+            };
+            (false, p.collider, Vector::new(0.0, walking as Real))
+        });
+        let vehicles = self.traffic.movers().map(|(c, v)| (true, c, v));
+        for (vehicle, handle, velocity) in peds.chain(vehicles) {
+            let other = &self.phys.colliders[handle];
+            let Ok(clearance) =
+                rapier2d::parry::query::distance(car.position(), car.shape(), other.position(), other.shape())
+            else {
+                continue;
             };
             let options = rapier2d::parry::query::ShapeCastOptions {
                 stop_at_penetration: true,
@@ -490,18 +497,24 @@ impl World {
                 car.position(),
                 car_velocity,
                 car.shape(),
-                ped.position(),
-                Vector::new(0.0, walking as Real),
-                ped.shape(),
+                other.position(),
+                velocity,
+                other.shape(),
                 options,
             );
             let course = hit.ok().flatten().map(|h| {
                 let ttc = f64::from(h.time_of_impact);
                 (ttc, speed * ttc - stop)
             });
-            margins.record(f64::from(clearance.distance), course);
+            measure.record(vehicle, f64::from(clearance.distance), course);
+            if let Some(ball) = other.shape().as_ball().filter(|_| !vehicle) {
+                let at = other.position().translation;
+                let gap = ((f64::from(at.y) - lane).abs() - half_width).max(0.0);
+                let radius = f64::from(ball.radius);
+                measure.pedestrian_at(now, f64::from(at.x), gap, radius, self.map.vehicle.length);
+            }
         }
-        self.margins = Some(margins);
+        self.margins = Some(measure);
     }
 
     /// Velocity control for sub-step `k` (1-based) of a tick that began at

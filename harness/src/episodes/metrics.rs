@@ -43,21 +43,56 @@ pub struct Aggregate {
     pub us_per_tick: f64,
     /// Mean wall-clock microseconds per reasoning tick (0 when none reasoned).
     pub us_per_reasoning_tick: f64,
-    /// Smallest clearance between the car and a pedestrian over the episodes, m (none
-    /// when no pedestrian appeared in any).
+    /// How close the episodes came to a collision.
+    #[serde(flatten)]
+    pub margins: MarginFigures,
+}
+
+/// The smallest margins over a set of episodes (docs/ARCHITECTURE.md §2, "Margins";
+/// [`unforeseen_sim::margins`]), as the batch's and search's lines carry them. Each
+/// smallest is none (null) when no episode had one. Files written before a key existed
+/// read it as none.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MarginFigures {
+    /// Smallest clearance between the car and a pedestrian, m.
     #[serde(default)]
     pub min_clearance_m: Option<f64>,
-    /// Smallest time-to-collision over the episodes, s (none when no episode was on a
-    /// collision course).
+    /// Smallest time-to-collision with a pedestrian or a vehicle, s.
     #[serde(default)]
     pub min_ttc_s: Option<f64>,
-    /// Smallest stopping margin over the episodes, m (none as for the TTC).
+    /// Smallest stopping margin on a collision course, m (negative: the car could no
+    /// longer have stopped short of the other's path).
     #[serde(default)]
     pub min_stop_margin_m: Option<f64>,
     /// Share of episodes in which braking could have stopped the car short of every
     /// collision course it was on.
     #[serde(default)]
     pub could_stop_rate: f64,
+    /// Smallest clearance between the car and another vehicle, m.
+    #[serde(default)]
+    pub min_vehicle_clearance_m: Option<f64>,
+    /// Smallest post-encroachment time car–pedestrian, s.
+    #[serde(default)]
+    pub min_pet_s: Option<f64>,
+}
+
+impl MarginFigures {
+    /// The smallest margins of `results` (the default for an empty slice).
+    pub fn of(results: &[EpisodeResult]) -> MarginFigures {
+        if results.is_empty() {
+            return MarginFigures::default();
+        }
+        let least = |f: &dyn Fn(&EpisodeResult) -> Option<f64>| results.iter().filter_map(f).reduce(f64::min);
+        let could_stop = results.iter().filter(|r| r.could_stop()).count();
+        MarginFigures {
+            min_clearance_m: least(&|r| r.min_clearance),
+            min_ttc_s: least(&|r| r.min_ttc),
+            min_stop_margin_m: least(&|r| r.min_stop_margin),
+            could_stop_rate: could_stop as f64 / results.len() as f64,
+            min_vehicle_clearance_m: least(&|r| r.min_vehicle_clearance),
+            min_pet_s: least(&|r| r.min_pet),
+        }
+    }
 }
 
 impl Aggregate {
@@ -72,7 +107,6 @@ impl Aggregate {
         let reasoning: u64 = results.iter().map(|r| u64::from(r.reasoning_ticks)).sum();
         let decide_ns: u64 = results.iter().map(|r| r.decide_ns).sum();
         let reasoning_ns: u64 = results.iter().map(|r| r.reasoning_ns).sum();
-        let least = |f: &dyn Fn(&EpisodeResult) -> Option<f64>| results.iter().filter_map(f).reduce(f64::min);
         Self {
             episodes: n,
             mean_reward: results.iter().map(|r| r.ret).sum::<f64>() / n as f64,
@@ -96,10 +130,7 @@ impl Aggregate {
             } else {
                 reasoning_ns as f64 / reasoning as f64 / 1e3
             },
-            min_clearance_m: least(&|r| r.min_clearance),
-            min_ttc_s: least(&|r| r.min_ttc),
-            min_stop_margin_m: least(&|r| r.min_stop_margin),
-            could_stop_rate: share(&|r| r.could_stop()),
+            margins: MarginFigures::of(results),
         }
     }
 }
@@ -119,6 +150,8 @@ mod tests {
             decide_ns: 10_000,
             reasoning_ns: 9_000,
             min_clearance: Some(1.5),
+            min_pet: Some(3.0),
+            min_vehicle_clearance: Some(7.0),
             ..Default::default()
         };
         let b = EpisodeResult {
@@ -130,6 +163,7 @@ mod tests {
             min_clearance: Some(0.0),
             min_ttc: Some(0.0),
             min_stop_margin: Some(-2.0),
+            min_pet: Some(0.0),
             ..Default::default()
         };
         let agg = Aggregate::of(&[a, b]);
@@ -143,11 +177,13 @@ mod tests {
         assert_eq!(agg.mean_ticks, 7.0);
         assert!((agg.us_per_tick - 1.0).abs() < 1e-12);
         assert!((agg.us_per_reasoning_tick - 1.8).abs() < 1e-12);
+        let m = &agg.margins;
         assert_eq!(
-            (agg.min_clearance_m, agg.min_ttc_s, agg.min_stop_margin_m),
+            (m.min_clearance_m, m.min_ttc_s, m.min_stop_margin_m),
             (Some(0.0), Some(0.0), Some(-2.0))
         );
-        assert_eq!(agg.could_stop_rate, 0.5);
+        assert_eq!((m.min_vehicle_clearance_m, m.min_pet_s), (Some(7.0), Some(0.0)));
+        assert_eq!(m.could_stop_rate, 0.5);
         assert_eq!(Aggregate::of(&[]), Aggregate::default());
     }
 }

@@ -77,6 +77,14 @@ pub struct EpisodeResult {
     /// less the stopping distance (negative: the car could no longer have stopped).
     #[serde(default)]
     pub min_stop_margin: Option<f64>,
+    /// Smallest clearance between the car's collider and another vehicle's, m (none when
+    /// no vehicle appeared).
+    #[serde(default)]
+    pub min_vehicle_clearance: Option<f64>,
+    /// Smallest post-encroachment time car–pedestrian, s (none when no pedestrian's path
+    /// met the car's).
+    #[serde(default)]
+    pub min_pet: Option<f64>,
 }
 
 impl EpisodeResult {
@@ -165,6 +173,7 @@ pub fn run_episode(
             result.timeout = events.timeout;
             if let Some(m) = env.margins() {
                 (result.min_clearance, result.min_ttc, result.min_stop_margin) = (m.clearance, m.ttc, m.stop_margin);
+                (result.min_vehicle_clearance, result.min_pet) = (m.vehicle_clearance, m.pet);
             }
             if record {
                 // The terminal frame, for the filmstrip.

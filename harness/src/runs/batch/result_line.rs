@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::episodes::metrics::Aggregate;
+use crate::episodes::metrics::{Aggregate, MarginFigures};
 use crate::episodes::protocol::Protocol;
 
 use super::expectations::Check;
@@ -57,22 +57,9 @@ pub struct ResultLine {
     /// The map's expectations for this method and protocol, checked on this agent alone
     /// (the gate is the check on the mean over training seeds, in the summary).
     pub checks: Vec<Check>,
-    /// Smallest clearance between the car and a pedestrian over the episodes, m
-    /// (docs/ARCHITECTURE.md §2, "Margins"; null when no pedestrian appeared).
-    #[serde(default)]
-    pub min_clearance_m: Option<f64>,
-    /// Smallest time-to-collision over the episodes, s (null when never on a collision
-    /// course).
-    #[serde(default)]
-    pub min_ttc_s: Option<f64>,
-    /// Smallest stopping margin over the episodes, m (negative: the car could no longer
-    /// have stopped short of a pedestrian's path; null as for the TTC).
-    #[serde(default)]
-    pub min_stop_margin_m: Option<f64>,
-    /// Share of episodes in which braking could have stopped the car short of every
-    /// collision course it was on.
-    #[serde(default)]
-    pub could_stop_rate: f64,
+    /// How close the episodes came to a collision (docs/ARCHITECTURE.md §2, "Margins").
+    #[serde(flatten)]
+    pub margins: MarginFigures,
     /// Wall-clock µs per decision tick (the only field that varies between identical runs).
     pub timing_us_per_tick: f64,
     /// For a stream scenario, the figures of each map within the stream that episodes ran
@@ -106,22 +93,9 @@ pub struct MapFigures {
     pub efe_matvecs_per_tick: f64,
     /// Mean decision ticks per episode.
     pub mean_ticks: f64,
-    /// Smallest clearance between the car and a pedestrian over the episodes, m
-    /// (docs/ARCHITECTURE.md §2, "Margins"; null when no pedestrian appeared).
-    #[serde(default)]
-    pub min_clearance_m: Option<f64>,
-    /// Smallest time-to-collision over the episodes, s (null when never on a collision
-    /// course).
-    #[serde(default)]
-    pub min_ttc_s: Option<f64>,
-    /// Smallest stopping margin over the episodes, m (negative: the car could no longer
-    /// have stopped short of a pedestrian's path; null as for the TTC).
-    #[serde(default)]
-    pub min_stop_margin_m: Option<f64>,
-    /// Share of episodes in which braking could have stopped the car short of every
-    /// collision course it was on.
-    #[serde(default)]
-    pub could_stop_rate: f64,
+    /// How close its episodes came to a collision.
+    #[serde(flatten)]
+    pub margins: MarginFigures,
     /// Wall-clock µs per decision tick.
     pub timing_us_per_tick: f64,
 }
@@ -189,10 +163,7 @@ impl ResultLine {
             efe_matvecs_per_tick: agg.inference_rate * reasoning_tree as f64,
             mean_ticks: agg.mean_ticks,
             checks,
-            min_clearance_m: agg.min_clearance_m,
-            min_ttc_s: agg.min_ttc_s,
-            min_stop_margin_m: agg.min_stop_margin_m,
-            could_stop_rate: agg.could_stop_rate,
+            margins: agg.margins.clone(),
             timing_us_per_tick: agg.us_per_tick,
             per_map,
         }
@@ -214,10 +185,7 @@ impl MapFigures {
             inference_rate: agg.inference_rate,
             efe_matvecs_per_tick: agg.inference_rate * reasoning_tree as f64,
             mean_ticks: agg.mean_ticks,
-            min_clearance_m: agg.min_clearance_m,
-            min_ttc_s: agg.min_ttc_s,
-            min_stop_margin_m: agg.min_stop_margin_m,
-            could_stop_rate: agg.could_stop_rate,
+            margins: agg.margins.clone(),
             timing_us_per_tick: agg.us_per_tick,
         }
     }
@@ -239,10 +207,7 @@ impl ResultLine {
             inference_rate: f.inference_rate,
             efe_matvecs_per_tick: f.efe_matvecs_per_tick,
             mean_ticks: f.mean_ticks,
-            min_clearance_m: f.min_clearance_m,
-            min_ttc_s: f.min_ttc_s,
-            min_stop_margin_m: f.min_stop_margin_m,
-            could_stop_rate: f.could_stop_rate,
+            margins: f.margins.clone(),
             timing_us_per_tick: f.timing_us_per_tick,
             checks: Vec::new(),
             per_map: Vec::new(),

@@ -10,6 +10,7 @@ use super::identity::{IdentityLine, RunIdentity};
 use super::result_line::ResultLine;
 use super::scenario::Scenario;
 use super::units::Unit;
+use crate::episodes::metrics::MarginFigures;
 
 /// A result line read back from a results file, with its text as written.
 #[derive(Debug, Clone, PartialEq)]
@@ -222,13 +223,7 @@ pub(crate) fn figures_problem(l: &ResultLine) -> Option<String> {
         [l.efe_matvecs_per_tick, l.mean_ticks, l.timing_us_per_tick],
         l.mean_reward,
     )
-    .or_else(|| {
-        margins_problem(
-            "",
-            [l.min_clearance_m, l.min_ttc_s, l.min_stop_margin_m],
-            l.could_stop_rate,
-        )
-    });
+    .or_else(|| margins_problem("", &l.margins));
     if own.is_some() {
         return own;
     }
@@ -248,22 +243,22 @@ pub(crate) fn figures_problem(l: &ResultLine) -> Option<String> {
             [f.efe_matvecs_per_tick, f.mean_ticks, f.timing_us_per_tick],
             f.mean_reward,
         )
-        .or_else(|| {
-            margins_problem(
-                &format!("per_map {}: ", f.map),
-                [f.min_clearance_m, f.min_ttc_s, f.min_stop_margin_m],
-                f.could_stop_rate,
-            )
-        })
+        .or_else(|| margins_problem(&format!("per_map {}: ", f.map), &f.margins))
     })
 }
 
 /// What is wrong with a line's (or one of its maps', `prefix`) margins
-/// (docs/ARCHITECTURE.md §2, "Margins"): the clearance and the TTC, where given, outside
-/// [0, [`MAX_FIGURE`]], the stopping margin not finite within ±[`MAX_FIGURE`], or the
-/// share that could stop outside [0, 1].
-fn margins_problem(prefix: &str, [clearance, ttc, stop]: [Option<f64>; 3], could_stop: f64) -> Option<String> {
-    for (name, x) in [("min_clearance_m", clearance), ("min_ttc_s", ttc)] {
+/// (docs/ARCHITECTURE.md §2, "Margins"): the clearances, the TTC and the PET, where given,
+/// outside [0, [`MAX_FIGURE`]], the stopping margin not finite within ±[`MAX_FIGURE`], or
+/// the share that could stop outside [0, 1].
+fn margins_problem(prefix: &str, m: &MarginFigures) -> Option<String> {
+    let (stop, could_stop) = (m.min_stop_margin_m, m.could_stop_rate);
+    for (name, x) in [
+        ("min_clearance_m", m.min_clearance_m),
+        ("min_vehicle_clearance_m", m.min_vehicle_clearance_m),
+        ("min_ttc_s", m.min_ttc_s),
+        ("min_pet_s", m.min_pet_s),
+    ] {
         if let Some(x) = x.filter(|x| !(0.0..=MAX_FIGURE).contains(x)) {
             return Some(format!("has {prefix}{name} {x}, outside [0, {MAX_FIGURE:e}]"));
         }
@@ -306,12 +301,29 @@ mod tests {
 
     #[test]
     fn margins_out_of_their_ranges_are_named() {
-        assert_eq!(margins_problem("", [Some(2.3), None, Some(-4.0)], 0.5), None);
-        assert_eq!(margins_problem("", [None, None, None], 1.0), None);
-        let named = |m: [Option<f64>; 3], share: f64| margins_problem("p: ", m, share).unwrap_or_default();
-        assert!(named([Some(-0.1), None, None], 1.0).contains("p: min_clearance_m -0.1"));
-        assert!(named([None, Some(f64::NAN), None], 1.0).contains("min_ttc_s NaN"));
-        assert!(named([None, None, Some(f64::INFINITY)], 1.0).contains("min_stop_margin_m inf"));
-        assert!(named([None, None, None], 1.5).contains("could_stop_rate 1.5"));
+        let m = |clearance, ttc, stop, could_stop_rate| MarginFigures {
+            min_clearance_m: clearance,
+            min_ttc_s: ttc,
+            min_stop_margin_m: stop,
+            could_stop_rate,
+            ..MarginFigures::default()
+        };
+        assert_eq!(margins_problem("", &m(Some(2.3), None, Some(-4.0), 0.5)), None);
+        assert_eq!(margins_problem("", &m(None, None, None, 1.0)), None);
+        let named = |m: MarginFigures| margins_problem("p: ", &m).unwrap_or_default();
+        assert!(named(m(Some(-0.1), None, None, 1.0)).contains("p: min_clearance_m -0.1"));
+        assert!(named(m(None, Some(f64::NAN), None, 1.0)).contains("min_ttc_s NaN"));
+        assert!(named(m(None, None, Some(f64::INFINITY), 1.0)).contains("min_stop_margin_m inf"));
+        assert!(named(m(None, None, None, 1.5)).contains("could_stop_rate 1.5"));
+        let pet = MarginFigures {
+            min_pet_s: Some(-1.0),
+            ..MarginFigures::default()
+        };
+        assert!(named(pet).contains("min_pet_s -1"));
+        let vehicle = MarginFigures {
+            min_vehicle_clearance_m: Some(f64::NAN),
+            ..MarginFigures::default()
+        };
+        assert!(named(vehicle).contains("min_vehicle_clearance_m NaN"));
     }
 }

@@ -31,7 +31,7 @@
 //!   *score* ([`Draw::score`]) is minus its failed share when it failed; otherwise `is`,
 //!   aimed at P(fails | fair), scores a fair draw 0 and an unfair one +∞ (its elite is
 //!   every fair draw until the fair failures alone fill it), and `is-fails`, aimed at
-//!   P(fails), scores a valid draw by its smallest clearance car–pedestrian. Then a final
+//!   P(fails), scores a valid draw by its smallest stopping margin. Then a final
 //!   stage from the last proposal. The estimates pool every stage's draws, rounds
 //!   included, each weighted by one over the density of the mixture of the stages'
 //!   proposals in proportion to their draws ([`proposal::Mixture`], the balance
@@ -171,6 +171,17 @@ pub struct Draw {
     pub min_clearance_m: Option<f64>,
     /// The smallest time-to-collision over them, s.
     pub min_ttc_s: Option<f64>,
+    /// The smallest stopping margin over them, m (absent from draws written before it
+    /// was kept).
+    #[serde(default)]
+    pub min_stop_margin_m: Option<f64>,
+    /// The smallest clearance car–vehicle over them, m (absent as the stopping margin).
+    #[serde(default)]
+    pub min_vehicle_clearance_m: Option<f64>,
+    /// The smallest post-encroachment time car–pedestrian over them, s (absent as the
+    /// vehicle clearance).
+    #[serde(default)]
+    pub min_pet_s: Option<f64>,
 }
 
 impl Draw {
@@ -200,8 +211,11 @@ impl Draw {
 
     /// The cross-entropy stage's score, lower nearer a failure: +∞ when rejected; minus
     /// the failed share when an episode failed. Otherwise, aiming at P(fails) (`is-fails`,
-    /// `fair_only` false), the smallest clearance car–pedestrian (+∞ without a
-    /// pedestrian); aiming at P(fails | fair) (`is`, `fair_only`), +∞ when unfair and 0
+    /// `fair_only` false), the smallest stopping margin (+∞ when the car was never on a
+    /// collision course): it falls as the car comes nearer a course it can no longer stop
+    /// short of, where the clearance and the post-encroachment time are also small when
+    /// the car yields close to a pedestrian and waits (EXPERIMENTS.md, "How rare is a
+    /// failure"); aiming at P(fails | fair) (`is`, `fair_only`), +∞ when unfair and 0
     /// when fair, so that the elite is every fair draw until the fair failures alone fill
     /// it (the levels "fair", then "fair and failed": on the jaywalk space the fair draws
     /// that came closest did not lie where the fair failures lie, EXPERIMENTS.md, "How
@@ -214,7 +228,7 @@ impl Draw {
         } else if fair_only {
             0.0
         } else {
-            self.min_clearance_m.unwrap_or(f64::INFINITY)
+            self.min_stop_margin_m.unwrap_or(f64::INFINITY)
         }
     }
 }
@@ -566,6 +580,9 @@ impl Draw {
             failed: 0,
             min_clearance_m: None,
             min_ttc_s: None,
+            min_stop_margin_m: None,
+            min_vehicle_clearance_m: None,
+            min_pet_s: None,
         };
         let Some(lines) = lines else { return draw };
         draw.fairness = lines.first().map(|l| l.fairness);
@@ -573,12 +590,19 @@ impl Draw {
             let r = &l.result;
             draw.episodes += r.episodes;
             draw.failed += (r.episodes as f64 * (1.0 - r.success_rate)).round() as u64;
-            let least = |a: Option<f64>, b: Option<f64>| match (a, b) {
-                (Some(a), Some(b)) => Some(a.min(b)),
-                (a, b) => a.or(b),
-            };
-            draw.min_clearance_m = least(draw.min_clearance_m, r.min_clearance_m);
-            draw.min_ttc_s = least(draw.min_ttc_s, r.min_ttc_s);
+            let m = &r.margins;
+            for (least, x) in [
+                (&mut draw.min_clearance_m, m.min_clearance_m),
+                (&mut draw.min_ttc_s, m.min_ttc_s),
+                (&mut draw.min_stop_margin_m, m.min_stop_margin_m),
+                (&mut draw.min_vehicle_clearance_m, m.min_vehicle_clearance_m),
+                (&mut draw.min_pet_s, m.min_pet_s),
+            ] {
+                *least = match (*least, x) {
+                    (Some(a), Some(b)) => Some(a.min(b)),
+                    (a, b) => a.or(b),
+                };
+            }
         }
         draw
     }

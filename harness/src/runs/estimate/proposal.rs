@@ -1,9 +1,9 @@
 //! The importance-sampling proposal over the space's unit cube: the uniform cube at
 //! first, then a defensive mixture (Hesterberg 1995) `q = α + (1 − α) ∏ f_d`, `α =`
 //! [`DEFENSIVE`], of one marginal per parameter (uniform, a normal truncated to [0, 1] for
-//! a range, or cell probabilities spread evenly within each cell for a count or a choice),
-//! refitted by the cross-entropy method (Rubinstein 1999) to the draws with the smallest
-//! scores. A refit moves only the marginals whose elite departs from the uniform beyond
+//! a range, or cell probabilities spread evenly within each cell for a count or a choice,
+//! each moved one itself a mixture with [`SPREAD`] of the uniform), refitted by the
+//! cross-entropy method (Rubinstein 1999) to the draws with the smallest scores. A refit moves only the marginals whose elite departs from the uniform beyond
 //! its noise ([`MOVE_Z`] standard errors, at the elite's effective size); every other
 //! parameter stays uniform, so a 17-parameter space whose failures depend on three is
 //! fitted in three (a product of 17 refitted marginals makes weights vary in every
@@ -21,7 +21,6 @@ use serde::{Deserialize, Serialize};
 use statrs::distribution::{Continuous, ContinuousCDF, Normal};
 
 use crate::runs::search::Space;
-use crate::runs::search::space::Domain;
 use unforeseen_env::seeds::episode_seed;
 
 /// The uniform share of a fitted proposal.
@@ -30,12 +29,11 @@ pub const DEFENSIVE: f64 = 0.2;
 pub const ELITE_SHARE: f64 = 0.1;
 /// Fewest elite draws (a refit waits until it has them).
 pub const MIN_ELITE: usize = 10;
-/// How far a refit moves each marginal toward the elite's (1 = all the way).
-pub const SMOOTHING: f64 = 0.7;
 /// Smallest standard deviation of a range's normal, on the unit interval.
-pub const MIN_SD: f64 = 0.05;
-/// Smallest probability of a cell.
-pub const MIN_CELL: f64 = 0.02;
+pub const MIN_SD: f64 = 0.01;
+/// The uniform share within each moved marginal: a parameter the elite moved on noise,
+/// or narrower than the failures spread, still draws over its whole range.
+pub const SPREAD: f64 = 0.2;
 /// Standard errors by which an elite's marginal must depart from the uniform for a refit
 /// to move it (its mean, its spread, or a cell's frequency).
 pub const MOVE_Z: f64 = 3.0;
@@ -49,14 +47,16 @@ const VAR_OF_VAR: f64 = 1.0 / 80.0 - 1.0 / 144.0;
 pub enum Marginal {
     /// The uniform interval (the target's own marginal: weight 1).
     Uniform,
-    /// A normal (mean, standard deviation) truncated to [0, 1].
+    /// A normal (mean, standard deviation) truncated to [0, 1], mixed with [`SPREAD`] of
+    /// the uniform interval.
     Normal {
         /// Mean, on the unit interval.
         mean: f64,
         /// Standard deviation, on the unit interval.
         sd: f64,
     },
-    /// The cells' probabilities (each spread evenly over its cell).
+    /// The cells' probabilities (each spread evenly over its cell; a fitted one holds
+    /// [`SPREAD`] of the even cells).
     Cells(Vec<f64>),
 }
 
@@ -102,12 +102,15 @@ impl Proposal {
     /// with a finite score (at least [`MIN_ELITE`]; fewer: no refit), lowest first, ties
     /// by order, and every failure (a negative score) when there are more (the multilevel
     /// method's level: the elite's threshold is the larger of the quantile and the
-    /// failure level); every draw scoring the threshold joins. A parameter's marginal moves only when the elite's weighted
-    /// marginal departs from the uniform by more than [`MOVE_Z`] standard errors at the
-    /// elite's effective size (Kish's): its mean, its variance (smaller only) or a cell's
-    /// frequency; it then moves [`SMOOTHING`] of the way from the current marginal to the
-    /// elite's weighted mean and standard deviation (or cell frequencies), floored at
-    /// [`MIN_SD`] (or [`MIN_CELL`]). Any other marginal is the uniform.
+    /// failure level); every draw scoring the threshold joins. A parameter's marginal
+    /// moves only when the elite's weighted marginal departs from the uniform by more than
+    /// [`MOVE_Z`] standard errors at the elite's effective size (Kish's): its mean, its
+    /// variance (smaller only) or a cell's frequency; it is then the elite's weighted mean
+    /// and standard deviation, floored at [`MIN_SD`] (or its cell frequencies), mixed
+    /// with [`SPREAD`] of the uniform, without smoothing toward the marginal before: a failure region that
+    /// fills 1% of a parameter's range is reached in the three rounds, where smoothing
+    /// held the proposal wide (EXPERIMENTS.md, "How rare is a failure"). Any other
+    /// marginal is the uniform.
     pub fn refit(&self, space: &Space, scored: &[Scored<'_>]) -> Proposal {
         let mut order: Vec<usize> = (0..scored.len()).filter(|&i| scored[i].2.is_finite()).collect();
         if order.len() < MIN_ELITE {
@@ -125,11 +128,8 @@ impl Proposal {
         let elite: Vec<(&[f64], f64)> = order[..n].iter().map(|&i| (scored[i].0, scored[i].1)).collect();
         let total: f64 = elite.iter().map(|e| e.1).sum();
         let n_eff = total * total / elite.iter().map(|e| e.1 * e.1).sum::<f64>();
-        let before = self.marginals.clone().unwrap_or_else(|| uniform_marginals(space));
-        let marginals: Vec<Marginal> = before
-            .into_iter()
-            .enumerate()
-            .map(|(d, m)| match space.params[d].cells() {
+        let marginals: Vec<Marginal> = (0..space.params.len())
+            .map(|d| match space.params[d].cells() {
                 None => {
                     let mu = elite.iter().map(|(x, w)| w * x[d]).sum::<f64>() / total;
                     let var = elite.iter().map(|(x, w)| w * (x[d] - mu).powi(2)).sum::<f64>() / total;
@@ -138,13 +138,9 @@ impl Proposal {
                     if z_mean.abs() <= MOVE_Z && z_var >= -MOVE_Z {
                         return Marginal::Uniform;
                     }
-                    let (mean, sd) = match m {
-                        Marginal::Normal { mean, sd } => (mean, sd),
-                        _ => (0.5, (1.0f64 / 12.0).sqrt()),
-                    };
                     Marginal::Normal {
-                        mean: SMOOTHING * mu + (1.0 - SMOOTHING) * mean,
-                        sd: (SMOOTHING * var.sqrt() + (1.0 - SMOOTHING) * sd).max(MIN_SD),
+                        mean: mu,
+                        sd: var.sqrt().max(MIN_SD),
                     }
                 }
                 Some(k) => {
@@ -157,17 +153,7 @@ impl Proposal {
                     if freq.iter().all(|f| (f - even).abs() <= noise) {
                         return Marginal::Cells(vec![even; k]);
                     }
-                    let p = match m {
-                        Marginal::Cells(p) => p,
-                        _ => vec![even; k],
-                    };
-                    let p: Vec<f64> = p
-                        .iter()
-                        .zip(freq)
-                        .map(|(pi, f)| (SMOOTHING * f + (1.0 - SMOOTHING) * pi).max(MIN_CELL))
-                        .collect();
-                    let sum: f64 = p.iter().sum();
-                    Marginal::Cells(p.into_iter().map(|x| x / sum).collect())
+                    Marginal::Cells(freq.into_iter().map(|f| SPREAD * even + (1.0 - SPREAD) * f).collect())
                 }
             })
             .collect();
@@ -215,22 +201,6 @@ impl Mixture {
     }
 }
 
-/// The marginals that start a refit: the uniform interval for a range, even cells for a
-/// count or a choice.
-fn uniform_marginals(space: &Space) -> Vec<Marginal> {
-    space
-        .params
-        .iter()
-        .map(|p| match p.domain {
-            Domain::Range(..) => Marginal::Uniform,
-            _ => {
-                let k = p.cells().unwrap_or(1);
-                Marginal::Cells(vec![1.0 / k as f64; k])
-            }
-        })
-        .collect()
-}
-
 /// The cell of coordinate `u` among `k`.
 fn cell(u: f64, k: usize) -> usize {
     ((u * k as f64).floor().max(0.0) as usize).min(k - 1)
@@ -248,7 +218,7 @@ fn marginal_density(m: &Marginal, u: f64) -> f64 {
         Marginal::Uniform => 1.0,
         Marginal::Normal { mean, sd } => {
             let (n, _, mass) = truncated(*mean, *sd);
-            n.pdf(u) / mass
+            SPREAD + (1.0 - SPREAD) * n.pdf(u) / mass
         }
         Marginal::Cells(p) => p[cell(u, p.len())] * p.len() as f64,
     }
@@ -258,10 +228,15 @@ fn marginal_draw(m: &Marginal, rng: &mut ChaCha8Rng) -> f64 {
     let u: f64 = rng.random_range(0.0..1.0);
     let x = match m {
         Marginal::Uniform => u,
-        // Inverse CDF within [0, 1].
+        // The uniform share, else the inverse CDF within [0, 1].
         Marginal::Normal { mean, sd } => {
-            let (n, lo, mass) = truncated(*mean, *sd);
-            n.inverse_cdf(lo + u * mass)
+            let v: f64 = rng.random_range(0.0..1.0);
+            if u < SPREAD {
+                v
+            } else {
+                let (n, lo, mass) = truncated(*mean, *sd);
+                n.inverse_cdf(lo + v * mass)
+            }
         }
         Marginal::Cells(p) => {
             let k = p.len();
@@ -328,28 +303,29 @@ mod tests {
 
     /// By hand: a mixture of 1 uniform draw and 3 of a proposal whose one marginal is a
     /// normal (0.5, 0.1) truncated to [0, 1]: its mass in [0, 1] is Φ(5) − Φ(−5) ≈ 1, so at
-    /// 0.5 its density is 1/(0.1 √(2π)) = 3.98942, the proposal's 0.2 + 0.8 × 3.98942 =
-    /// 3.39154, and the mixture's (1 × 1 + 3 × 3.39154)/4 = 2.79365.
+    /// 0.5 its density is 1/(0.1 √(2π)) = 3.98942, the marginal's 0.2 + 0.8 × 3.98942 =
+    /// 3.39154, the proposal's 0.2 + 0.8 × 3.39154 = 2.91323, and the mixture's (1 × 1 + 3
+    /// × 2.91323)/4 = 2.43492.
     #[test]
     fn the_mixture_density_is_the_draw_weighted_sum_by_hand() {
         let q = Proposal {
             marginals: Some(vec![Marginal::Normal { mean: 0.5, sd: 0.1 }]),
         };
-        assert!((q.density(&[0.5]) - 3.391_54).abs() < 1e-5, "{}", q.density(&[0.5]));
+        assert!((q.density(&[0.5]) - 2.913_23).abs() < 1e-5, "{}", q.density(&[0.5]));
         let mut m = Mixture::default();
         m.add(1, &Proposal::uniform());
         m.add(2, &q);
         m.add(1, &q);
         assert_eq!(m.parts.len(), 2, "the same proposal's draws are one part");
-        assert!((m.density(&[0.5]) - 2.793_65).abs() < 1e-5, "{}", m.density(&[0.5]));
-        assert!((m.weight(&[0.5]) - 1.0 / 2.793_65).abs() < 1e-5);
+        assert!((m.density(&[0.5]) - 2.434_92).abs() < 1e-5, "{}", m.density(&[0.5]));
+        assert!((m.weight(&[0.5]) - 1.0 / 2.434_92).abs() < 1e-5);
         // Truncation: the normal (0.9, 0.2) keeps Φ(0.5) − Φ(−4.5) = 0.691459 of its mass,
         // so at 0.9 its density is 1.994711/0.691459 = 2.884786.
         let t = Proposal {
             marginals: Some(vec![Marginal::Normal { mean: 0.9, sd: 0.2 }]),
         };
         assert!(
-            (t.density(&[0.9]) - (0.2 + 0.8 * 2.884_786)).abs() < 1e-5,
+            (t.density(&[0.9]) - (0.2 + 0.8 * (0.2 + 0.8 * 2.884_786))).abs() < 1e-5,
             "{}",
             t.density(&[0.9])
         );
@@ -404,9 +380,13 @@ mod tests {
             .map(|x| (x.as_slice(), 1.0, if x[0] < 0.3 { -1.0 } else { 1.0 }))
             .collect();
         let q = Proposal::uniform().refit(&space, &failing);
-        // The 30 failures' mean is 0.15: the marginal moves 0.7 of the way from 0.5.
+        // The 30 failures' mean is 0.15 and their sd 0.3/√12 (less the grid's 1/100):
+        // the marginal is theirs.
         match q.marginals.unwrap()[0] {
-            Marginal::Normal { mean, .. } => assert!((mean - (0.7 * 0.15 + 0.3 * 0.5)).abs() < 1e-9, "{mean}"),
+            Marginal::Normal { mean, sd } => {
+                let grid_sd = ((30.0f64 * 30.0 - 1.0) / 12.0).sqrt() / 100.0;
+                assert!((mean - 0.15).abs() < 1e-9 && (sd - grid_sd).abs() < 1e-9, "{mean} {sd}");
+            }
             ref m => panic!("{m:?}"),
         }
         // No failure, 60 draws tied at 0 (the fair ones, for `is`): all 60 are the elite.
@@ -415,7 +395,7 @@ mod tests {
             .map(|x| (x.as_slice(), 1.0, if x[0] >= 0.4 { 0.0 } else { f64::INFINITY }))
             .collect();
         match Proposal::uniform().refit(&space, &tied).marginals.unwrap()[0] {
-            Marginal::Normal { mean, .. } => assert!((mean - (0.7 * 0.7 + 0.3 * 0.5)).abs() < 1e-9, "{mean}"),
+            Marginal::Normal { mean, .. } => assert!((mean - 0.7).abs() < 1e-9, "{mean}"),
             ref m => panic!("{m:?}"),
         }
     }

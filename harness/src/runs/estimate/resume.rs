@@ -84,7 +84,14 @@ pub(super) fn kept_draws(
 /// seed, at most all of them failed.
 fn figures_problem(cfg: &SearchConfig<'_>, d: &Draw) -> Option<String> {
     let episodes = cfg.episodes * cfg.train_seeds.len() as u64;
-    let empty = d.fairness.is_none() && d.episodes == 0 && d.min_clearance_m.is_none() && d.min_ttc_s.is_none();
+    let margins = [
+        d.min_clearance_m,
+        d.min_ttc_s,
+        d.min_stop_margin_m,
+        d.min_vehicle_clearance_m,
+        d.min_pet_s,
+    ];
+    let empty = d.fairness.is_none() && d.episodes == 0 && margins.iter().all(Option::is_none);
     if d.rejected.is_some() {
         return (!empty || d.failed != 0).then(|| "is rejected (no valid map) yet has figures".into());
     }
