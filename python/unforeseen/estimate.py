@@ -43,9 +43,10 @@ def estimate(
     estimate`` does: by ``estimator`` (``"mc"``, plain Monte Carlo with the Wilson
     interval, or ``"is"`` / ``"is-fails"``, cross-entropy importance sampling aimed at
     P(fails | fair) / P(fails), with a weighted interval), at
-    most ``budget`` draws of ``episodes`` episodes each, stopping once both relative
-    half-widths are at most ``target_rel_error``. Agents: ``agent`` (an agent file), one
-    per training seed (``train_seeds``, trained on ``train_map``, a map file or an
+    most ``budget`` draws of ``episodes`` episodes each, stopping once the relative
+    half-width of what the estimator aims at (both probabilities for ``"mc"``, P(fails |
+    fair) for ``"is"``, P(fails) for ``"is-fails"``) is at most ``target_rel_error``.
+    Agents: ``agent`` (an agent file), one per training seed (``train_seeds``, trained on ``train_map``, a map file or an
     embedded name, for ``train_episodes`` and kept in ``cache`` when given), or, with
     neither, one trained on ``train_map`` with ``seed``. ``jobs`` threads (None: every
     core; the results do not depend on it); ``force`` replaces files in ``out`` an

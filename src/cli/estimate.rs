@@ -31,7 +31,8 @@ pub struct EstimateArgs {
     /// The estimator.
     #[arg(long, default_value_t = EstimateRequest::default().estimator, value_parser = estimator_parser())]
     pub estimator: Estimator,
-    /// Stop once both probabilities' relative half-widths are at most this, in (0, 1).
+    /// Stop once the relative half-width of what the estimator aims at is at most this, in
+    /// (0, 1): both probabilities' for mc, P(fails | fair)'s for is, P(fails)'s for is-fails.
     #[arg(long, value_name = "R", default_value_t = EstimateRequest::default().target_rel_error)]
     pub target_rel_error: f64,
     /// Most draws (points of the space evaluated); mc needs 50 at least, is and is-fails 200.

@@ -16,16 +16,18 @@
 //!   witnesses decide it ([`crate::runs::search::Fairness`]), with the same `episodes`;
 //! * `fair_share` = `E[F]`, the fair part of the space.
 //!
-//! **Estimators** ([`estimators`]), each stopping once both probabilities' relative
-//! half-widths are at most the target or the budget of draws is spent, checked after
+//! **Estimators** ([`estimators`]), each stopping once the relative half-widths of what
+//! it aims at ([`Estimates::reach`]: `mc` both probabilities, `is` P(fails | fair),
+//! `is-fails` P(fails)) are at most the target or the budget of draws is spent, checked after
 //! each block of draws (blocks of fixed sizes, so the stopping point does not depend on
 //! the threads):
 //!
 //! * **mc**: independent uniform draws; the mean with its Wilson interval, over the valid
 //!   draws and over the fair ones (conditionally on their number, the fair draws are
 //!   independent draws of the distribution restricted to the fair part).
-//! * **is**, **is-fails**: cross-entropy importance sampling. [`ROUNDS`] rounds of draws,
-//!   the first uniform, each refitting the proposal ([`proposal`]: a defensive mixture of
+//! * **is**, **is-fails**: cross-entropy importance sampling. Rounds of draws
+//!   ([`rounds`]: a tenth of the budget each, at most [`MAX_ROUNDS`] and half the budget,
+//!   fewer once the failures fill the elite), the first uniform, each refitting the proposal ([`proposal`]: a defensive mixture of
 //!   the uniform and a product of marginals, of which only those the elite departs in
 //!   move) to the elite of the draws so far, each draw weighted as below. A draw's
 //!   *score* ([`Draw::score`]) is minus its failed share when it failed; otherwise `is`,
@@ -113,8 +115,10 @@ pub use output::{EstimateIdentity, Summary};
 pub use proposal::Proposal;
 pub use request::{EstimateJob, EstimateRequest, EstimateSetup, Estimator};
 
-/// Rounds of the cross-entropy stage of `is` and `is-fails` (the first from the uniform cube).
-pub const ROUNDS: usize = 3;
+/// Most rounds of the cross-entropy stage of `is` and `is-fails` (the first from the
+/// uniform cube); the rounds stop earlier once the failures fill the elite
+/// ([`proposal::failure_level_reached`]), and take at most half the budget.
+pub const MAX_ROUNDS: usize = 5;
 /// Fewest draws of one block (one cross-entropy round, one check of the stopping rule).
 pub const MIN_BLOCK: usize = 50;
 /// Most draws one estimate may have.
@@ -279,9 +283,14 @@ impl Estimates {
         }
     }
 
-    /// Whether both probabilities reach the relative half-width `target`.
-    pub fn reach(&self, target: f64) -> bool {
-        self.p_fail.reaches(target) && self.p_fail_given_fair.reaches(target)
+    /// Whether the probabilities `estimator` aims at reach the relative half-width
+    /// `target`: both for `mc`, P(fails | fair) for `is`, P(fails) for `is-fails`.
+    pub fn reach(&self, estimator: Estimator, target: f64) -> bool {
+        match estimator {
+            Estimator::Mc => self.p_fail.reaches(target) && self.p_fail_given_fair.reaches(target),
+            Estimator::Is => self.p_fail_given_fair.reaches(target),
+            Estimator::IsFails => self.p_fail.reaches(target),
+        }
     }
 }
 
@@ -316,23 +325,20 @@ pub struct Checkpoint {
     pub p_fail_given_fair: Estimate,
 }
 
-/// The sizes of the stages of `estimator` with `budget` draws: for `mc` its blocks;
-/// for `is` and `is-fails` the cross-entropy rounds, then the final stage's blocks. Every
-/// block has at least [`MIN_BLOCK`] draws (`budget` at least [`Estimator::min_budget`]).
-pub fn blocks(estimator: Estimator, budget: usize) -> (Vec<usize>, Vec<usize>) {
-    let split = |total: usize, size: usize| {
-        let n = (total / size).max(1);
-        (0..n).map(|k| total * (k + 1) / n - total * k / n).collect::<Vec<_>>()
-    };
-    let block = (budget / 20).max(MIN_BLOCK);
-    match estimator {
-        Estimator::Mc => (Vec::new(), split(budget, block)),
-        Estimator::Is | Estimator::IsFails => {
-            let round = (budget / 10).max(MIN_BLOCK);
-            let rest = budget - ROUNDS * round;
-            (vec![round; ROUNDS], split(rest, block.min(rest)))
-        }
-    }
+/// The size of a cross-entropy round of `is` and `is-fails` with `budget` draws, and the
+/// most rounds: a tenth of the budget (at least [`MIN_BLOCK`]), at most [`MAX_ROUNDS`]
+/// rounds and half the budget.
+pub fn rounds(budget: usize) -> (usize, usize) {
+    let round = (budget / 10).max(MIN_BLOCK);
+    (round, MAX_ROUNDS.min(budget / 2 / round).max(1))
+}
+
+/// The blocks of the estimating stage (`mc`'s uniform draws, the final ones of `is` and
+/// `is-fails`): its `draws` in blocks of a twentieth of the `budget`, each at least
+/// [`MIN_BLOCK`] (`budget` at least [`Estimator::min_budget`]).
+pub fn blocks(draws: usize, budget: usize) -> Vec<usize> {
+    let n = (draws / (budget / 20).max(MIN_BLOCK)).max(1);
+    (0..n).map(|k| draws * (k + 1) / n - draws * k / n).collect()
 }
 
 /// What a run ended with.
@@ -673,11 +679,12 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
     let cfg = run.cfg;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(cfg.jobs.max(1)).build()?;
     pool.install(|| {
-        let (rounds, finals) = blocks(estimator, budget);
+        let (size, most) = rounds(budget);
+        let most = if estimator.weighted() { most } else { 0 };
         let mut draws: Vec<Draw> = Vec::new();
         let mut proposal = Proposal::uniform();
         let mut mixture = proposal::Mixture::default();
-        for (round, size) in rounds.into_iter().enumerate() {
+        for round in 0..most {
             let stage = DrawStage::Round { round };
             let range = draws.len()..draws.len() + size;
             if let Some(part) = run.shard_part(&proposal, stage, range.clone(), range.clone())? {
@@ -694,6 +701,9 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
                 })
                 .collect();
             proposal = proposal.refit(cfg.space, &scored);
+            if proposal::failure_level_reached(&scored) {
+                break;
+            }
         }
         let stage = match estimator {
             Estimator::Mc => DrawStage::Uniform,
@@ -702,7 +712,7 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
         let mut estimates = Estimates::of(estimator, &[], &mixture);
         let mut reached = false;
         let mut checkpoints = Vec::new();
-        for size in finals {
+        for size in blocks(budget - draws.len(), budget) {
             let range = draws.len()..draws.len() + size;
             if let Some(part) = run.shard_part(&proposal, stage, range.clone(), range.start..budget)? {
                 return Ok(part);
@@ -716,7 +726,7 @@ fn estimate(run: &Run<'_, '_>, estimator: Estimator, budget: usize, target: f64)
                 p_fail: estimates.p_fail.clone(),
                 p_fail_given_fair: estimates.p_fail_given_fair.clone(),
             });
-            if estimates.reach(target) {
+            if estimates.reach(estimator, target) {
                 reached = true;
                 break;
             }
@@ -876,11 +886,15 @@ mod tests {
 
     #[test]
     fn the_stages_split_the_budget() {
-        assert_eq!(blocks(Estimator::Mc, 1000), (Vec::new(), vec![50; 20]));
-        let (rounds, finals) = blocks(Estimator::Is, 1000);
-        assert_eq!(rounds, vec![100; 3]);
-        assert_eq!(finals.iter().sum::<usize>(), 700);
+        assert_eq!(blocks(1000, 1000), vec![50; 20]);
+        assert_eq!(rounds(1000), (100, 5));
+        assert_eq!(rounds(2000), (200, 5));
+        assert_eq!(rounds(200), (50, 2), "the rounds take at most half of the budget");
+        assert_eq!(blocks(100, 200), vec![50; 2]);
+        assert_eq!(blocks(700, 1000), vec![50; 14]);
+        assert_eq!(blocks(75, 200), vec![75], "one block of the rest when it is under two");
+        let finals = blocks(1470, 2000);
+        assert_eq!(finals.iter().sum::<usize>(), 1470);
         assert!(finals.iter().all(|&b| b >= MIN_BLOCK));
-        assert_eq!(blocks(Estimator::Is, 200), (vec![50; 3], vec![50]));
     }
 }

@@ -96,7 +96,7 @@ pub struct Summary {
     pub estimate_draws: usize,
     /// Episodes of the method run, over all draws (the witnesses' come on top).
     pub method_episodes: u64,
-    /// Whether both probabilities reached the target (else the budget was spent).
+    /// Whether what the estimator aims at reached the target (else the budget was spent).
     pub target_reached: bool,
     /// The proposal of the last stage (the uniform cube for `mc`).
     pub proposal: Proposal,

@@ -28,7 +28,7 @@ pub const DEFENSIVE: f64 = 0.2;
 /// Share of the scored draws that form the elite.
 pub const ELITE_SHARE: f64 = 0.1;
 /// Fewest elite draws (a refit waits until it has them).
-pub const MIN_ELITE: usize = 10;
+pub const MIN_ELITE: usize = 5;
 /// Smallest standard deviation of a range's normal, on the unit interval.
 pub const MIN_SD: f64 = 0.01;
 /// The uniform share within each moved marginal: a parameter the elite moved on noise,
@@ -118,10 +118,7 @@ impl Proposal {
         }
         order.sort_by(|&a, &b| scored[a].2.total_cmp(&scored[b].2).then(a.cmp(&b)));
         let failures = order.iter().filter(|&&i| scored[i].2 < 0.0).count();
-        let n = ((order.len() as f64 * ELITE_SHARE).ceil() as usize)
-            .max(MIN_ELITE)
-            .max(failures)
-            .min(order.len());
+        let n = quantile_size(order.len()).max(failures).min(order.len());
         // Every draw at the threshold joins (the elite is {score ≤ γ}).
         let threshold = scored[order[n - 1]].2;
         let n = order.iter().take_while(|&&i| scored[i].2 <= threshold).count();
@@ -166,6 +163,22 @@ impl Proposal {
             marginals: moved.then_some(marginals),
         }
     }
+}
+
+/// Whether the failures of `scored` fill the elite's quantile ([`ELITE_SHARE`] of the
+/// draws with a finite score, at least [`MIN_ELITE`]): the multilevel method's threshold
+/// has reached the failure level, so a refit fits the failures alone and a further round
+/// would only add draws to the same fit.
+pub fn failure_level_reached(scored: &[Scored<'_>]) -> bool {
+    let finite = scored.iter().filter(|s| s.2.is_finite()).count();
+    let failures = scored.iter().filter(|s| s.2 < 0.0).count();
+    finite >= MIN_ELITE && failures >= quantile_size(finite)
+}
+
+/// The elite's quantile among `finite` scored draws: [`ELITE_SHARE`] of them, at least
+/// [`MIN_ELITE`].
+fn quantile_size(finite: usize) -> usize {
+    ((finite as f64 * ELITE_SHARE).ceil() as usize).max(MIN_ELITE)
 }
 
 /// The proposals of an estimate's stages, each with its number of draws: the pooled draws

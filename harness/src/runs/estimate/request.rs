@@ -17,7 +17,7 @@ use crate::runs::search::{Evaluator, SearchConfig, SearchRequest, SearchSetup};
 use crate::training::TimeoutAs;
 use crate::training::seed_agents::{Agent, TrainSeeds};
 
-use super::{MAX_BUDGET, MIN_BLOCK, ROUNDS, Report};
+use super::{MAX_BUDGET, MIN_BLOCK, Report};
 
 /// An estimator of a failure probability (module doc of [`super`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -63,12 +63,12 @@ impl Estimator {
         }
     }
 
-    /// The fewest draws it runs with: one block (`mc`), or its cross-entropy rounds and
-    /// one final block (`is`).
+    /// The fewest draws it runs with: one block (`mc`), or two cross-entropy rounds and
+    /// two final blocks (`is`, `is-fails`: the rounds take at most half the budget).
     pub fn min_budget(self) -> usize {
         match self {
             Estimator::Mc => MIN_BLOCK,
-            Estimator::Is | Estimator::IsFails => (ROUNDS + 1) * MIN_BLOCK,
+            Estimator::Is | Estimator::IsFails => 4 * MIN_BLOCK,
         }
     }
 }
@@ -104,7 +104,8 @@ pub struct EstimateRequest {
     /// The estimator. Default `mc`, the one that measured narrower on the project's
     /// spaces (EXPERIMENTS.md, "How rare is a failure").
     pub estimator: Estimator,
-    /// Stop once both probabilities' relative half-widths are at most this, in (0, 1).
+    /// Stop once the relative half-width of what the estimator aims at (both probabilities
+    /// for `mc`, P(fails | fair) for `is`, P(fails) for `is-fails`) is at most this, in (0, 1).
     /// Default 0.3.
     pub target_rel_error: f64,
     /// Most draws (points of the space evaluated). Default 2000.
