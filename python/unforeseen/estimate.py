@@ -46,9 +46,9 @@ def estimate(
     most ``budget`` draws of ``episodes`` episodes each, stopping once the relative
     half-width of what the estimator aims at (both probabilities for ``"mc"``, P(fails |
     fair) for ``"is"``, P(fails) for ``"is-fails"``) is at most ``target_rel_error``.
-    Agents: ``agent`` (an agent file), one per training seed (``train_seeds``, trained on ``train_map``, a map file or an
-    embedded name, for ``train_episodes`` and kept in ``cache`` when given), or, with
-    neither, one trained on ``train_map`` with ``seed``. ``jobs`` threads (None: every
+    Agents: ``agent`` (an agent file), one per training seed (``train_seeds``, trained
+    on ``train_map``, a map file or an embedded name, for ``train_episodes`` and kept in
+    ``cache`` when given), or, with neither, one trained on ``train_map`` with ``seed``. ``jobs`` threads (None: every
     core; the results do not depend on it); ``force`` replaces files in ``out`` an
     estimate did not write.
 

@@ -3,8 +3,8 @@
 //! [`DEFENSIVE`], of one marginal per parameter (uniform, a normal truncated to [0, 1] for
 //! a range, or cell probabilities spread evenly within each cell for a count or a choice,
 //! each moved one itself a mixture with [`SPREAD`] of the uniform), refitted by the
-//! cross-entropy method (Rubinstein 1999) to the draws with the smallest scores. A refit moves only the marginals whose elite departs from the uniform beyond
-//! its noise ([`MOVE_Z`] standard errors, at the elite's effective size); every other
+//! cross-entropy method (Rubinstein 1999) to the draws with the smallest scores. A refit
+//! moves only the marginals whose elite departs from the uniform beyond its noise ([`MOVE_Z`] standard errors, at the elite's effective size); every other
 //! parameter stays uniform, so a 17-parameter space whose failures depend on three is
 //! fitted in three (a product of 17 refitted marginals makes weights vary in every
 //! dimension, noise included). The uniform part keeps every point of the cube in the
@@ -107,10 +107,10 @@ impl Proposal {
     /// [`MOVE_Z`] standard errors at the elite's effective size (Kish's): its mean, its
     /// variance (smaller only) or a cell's frequency; it is then the elite's weighted mean
     /// and standard deviation, floored at [`MIN_SD`] (or its cell frequencies), mixed
-    /// with [`SPREAD`] of the uniform, without smoothing toward the marginal before: a failure region that
-    /// fills 1% of a parameter's range is reached in the three rounds, where smoothing
-    /// held the proposal wide (EXPERIMENTS.md, "How rare is a failure"). Any other
-    /// marginal is the uniform.
+    /// with [`SPREAD`] of the uniform, without smoothing toward the marginal before: a
+    /// failure region that fills 1% of a parameter's range is reached within the rounds,
+    /// where smoothing held the proposal wide (EXPERIMENTS.md, "How rare is a failure").
+    /// Any other marginal is the uniform.
     pub fn refit(&self, space: &Space, scored: &[Scored<'_>]) -> Proposal {
         let mut order: Vec<usize> = (0..scored.len()).filter(|&i| scored[i].2.is_finite()).collect();
         if order.len() < MIN_ELITE {
@@ -411,6 +411,35 @@ mod tests {
             Marginal::Normal { mean, .. } => assert!((mean - 0.7).abs() < 1e-9, "{mean}"),
             ref m => panic!("{m:?}"),
         }
+    }
+
+    #[test]
+    fn the_failure_level_is_reached_when_the_failures_fill_the_quantile() {
+        let points: Vec<Vec<f64>> = (0..100).map(|i| vec![i as f64 / 100.0]).collect();
+        let scored = |failures: usize, finite: usize| -> Vec<Scored<'_>> {
+            points
+                .iter()
+                .enumerate()
+                .map(|(i, x)| {
+                    let score = if i < failures {
+                        -1.0
+                    } else if i < finite {
+                        1.0
+                    } else {
+                        f64::INFINITY
+                    };
+                    (x.as_slice(), 1.0, score)
+                })
+                .collect()
+        };
+        // 100 finite scores: the quantile is 10 draws.
+        assert!(!failure_level_reached(&scored(9, 100)));
+        assert!(failure_level_reached(&scored(10, 100)));
+        // 30 finite scores: 3 draws, but at least MIN_ELITE.
+        assert!(!failure_level_reached(&scored(MIN_ELITE - 1, 30)));
+        assert!(failure_level_reached(&scored(MIN_ELITE, 30)));
+        // Fewer finite scores than MIN_ELITE: no refit, no level.
+        assert!(!failure_level_reached(&scored(MIN_ELITE - 1, MIN_ELITE - 1)));
     }
 
     proptest::proptest! {
