@@ -30,11 +30,15 @@ def main() -> None:
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--reference", help="P(fails) of the reference: p,low,high")
     ap.add_argument("--reference-fair", help="P(fails | fair) of the reference: p,low,high")
+    ap.add_argument("--log", action="store_true",
+                    help="both axes on log scales (runs of unequal budgets, a rare target; "
+                         "estimates of 0 are left out)")
     args = ap.parse_args()
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     panels = [("p_fail", "P(fails)", _band(args.reference)),
@@ -43,20 +47,28 @@ def main() -> None:
         for run in args.runs:
             label, path = run.split("=", 1)
             points = json.loads(Path(path).read_text())["checkpoints"]
-            shown = [c for c in points if c[key]["p"] is not None]
+            # On log scales an estimate of 0 has no place: it is left out.
+            shown = [c for c in points if c[key]["p"] is not None and (c[key]["p"] > 0 or not args.log)]
             refused = [c["evaluations"] for c in points if c[key]["p"] is None]
+            floor = ref[0] / 8 if args.log and ref is not None else 0.0
             x = [c["evaluations"] for c in shown]
             line = ax.plot(x, [c[key]["p"] for c in shown], marker=".", label=label)[0]
             ax.fill_between(x, [c[key]["ci95_low"] for c in shown], [c[key]["ci95_high"] for c in shown],
                             color=line.get_color(), alpha=0.2)
             if refused:
-                ax.plot(refused, [0.0] * len(refused), "x", color=line.get_color(),
+                ax.plot(refused, [floor] * len(refused), "x", color=line.get_color(),
                         label=f"{label}: refused (too few effective failures or degenerate weights)")
         if ref is not None:
             ax.axhline(ref[0], color="black", lw=1, label="reference (Monte Carlo, its 95% interval grey)")
             ax.axhspan(ref[1], ref[2], color="black", alpha=0.1)
         ax.set_title(title)
         ax.set_xlabel("evaluations (draws of the space)")
+        if args.log:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+            if ref is not None:
+                ax.set_ylim(ref[0] / 10, ref[0] * 30)
         ax.set_ylabel("estimate, 95% interval")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
