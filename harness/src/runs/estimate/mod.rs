@@ -873,7 +873,7 @@ mod tests {
             };
             request("whole", false).plan().unwrap().run(&[], &NoProgress).unwrap();
             // Cancelled in the last block of 50 (for is and is-fails, in its final draws, after
-            // three rounds whose refits the resumed run redoes from the kept draws).
+            // the rounds, whose refits the resumed run redoes from the kept draws).
             let cancel = CancelAfter(Default::default(), budget as u64 - 30);
             let e = request("cut", false).plan().unwrap().run(&[], &cancel).err().unwrap();
             assert!(matches!(e, Error::Interrupted), "{e}");
